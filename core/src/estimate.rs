@@ -1,0 +1,272 @@
+//! Hardness from a press sequence, behind one trait so that learned models (ONNX) and the
+//! physics inversion are interchangeable.
+//!
+//! The physics estimator reads how much of the robot's travel the gel took. In Hertz contact
+//! each body's surface moves by its compliance share of the approach, so the gel's slope field
+//! is s * du/dr of the Hertz displacement with s = c_gel / (c_gel + c_object). From the frames
+//! it recovers the gel's surface slopes (photometric inversion against the no-contact frame),
+//! finds the contact centre, and fits the local object radius R, the approach at the first
+//! contact frame and the share s to all frames at the known arm travel. The object's modulus
+//! follows from s and the gel's modulus.
+
+use crate::frames::TactileFrame;
+use crate::hardness::Hardness;
+use crate::hertz::{Elastic, Hertz, object_modulus_from_share};
+use crate::perception::slopes::{SlopeField, recover_slopes};
+use crate::tactile_spec::TactileSpec;
+use serde::Serialize;
+
+/// What the press routine records for one object.
+#[derive(Clone, Debug)]
+pub struct PressSequence {
+    /// The no-contact frame taken just above the object.
+    pub reference: TactileFrame,
+    /// Frames from the first contact frame on, one per press step.
+    pub frames: Vec<TactileFrame>,
+    /// Arm travel of each frame past the first contact frame (mm).
+    pub travel_mm: Vec<f64>,
+}
+
+/// The evidence an estimate rests on, so that explanations can cite it.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Evidence {
+    /// Share of the approach taken by the gel, and its standard error.
+    pub gel_share: f64,
+    pub gel_share_se: f64,
+    /// Local radius of the object at the contact (mm).
+    pub local_radius_mm: f64,
+    /// Total approach of gel and object at the first contact frame (mm).
+    pub first_contact_approach_mm: f64,
+    /// Contact radius at the last frame (mm).
+    pub last_contact_radius_mm: f64,
+    /// Gel indentation at the last frame (mm).
+    pub last_gel_indentation_mm: f64,
+    pub frames_used: usize,
+    /// RMS of the slope residual after the fit.
+    pub slope_residual_rms: f64,
+    /// Poisson's ratio assumed for the object.
+    pub object_poisson: f64,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct HardnessEstimate {
+    pub hardness: Hardness,
+    /// One-standard-error interval of the modulus in MPa (upper None: not distinguishable from rigid).
+    pub modulus_interval_mpa: [Option<f64>; 2],
+    pub evidence: Evidence,
+}
+
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum EstimateError {
+    #[error("press sequence: {0}")]
+    BadSequence(String),
+    #[error("press sequence: no contact imprint in the frames")]
+    NoImprint,
+}
+
+pub trait HardnessEstimator {
+    fn name(&self) -> &str;
+    fn estimate(&self, press: &PressSequence, spec: &TactileSpec) -> Result<HardnessEstimate, EstimateError>;
+}
+
+/// Physics inversion of the Hertz compliance split (see the module docs).
+#[derive(Clone, Debug)]
+pub struct PhysicsEstimator {
+    /// Poisson's ratio assumed for the object (fruit flesh: 0.2-0.5; Mohsenin 1986).
+    pub object_poisson: f64,
+    /// Every n-th pixel in each direction enters the fit.
+    pub stride: usize,
+}
+
+impl Default for PhysicsEstimator {
+    fn default() -> Self {
+        Self { object_poisson: 0.35, stride: 3 }
+    }
+}
+
+struct Sample {
+    frame: usize,
+    r_mm: f64,
+    slope: f64,
+}
+
+impl HardnessEstimator for PhysicsEstimator {
+    fn name(&self) -> &str {
+        "physics"
+    }
+
+    fn estimate(&self, press: &PressSequence, spec: &TactileSpec) -> Result<HardnessEstimate, EstimateError> {
+        if press.frames.len() < 2 || press.frames.len() != press.travel_mm.len() {
+            return Err(EstimateError::BadSequence(format!(
+                "need at least 2 frames with one travel each, got {} frames and {} travels",
+                press.frames.len(),
+                press.travel_mm.len()
+            )));
+        }
+        if press.travel_mm.iter().any(|t| !t.is_finite()) {
+            return Err(EstimateError::BadSequence("travel must be finite".into()));
+        }
+        let fields: Vec<SlopeField> = press
+            .frames
+            .iter()
+            .map(|f| recover_slopes(&f.image, &press.reference.image, &spec.photometric))
+            .collect::<Option<_>>()
+            .ok_or_else(|| EstimateError::BadSequence("frame and reference sizes differ".into()))?;
+        let last = fields.last().expect("at least two frames");
+        let centre = radial_centre(last).ok_or(EstimateError::NoImprint)?;
+        let px = spec.mm_per_px;
+
+        let mut samples = Vec::new();
+        for (i, f) in fields.iter().enumerate() {
+            for y in (0..f.height).step_by(self.stride) {
+                for x in (0..f.width).step_by(self.stride) {
+                    let k = y * f.width + x;
+                    if !f.valid[k] {
+                        continue;
+                    }
+                    let (dx, dy) = (x as f64 - centre.0, y as f64 - centre.1);
+                    let r = dx.hypot(dy);
+                    if r < 3.0 {
+                        continue;
+                    }
+                    let slope = (f.gx[k] as f64 * dx + f.gy[k] as f64 * dy) / r;
+                    samples.push(Sample { frame: i, r_mm: r * px, slope });
+                }
+            }
+        }
+        if samples.len() < 100 {
+            return Err(EstimateError::NoImprint);
+        }
+
+        let travel = &press.travel_mm;
+        let fit = |log_r: f64, approach0: f64| -> (f64, f64) {
+            let radius = log_r.exp();
+            let mut sxy = 0.0;
+            let mut sxx = 0.0;
+            let mut syy = 0.0;
+            for s in &samples {
+                let h = Hertz { radius_mm: radius, approach_mm: approach0 + travel[s.frame], contact_modulus_mpa: 1.0 };
+                let model = h.total_displacement_slope(s.r_mm);
+                sxy += model * s.slope;
+                sxx += model * model;
+                syy += s.slope * s.slope;
+            }
+            if sxx <= 0.0 {
+                return (0.0, syy);
+            }
+            let share = sxy / sxx;
+            (share, syy - share * sxy)
+        };
+
+        // Coarse grid over ln R and the first-contact approach, then a shrinking pattern search.
+        let (mut best_lr, mut best_a0, mut best_rss) = (0.0, 0.0, f64::INFINITY);
+        for i in 0..=20 {
+            let lr = (1.0f64).ln() + i as f64 * ((400.0f64).ln() - (1.0f64).ln()) / 20.0;
+            for j in 0..=15 {
+                let a0 = 0.02 + j as f64 * 0.2;
+                let (_, rss) = fit(lr, a0);
+                if rss < best_rss {
+                    (best_lr, best_a0, best_rss) = (lr, a0, rss);
+                }
+            }
+        }
+        let (mut step_lr, mut step_a0) = (0.15, 0.1);
+        while step_a0 > 1e-4 {
+            let mut improved = false;
+            for (dl, da) in [(step_lr, 0.0), (-step_lr, 0.0), (0.0, step_a0), (0.0, -step_a0)] {
+                let (lr, a0) = (best_lr + dl, (best_a0 + da).max(1e-4));
+                let (_, rss) = fit(lr, a0);
+                if rss < best_rss {
+                    (best_lr, best_a0, best_rss) = (lr, a0, rss);
+                    improved = true;
+                }
+            }
+            if !improved {
+                step_lr *= 0.5;
+                step_a0 *= 0.5;
+            }
+        }
+        let radius = best_lr.exp();
+        let (share, rss) = fit(best_lr, best_a0);
+
+        // Standard error from the spread of per-frame shares at the fitted geometry: pixels of
+        // one frame are correlated, frames are the honest replicates.
+        let per_frame: Vec<f64> = (0..fields.len())
+            .filter_map(|i| {
+                let (mut sxy, mut sxx) = (0.0, 0.0);
+                for s in samples.iter().filter(|s| s.frame == i) {
+                    let h = Hertz { radius_mm: radius, approach_mm: best_a0 + travel[i], contact_modulus_mpa: 1.0 };
+                    let m = h.total_displacement_slope(s.r_mm);
+                    sxy += m * s.slope;
+                    sxx += m * m;
+                }
+                (sxx > 0.0).then(|| sxy / sxx)
+            })
+            .collect();
+        let n = per_frame.len() as f64;
+        let mean = per_frame.iter().sum::<f64>() / n;
+        let share_se = (per_frame.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0) / n).sqrt();
+        if !(share.is_finite() && share > 0.0) {
+            return Err(EstimateError::NoImprint);
+        }
+
+        let gel = Elastic { modulus_mpa: Some(spec.gel.modulus_mpa), poisson: spec.gel.poisson };
+        let to_modulus = |s: f64| object_modulus_from_share(gel, self.object_poisson, s.clamp(1e-6, 1.0));
+        let hardness = match to_modulus(share) {
+            Some(e) => Hardness::ModulusMpa(e),
+            None => Hardness::Rigid,
+        };
+        let last_approach = best_a0 + travel.last().copied().unwrap_or(0.0);
+        let last_hertz = Hertz { radius_mm: radius, approach_mm: last_approach, contact_modulus_mpa: 1.0 };
+        Ok(HardnessEstimate {
+            hardness,
+            modulus_interval_mpa: [to_modulus(share - share_se), to_modulus(share + share_se)],
+            evidence: Evidence {
+                gel_share: share,
+                gel_share_se: share_se,
+                local_radius_mm: radius,
+                first_contact_approach_mm: best_a0,
+                last_contact_radius_mm: last_hertz.contact_radius_mm(),
+                last_gel_indentation_mm: share.min(1.0) * last_approach,
+                frames_used: fields.len(),
+                slope_residual_rms: (rss.max(0.0) / samples.len() as f64).sqrt(),
+                object_poisson: self.object_poisson,
+            },
+        })
+    }
+}
+
+/// The point the slope field converges on: least squares of g x (p - c) = 0 over valid
+/// pixels (slopes of an axisymmetric imprint are radial). None without an imprint.
+fn radial_centre(f: &SlopeField) -> Option<(f64, f64)> {
+    let (mut a11, mut a12, mut a22, mut b1, mut b2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut weight_sum = 0.0;
+    for y in 0..f.height {
+        for x in 0..f.width {
+            let k = y * f.width + x;
+            if !f.valid[k] {
+                continue;
+            }
+            let (gx, gy) = (f.gx[k] as f64, f.gy[k] as f64);
+            let g2 = gx * gx + gy * gy;
+            // Weak slopes are mostly noise; weight by slope magnitude.
+            if g2 < 1e-4 {
+                continue;
+            }
+            let w = g2.sqrt();
+            // Row of the linear system: [gy, -gx] . c = gy x - gx y, normalised by |g|.
+            let (r1, r2, rhs) = (gy / w, -gx / w, (gy * x as f64 - gx * y as f64) / w);
+            a11 += w * r1 * r1;
+            a12 += w * r1 * r2;
+            a22 += w * r2 * r2;
+            b1 += w * r1 * rhs;
+            b2 += w * r2 * rhs;
+            weight_sum += w;
+        }
+    }
+    let det = a11 * a22 - a12 * a12;
+    if weight_sum < 1.0 || det.abs() < 1e-9 * (a11 * a22).max(1e-30) {
+        return None;
+    }
+    Some(((a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det))
+}

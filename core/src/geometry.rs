@@ -1,0 +1,125 @@
+//! Poses and pinhole camera intrinsics.
+//!
+//! World frame: origin at the table centre, x to the right of the camera image, y towards the
+//! top of the image ("back"), z up. Camera frames follow the OpenCV convention (x right,
+//! y down, z along the optical axis).
+
+use glam::{DMat3, DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+
+/// A rigid transform from a local frame to the world frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    pub position: DVec3,
+    pub rotation: DQuat,
+}
+
+impl Pose {
+    pub const IDENTITY: Pose = Pose { position: DVec3::ZERO, rotation: DQuat::IDENTITY };
+
+    pub fn new(position: DVec3, rotation: DQuat) -> Self {
+        Self { position, rotation }
+    }
+
+    /// A camera at `eye` whose optical axis points at `target`; image "down" is world -z
+    /// projected into the image plane, or world -y when looking straight down or up.
+    pub fn camera_looking_at(eye: DVec3, target: DVec3) -> Option<Self> {
+        let forward = (target - eye).try_normalize()?;
+        let mut down = DVec3::NEG_Z;
+        if down.cross(forward).length() < 1e-9 {
+            down = DVec3::NEG_Y;
+        }
+        let x = down.cross(forward).normalize();
+        let y = forward.cross(x);
+        let rotation = DQuat::from_mat3(&DMat3::from_cols(x, y, forward));
+        Some(Self { position: eye, rotation })
+    }
+
+    /// A tool pose whose z axis (the sensing direction of the tactile pad) points down, with
+    /// the pad's x axis along world x.
+    pub fn tool_down(position: DVec3) -> Self {
+        Self { position, rotation: DQuat::from_rotation_x(std::f64::consts::PI) }
+    }
+
+    pub fn transform_point(&self, p: DVec3) -> DVec3 {
+        self.rotation * p + self.position
+    }
+
+    pub fn transform_vector(&self, v: DVec3) -> DVec3 {
+        self.rotation * v
+    }
+
+    pub fn inverse(&self) -> Self {
+        let rotation = self.rotation.inverse();
+        Self { position: -(rotation * self.position), rotation }
+    }
+}
+
+/// Pinhole intrinsics (pixels). Defaults are the TactEx paper's RealSense colour stream.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CameraIntrinsics {
+    pub width: u32,
+    pub height: u32,
+    pub fx: f64,
+    pub fy: f64,
+    pub cx: f64,
+    pub cy: f64,
+}
+
+impl Default for CameraIntrinsics {
+    fn default() -> Self {
+        Self { width: 640, height: 480, fx: 608.5, fy: 606.9, cx: 309.4, cy: 213.83 }
+    }
+}
+
+impl CameraIntrinsics {
+    /// Pixel coordinates of a point in the camera frame, or None behind the camera.
+    pub fn project(&self, p: DVec3) -> Option<(f64, f64)> {
+        (p.z > 1e-9).then(|| (self.fx * p.x / p.z + self.cx, self.fy * p.y / p.z + self.cy))
+    }
+
+    /// The camera-frame point at pixel (u, v) with depth `z` along the optical axis.
+    pub fn back_project(&self, u: f64, v: f64, z: f64) -> DVec3 {
+        DVec3::new((u - self.cx) * z / self.fx, (v - self.cy) * z / self.fy, z)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn camera_looking_straight_down_maps_world_x_right_and_y_up_in_image() {
+        let cam = Pose::camera_looking_at(DVec3::new(0.0, 0.0, 0.7), DVec3::ZERO).unwrap();
+        let k = CameraIntrinsics::default();
+        let to_cam = cam.inverse();
+        let (u0, v0) = k.project(to_cam.transform_point(DVec3::ZERO)).unwrap();
+        let (u1, _) = k.project(to_cam.transform_point(DVec3::new(0.1, 0.0, 0.0))).unwrap();
+        let (_, v1) = k.project(to_cam.transform_point(DVec3::new(0.0, 0.1, 0.0))).unwrap();
+        assert!((u0 - k.cx).abs() < 1e-9 && (v0 - k.cy).abs() < 1e-9);
+        assert!(u1 > u0, "world +x must be image right");
+        assert!(v1 < v0, "world +y must be image up");
+    }
+
+    #[test]
+    fn back_projection_inverts_projection() {
+        let k = CameraIntrinsics::default();
+        let p = DVec3::new(0.03, -0.08, 0.65);
+        let (u, v) = k.project(p).unwrap();
+        assert!((k.back_project(u, v, p.z) - p).length() < 1e-12);
+    }
+
+    #[test]
+    fn pose_inverse_round_trips() {
+        let pose = Pose::new(DVec3::new(1.0, 2.0, 3.0), DQuat::from_rotation_z(0.7));
+        let p = DVec3::new(-0.3, 0.2, 0.9);
+        assert!((pose.inverse().transform_point(pose.transform_point(p)) - p).length() < 1e-12);
+    }
+
+    #[test]
+    fn tool_down_points_the_pad_at_the_table() {
+        let tool = Pose::tool_down(DVec3::new(0.0, 0.0, 0.2));
+        assert!((tool.transform_vector(DVec3::Z) - DVec3::NEG_Z).length() < 1e-12);
+        assert!((tool.transform_vector(DVec3::X) - DVec3::X).length() < 1e-12);
+    }
+}

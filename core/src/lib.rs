@@ -1,0 +1,25 @@
+//! tactex-core: everything TactEx needs that does not depend on a backend.
+//!
+//! Types (poses, intrinsics, frames), the device traits that the simulated (`tactex-sim`),
+//! real (`tactex-hw`) and replay backends implement, the fruit catalog and scene format,
+//! Hertz contact theory, perception (detection, mask refinement, centroids, tactile
+//! helpers), hardness estimation, the template explainer and the question pipeline that is
+//! generic over the device traits. Nothing in here knows which backend it runs against.
+
+pub mod catalog;
+pub mod devices;
+pub mod estimate;
+pub mod explain;
+pub mod frames;
+pub mod geometry;
+pub mod hardness;
+pub mod hertz;
+pub mod perception;
+pub mod photometric;
+pub mod pipeline;
+pub mod query;
+pub mod scene;
+pub mod tactile_spec;
+
+pub use glam;
+pub use image;

@@ -1,0 +1,151 @@
+//! The classical detector: points above the table plane (from depth), connected components,
+//! each classified by colour and size against the fruit catalog. Needs no model weights.
+
+use crate::catalog::FruitCatalog;
+use crate::frames::DepthImage;
+use crate::geometry::{CameraIntrinsics, Pose};
+use glam::DVec3;
+use image::{GrayImage, Luma, RgbImage};
+use imageproc::region_labelling::{Connectivity, connected_components};
+
+#[derive(Clone, Debug)]
+pub struct Detection {
+    pub label: String,
+    /// Classification confidence in [0, 1].
+    pub score: f64,
+    /// x0, y0, x1, y1 in pixels (inclusive).
+    pub bbox: [u32; 4],
+    pub mask: GrayImage,
+    /// Footprint extents seen from above: length, width, height (m).
+    pub size_m: [f64; 3],
+}
+
+pub struct ClassicalDetector<'a> {
+    pub catalog: &'a FruitCatalog,
+    /// Points this far above the table belong to objects.
+    pub min_height_m: f64,
+    pub min_pixels: usize,
+}
+
+impl<'a> ClassicalDetector<'a> {
+    pub fn new(catalog: &'a FruitCatalog) -> Self {
+        Self { catalog, min_height_m: 0.006, min_pixels: 150 }
+    }
+
+    pub fn detect(&self, color: &RgbImage, depth: &DepthImage, k: &CameraIntrinsics, camera: &Pose) -> Vec<Detection> {
+        let (w, h) = depth.dimensions();
+        let mut world = vec![None; (w * h) as usize];
+        let foreground = GrayImage::from_fn(w, h, |u, v| {
+            let z = depth.get_pixel(u, v)[0] as f64;
+            if z <= 0.0 || !z.is_finite() {
+                return Luma([0]);
+            }
+            let p = camera.transform_point(k.back_project(u as f64, v as f64, z));
+            world[(v * w + u) as usize] = Some(p);
+            Luma([if p.z > self.min_height_m { 255 } else { 0 }])
+        });
+        let labels = connected_components(&foreground, Connectivity::Eight, Luma([0u8]));
+        let n = labels.pixels().map(|p| p[0]).max().unwrap_or(0) as usize;
+        let mut members: Vec<Vec<(u32, u32)>> = vec![Vec::new(); n + 1];
+        for (u, v, l) in labels.enumerate_pixels() {
+            if l[0] > 0 {
+                members[l[0] as usize].push((u, v));
+            }
+        }
+        members
+            .into_iter()
+            .skip(1)
+            .filter(|m| m.len() >= self.min_pixels)
+            .filter_map(|pixels| {
+                let points: Vec<DVec3> = pixels.iter().filter_map(|(u, v)| world[(v * w + u) as usize]).collect();
+                let size_m = footprint(&points)?;
+                let chroma = mean_chromaticity(color, &pixels)?;
+                let (label, score) = self.classify(chroma, size_m)?;
+                let mut mask = GrayImage::new(w, h);
+                let mut bbox = [u32::MAX, u32::MAX, 0, 0];
+                for &(u, v) in &pixels {
+                    mask.put_pixel(u, v, Luma([255]));
+                    bbox = [bbox[0].min(u), bbox[1].min(v), bbox[2].max(u), bbox[3].max(v)];
+                }
+                Some(Detection { label, score, bbox, mask, size_m })
+            })
+            .collect()
+    }
+
+    /// Nearest catalog fruit (over all its ripeness colours) in chromaticity and log size.
+    fn classify(&self, chroma: [f64; 2], size: [f64; 3]) -> Option<(String, f64)> {
+        let mut best: Vec<(f64, &str)> = self
+            .catalog
+            .fruits
+            .iter()
+            .map(|f| {
+                let d_size = (0..3).map(|i| ((size[i] / f.size_m[i]).ln() / [0.15, 0.15, 0.25][i]).powi(2)).sum::<f64>();
+                let d = f
+                    .stages
+                    .iter()
+                    .map(|s| {
+                        let c = chromaticity(s.color);
+                        ((chroma[0] - c[0]).hypot(chroma[1] - c[1]) / 0.03).powi(2) + d_size
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                (d, f.name.as_str())
+            })
+            .collect();
+        best.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (d0, label) = *best.first()?;
+        let total: f64 = best.iter().map(|(d, _)| (-(d - d0) / 2.0).exp()).sum();
+        Some((label.to_string(), 1.0 / total))
+    }
+}
+
+fn chromaticity(rgb: [f64; 3]) -> [f64; 2] {
+    let s = (rgb[0] + rgb[1] + rgb[2]).max(1e-9);
+    [rgb[0] / s, rgb[1] / s]
+}
+
+fn mean_chromaticity(img: &RgbImage, pixels: &[(u32, u32)]) -> Option<[f64; 2]> {
+    let mut sum = [0.0; 3];
+    let mut n = 0;
+    for &(u, v) in pixels {
+        let p = img.get_pixel(u, v);
+        // Specular and very dark pixels say little about the surface colour.
+        if p.0.iter().all(|c| *c < 250) && p.0.iter().map(|c| *c as u32).sum::<u32>() > 30 {
+            for c in 0..3 {
+                sum[c] += p[c] as f64;
+            }
+            n += 1;
+        }
+    }
+    (n > 0).then(|| chromaticity(sum))
+}
+
+/// Length and width of the points' footprint on the table (2nd-98th percentile along its
+/// principal axes) and their height (98th percentile of z).
+fn footprint(points: &[DVec3]) -> Option<[f64; 3]> {
+    if points.len() < 10 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (mx, my) = (points.iter().map(|p| p.x).sum::<f64>() / n, points.iter().map(|p| p.y).sum::<f64>() / n);
+    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
+    for p in points {
+        let (dx, dy) = (p.x - mx, p.y - my);
+        sxx += dx * dx;
+        syy += dy * dy;
+        sxy += dx * dy;
+    }
+    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let (c, s) = (angle.cos(), angle.sin());
+    let spread = |f: &dyn Fn(&DVec3) -> f64| {
+        let mut v: Vec<f64> = points.iter().map(f).collect();
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+        at(0.98) - at(0.02)
+    };
+    let length = spread(&|p| (p.x - mx) * c + (p.y - my) * s) / 0.96;
+    let width = spread(&|p| -(p.x - mx) * s + (p.y - my) * c) / 0.96;
+    let mut z: Vec<f64> = points.iter().map(|p| p.z).collect();
+    z.sort_by(f64::total_cmp);
+    let height = z[((z.len() - 1) as f64 * 0.98).round() as usize];
+    Some([length.max(width), length.min(width), height])
+}

@@ -1,0 +1,95 @@
+//! Marker dots on a tactile image: detection (dark blobs against the local background),
+//! tracking against a reference frame, and the displacement statistic of the contact test.
+
+use image::{GrayImage, Luma, RgbImage};
+use imageproc::region_labelling::{Connectivity, connected_components};
+
+/// Marker centroids in pixels (x, y), darkness-weighted, sorted by row then column.
+pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
+    let (w, h) = img.dimensions();
+    let lum = GrayImage::from_fn(w, h, |x, y| {
+        let p = img.get_pixel(x, y);
+        Luma([((p[0] as u32 * 54 + p[1] as u32 * 183 + p[2] as u32 * 19) >> 8) as u8])
+    });
+    // Local background over a window a few marker diameters wide.
+    let background = imageproc::filter::box_filter(&lum, 9, 9);
+    let dark = GrayImage::from_fn(w, h, |x, y| {
+        let (l, b) = (lum.get_pixel(x, y)[0] as f64, background.get_pixel(x, y)[0] as f64);
+        Luma([if l < 0.6 * b { 255 } else { 0 }])
+    });
+    let labels = connected_components(&dark, Connectivity::Eight, Luma([0u8]));
+    let n = labels.pixels().map(|p| p[0]).max().unwrap_or(0) as usize;
+    let mut acc = vec![(0.0f64, 0.0f64, 0.0f64, 0usize); n + 1];
+    for (x, y, l) in labels.enumerate_pixels() {
+        let id = l[0] as usize;
+        if id > 0 {
+            let weight = (background.get_pixel(x, y)[0] as f64 - lum.get_pixel(x, y)[0] as f64).max(1.0);
+            let a = &mut acc[id];
+            a.0 += weight * x as f64;
+            a.1 += weight * y as f64;
+            a.2 += weight;
+            a.3 += 1;
+        }
+    }
+    let mut out: Vec<(f64, f64)> = acc
+        .iter()
+        .skip(1)
+        .filter(|a| (6..=600).contains(&a.3))
+        .map(|a| (a.0 / a.2, a.1 / a.2))
+        .collect();
+    out.sort_by(|p, q| (p.1.round(), p.0).partial_cmp(&(q.1.round(), q.0)).unwrap_or(std::cmp::Ordering::Equal));
+    out
+}
+
+/// For each reference marker, its displacement to the nearest current marker within
+/// `max_px`, or None when it was lost.
+pub fn track(reference: &[(f64, f64)], current: &[(f64, f64)], max_px: f64) -> Vec<Option<(f64, f64)>> {
+    reference
+        .iter()
+        .map(|r| {
+            current
+                .iter()
+                .map(|c| (c.0 - r.0, c.1 - r.1))
+                .filter(|d| d.0.hypot(d.1) <= max_px)
+                .min_by(|a, b| a.0.hypot(a.1).total_cmp(&b.0.hypot(b.1)))
+        })
+        .collect()
+}
+
+/// Tracking noise floor: displacements below this are taken as the marker not moving.
+pub const MARKER_NOISE_FLOOR_PX: f64 = 0.5;
+
+/// Mean displacement of the markers that moved beyond the noise floor (0 if none did): the
+/// "mean marker displacement" of the contact test, taken over the markers the contact moves
+/// rather than the whole grid, so that it does not shrink with the pad's size.
+pub fn mean_moved_displacement(displacements: &[Option<(f64, f64)>]) -> f64 {
+    let moved: Vec<f64> = displacements.iter().flatten().map(|d| d.0.hypot(d.1)).filter(|m| *m > MARKER_NOISE_FLOOR_PX).collect();
+    if moved.is_empty() { 0.0 } else { moved.iter().sum::<f64>() / moved.len() as f64 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use image::Rgb;
+
+    fn dots(centres: &[(f64, f64)]) -> RgbImage {
+        RgbImage::from_fn(120, 90, |x, y| {
+            let inside = centres.iter().any(|c| (x as f64 - c.0).hypot(y as f64 - c.1) <= 3.0);
+            if inside { Rgb([30, 30, 30]) } else { Rgb([170, 150, 140]) }
+        })
+    }
+
+    #[test]
+    fn finds_and_tracks_dots() {
+        let rest = [(20.0, 20.0), (60.0, 20.0), (100.0, 20.0), (20.0, 60.0), (60.0, 60.0)];
+        let found = detect_markers(&dots(&rest));
+        assert_eq!(found.len(), rest.len());
+        for (f, r) in found.iter().zip(&rest) {
+            assert!((f.0 - r.0).hypot(f.1 - r.1) < 0.3, "{f:?} vs {r:?}");
+        }
+        let moved: Vec<_> = rest.iter().map(|r| (r.0 + 3.0, r.1 - 1.0)).collect();
+        let d = track(&found, &detect_markers(&dots(&moved)), 8.0);
+        assert!(d.iter().all(|d| d.is_some_and(|d| (d.0 - 3.0).abs() < 0.3 && (d.1 + 1.0).abs() < 0.3)));
+        assert!((mean_moved_displacement(&d) - 10f64.sqrt()).abs() < 0.3);
+    }
+}

@@ -1,0 +1,10 @@
+//! Perception on device frames: RGB-D grounding (detection, mask refinement, depth median,
+//! centroids) and tactile helpers (SSIM, markers, surface slopes). All of it works on real
+//! frames as well as on the twin's.
+
+pub mod centroid;
+pub mod detect;
+pub mod markers;
+pub mod mask;
+pub mod slopes;
+pub mod ssim;

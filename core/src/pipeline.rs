@@ -1,0 +1,304 @@
+//! One question, end to end, generic over the device traits: parse -> ground -> press ->
+//! hardness -> explain. Every stage reports its wall time and the robot's (simulated) time.
+
+use crate::catalog::FruitCatalog;
+use crate::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
+use crate::estimate::{Evidence, HardnessEstimator, PressSequence};
+use crate::explain::{self, Measured, location_words};
+use crate::geometry::Pose;
+use crate::hardness::HardnessReport;
+use crate::perception::centroid::{back_project_mask, median_depth, median_point};
+use crate::perception::detect::ClassicalDetector;
+use crate::perception::markers::{detect_markers, mean_moved_displacement, track};
+use crate::perception::mask::refine_mask;
+use crate::perception::ssim::ssim_rgb;
+use crate::query::{self, Query, QueryError};
+use glam::DVec3;
+use serde::Serialize;
+use std::time::Instant;
+
+#[derive(Clone, Debug)]
+pub struct PipelineConfig {
+    /// Depth frames whose per-pixel median feeds the centroids (the paper: 10).
+    pub depth_frames: usize,
+    /// Frames recorded from the first contact on (the paper: 8) and the step between them.
+    pub press_frames: usize,
+    pub press_step_mm: f64,
+    /// Contact test: SSIM to the no-contact frame at most this, and mean marker displacement
+    /// above `contact_marker_px`.
+    pub contact_ssim: f64,
+    pub contact_marker_px: f64,
+    /// The search for contact starts this far above the surface the camera saw, and gives up
+    /// after `max_search_mm` of descent.
+    pub approach_clearance_mm: f64,
+    pub max_search_mm: f64,
+    pub safe_height_m: f64,
+    pub travel_speed_m_s: f64,
+    pub press_speed_m_s: f64,
+    /// Record wall-clock times (off for byte-reproducible output).
+    pub measure_wall_time: bool,
+}
+
+impl Default for PipelineConfig {
+    fn default() -> Self {
+        Self {
+            depth_frames: 10,
+            press_frames: 8,
+            press_step_mm: 0.25,
+            contact_ssim: 0.96,
+            contact_marker_px: 2.0,
+            approach_clearance_mm: 4.0,
+            max_search_mm: 20.0,
+            safe_height_m: 0.20,
+            travel_speed_m_s: 0.15,
+            press_speed_m_s: 0.005,
+            measure_wall_time: true,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    #[error(transparent)]
+    Query(#[from] QueryError),
+    #[error(transparent)]
+    Device(#[from] DeviceError),
+    #[error("camera: {0}")]
+    Camera(String),
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StageTiming {
+    pub stage: String,
+    pub wall_ms: Option<f64>,
+    pub sim_s: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectReport {
+    pub label: String,
+    pub detection_score: f64,
+    /// Centre estimate: x, y of the refined-mask centroid, z half the top height (it rests on
+    /// the table).
+    pub position_m: [f64; 3],
+    /// The paper's centroid: median of the refined mask's back-projected points.
+    pub surface_centroid_m: [f64; 3],
+    pub location: String,
+    pub hardness: Option<HardnessReport>,
+    pub modulus_interval_mpa: [Option<f64>; 2],
+    pub ripeness: Option<String>,
+    pub evidence: Option<Evidence>,
+    /// Press facts: travel from the search start to the first contact frame, and the contact
+    /// test's values there.
+    pub contact_search_mm: Option<f64>,
+    pub contact_ssim: Option<f64>,
+    pub contact_marker_px: Option<f64>,
+    pub warnings: Vec<String>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Answer {
+    pub query: Query,
+    pub objects: Vec<ObjectReport>,
+    pub selected: Vec<usize>,
+    pub answer: String,
+    pub not_found: Vec<String>,
+    pub estimator: String,
+    pub timing: Vec<StageTiming>,
+}
+
+/// The devices one question runs on.
+pub struct Devices<'a, C: RgbdCamera, T: TactileSensor, A: Arm> {
+    pub camera: &'a mut C,
+    pub tactile: &'a mut T,
+    pub arm: &'a mut A,
+}
+
+struct Target {
+    label: String,
+    score: f64,
+    centre: DVec3,
+    surface: DVec3,
+    touch: DVec3,
+}
+
+struct Press {
+    sequence: PressSequence,
+    search_mm: f64,
+    ssim: f64,
+    marker_px: f64,
+}
+
+pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
+    prompt: &str,
+    catalog: &FruitCatalog,
+    devices: Devices<'_, C, T, A>,
+    estimator: &dyn HardnessEstimator,
+    config: &PipelineConfig,
+) -> Result<Answer, PipelineError> {
+    let Devices { camera, tactile, arm } = devices;
+    let mut timing = Vec::new();
+    let mut lap = |stage: &str, arm: &A, start: (Instant, Option<f64>)| {
+        timing.push(StageTiming {
+            stage: stage.into(),
+            wall_ms: config.measure_wall_time.then(|| start.0.elapsed().as_secs_f64() * 1e3),
+            sim_s: arm.sim_time_s().zip(start.1).map(|(now, then)| now - then),
+        });
+    };
+    let start = |arm: &A| (Instant::now(), arm.sim_time_s());
+
+    let t = start(arm);
+    let query = query::parse(prompt, catalog)?;
+    lap("parse", arm, t);
+
+    let t = start(arm);
+    let targets = ground(&query, catalog, camera, config)?;
+    lap("ground", arm, t);
+    let not_found: Vec<String> = query.targets.iter().filter(|k| !targets.iter().any(|t| &t.label == *k)).cloned().collect();
+
+    let t = start(arm);
+    let mut presses = Vec::new();
+    for target in &targets {
+        presses.push(press(target, tactile, arm, config)?);
+    }
+    lap("press", arm, t);
+
+    let t = start(arm);
+    let mut objects = Vec::new();
+    for (target, pressed) in targets.iter().zip(&presses) {
+        let mut report = ObjectReport {
+            label: target.label.clone(),
+            detection_score: target.score,
+            position_m: target.centre.to_array(),
+            surface_centroid_m: target.surface.to_array(),
+            location: location_words(target.centre.x, target.centre.y),
+            hardness: None,
+            modulus_interval_mpa: [None, None],
+            ripeness: None,
+            evidence: None,
+            contact_search_mm: None,
+            contact_ssim: None,
+            contact_marker_px: None,
+            warnings: Vec::new(),
+        };
+        match pressed {
+            Ok(p) => {
+                report.contact_search_mm = Some(p.search_mm);
+                report.contact_ssim = Some(p.ssim);
+                report.contact_marker_px = Some(p.marker_px);
+                match estimator.estimate(&p.sequence, tactile.spec()) {
+                    Ok(est) => {
+                        report.hardness = Some(est.hardness.into());
+                        report.modulus_interval_mpa = est.modulus_interval_mpa;
+                        report.ripeness = catalog
+                            .get(&target.label)
+                            .filter(|f| f.has_ripeness())
+                            .map(|f| f.stage_for_modulus(est.hardness.modulus_mpa()).name.clone());
+                        report.evidence = Some(est.evidence);
+                    }
+                    Err(e) => report.warnings.push(e.to_string()),
+                }
+            }
+            Err(w) => report.warnings.push(w.clone()),
+        }
+        objects.push(report);
+    }
+    lap("hardness", arm, t);
+
+    let t = start(arm);
+    let measured: Vec<Measured> = objects
+        .iter()
+        .map(|o| Measured {
+            label: o.label.clone(),
+            location: o.location.clone(),
+            hardness: o.hardness,
+            modulus_interval_mpa: o.modulus_interval_mpa,
+            ripeness: o.ripeness.clone(),
+        })
+        .collect();
+    let selected = explain::select(&query, &measured, catalog);
+    let text = explain::explain(&query, &measured, &selected, &not_found);
+    lap("explain", arm, t);
+
+    Ok(Answer { query, objects, selected, answer: text, not_found, estimator: estimator.name().into(), timing })
+}
+
+/// Detections for the query's targets, with refined-mask centroids from the depth median.
+fn ground<C: RgbdCamera>(query: &Query, catalog: &FruitCatalog, camera: &mut C, config: &PipelineConfig) -> Result<Vec<Target>, PipelineError> {
+    let frames = (0..config.depth_frames.max(1)).map(|_| camera.capture()).collect::<Result<Vec<_>, _>>()?;
+    let depths: Vec<_> = frames.iter().map(|f| &f.depth_m).collect();
+    let depth = median_depth(&depths).ok_or_else(|| PipelineError::Camera(format!("{}: depth frames differ in size", camera.name())))?;
+    let (k, pose) = (camera.intrinsics(), camera.pose());
+    let detector = ClassicalDetector::new(catalog);
+    let mut targets: Vec<Target> = detector
+        .detect(&frames[0].color, &depth, &k, &pose)
+        .into_iter()
+        .filter(|d| query.wants(&d.label))
+        .filter_map(|d| {
+            let inner = refine_mask(&d.mask);
+            let mut points = back_project_mask(&inner, &depth, &k, &pose);
+            if points.len() < 20 {
+                points = back_project_mask(&d.mask, &depth, &k, &pose);
+            }
+            let surface = median_point(&points)?;
+            let mut heights: Vec<f64> = points.iter().map(|p| p.z).collect();
+            heights.sort_by(f64::total_cmp);
+            let top = heights[((heights.len() - 1) as f64 * 0.98).round() as usize];
+            // Press where the object is: the mask point nearest the centroid.
+            let touch = *points
+                .iter()
+                .min_by(|a, b| a.truncate().distance(surface.truncate()).total_cmp(&b.truncate().distance(surface.truncate())))?;
+            Some(Target { label: d.label, score: d.score, centre: DVec3::new(surface.x, surface.y, top / 2.0), surface, touch })
+        })
+        .collect();
+    // A stable order: left to right, then front to back.
+    targets.sort_by(|a, b| (a.centre.x, a.centre.y).partial_cmp(&(b.centre.x, b.centre.y)).unwrap_or(std::cmp::Ordering::Equal));
+    Ok(targets)
+}
+
+/// Above the target, descend until the contact test fires, record the press frames, retract.
+/// A press that finds no contact is a warning for that object, not a failure of the question.
+fn press<T: TactileSensor, A: Arm>(target: &Target, tactile: &mut T, arm: &mut A, config: &PipelineConfig) -> Result<Result<Press, String>, PipelineError> {
+    let above = |z: f64| Pose::tool_down(DVec3::new(target.touch.x, target.touch.y, z));
+    let safe = above(target.touch.z + config.safe_height_m);
+    arm.move_linear(&safe, config.travel_speed_m_s)?;
+    let start_z = target.touch.z + config.approach_clearance_mm * 1e-3;
+    arm.move_linear(&above(start_z), config.travel_speed_m_s)?;
+    let reference = tactile.capture()?;
+    let spec = tactile.spec().clone();
+    let pitch_px = spec.markers.pitch_mm / spec.mm_per_px;
+    let reference_markers = detect_markers(&reference.image);
+
+    let step_m = config.press_step_mm * 1e-3;
+    let max_steps = (config.max_search_mm / config.press_step_mm).ceil() as usize;
+    let mut found = None;
+    for i in 1..=max_steps {
+        arm.move_linear(&above(start_z - i as f64 * step_m), config.press_speed_m_s)?;
+        let frame = tactile.capture()?;
+        let ssim = ssim_rgb(&frame.image, &reference.image).unwrap_or(1.0);
+        let moved = mean_moved_displacement(&track(&reference_markers, &detect_markers(&frame.image), 0.45 * pitch_px));
+        if ssim <= config.contact_ssim && moved > config.contact_marker_px {
+            found = Some((i, frame, ssim, moved));
+            break;
+        }
+    }
+    let Some((contact_step, first, ssim, moved)) = found else {
+        arm.move_linear(&safe, config.travel_speed_m_s)?;
+        return Ok(Err(format!("no contact within {} mm of descent", config.max_search_mm)));
+    };
+    let contact_z = arm.pose()?.position.z;
+    let mut frames = vec![first];
+    let mut travel_mm = vec![0.0];
+    for j in 1..config.press_frames {
+        arm.move_linear(&above(start_z - (contact_step + j) as f64 * step_m), config.press_speed_m_s)?;
+        frames.push(tactile.capture()?);
+        travel_mm.push((contact_z - arm.pose()?.position.z) * 1e3);
+    }
+    arm.move_linear(&safe, config.travel_speed_m_s)?;
+    Ok(Ok(Press {
+        sequence: PressSequence { reference, frames, travel_mm },
+        search_mm: contact_step as f64 * config.press_step_mm,
+        ssim,
+        marker_px: moved,
+    }))
+}

@@ -1,0 +1,343 @@
+//! Scene files (TOML): the camera, the table and the objects resting on it.
+//!
+//! ```toml
+//! name = "demo"
+//! [camera]                       # optional; defaults: paper intrinsics, looking straight down
+//! position_m = [0.0, 0.0, 0.70]
+//! look_at_m = [0.0, 0.0, 0.0]
+//! [[objects]]
+//! kind = "banana"                # catalog fruit, or "sphere" | "ellipsoid" | "box" | "mesh"
+//! position_m = [0.12, -0.05]     # x, y on the table; the object rests on it
+//! yaw_deg = 30                   # optional
+//! ripeness = "ripe"              # optional: a catalog stage
+//! hardness = "35A"               # optional, overrides ripeness; or modulus_mpa = 0.8
+//! ```
+//! Every error names the file and the field (`objects[2].ripeness`).
+
+use crate::catalog::{FruitCatalog, FruitShape};
+use crate::geometry::{CameraIntrinsics, Pose};
+use crate::hardness::Hardness;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("{path}: {field}: {message}")]
+pub struct SceneError {
+    pub path: String,
+    pub field: String,
+    pub message: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum ObjectKind {
+    Fruit { name: String, shape: FruitShape, size_m: [f64; 3] },
+    Sphere { radius_m: f64 },
+    Ellipsoid { radii_m: [f64; 3] },
+    Box { size_m: [f64; 3] },
+    Mesh { path: PathBuf, scale: f64 },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SceneObject {
+    /// The catalog name for fruits, the kind otherwise (or the scene's `label`).
+    pub label: String,
+    pub kind: ObjectKind,
+    pub position_m: [f64; 2],
+    pub yaw_deg: f64,
+    pub hardness: Hardness,
+    pub ripeness: Option<String>,
+    /// sRGB in [0, 1].
+    pub color: [f64; 3],
+    pub poisson: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Table {
+    pub size_m: [f64; 2],
+    pub color: [f64; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Scene {
+    pub name: String,
+    pub path: PathBuf,
+    pub camera_pose: Pose,
+    pub intrinsics: CameraIntrinsics,
+    pub table: Table,
+    pub objects: Vec<SceneObject>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScene {
+    name: String,
+    camera: Option<RawCamera>,
+    table: Option<RawTable>,
+    #[serde(default)]
+    objects: Vec<RawObject>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCamera {
+    position_m: Option<[f64; 3]>,
+    look_at_m: Option<[f64; 3]>,
+    intrinsics: Option<CameraIntrinsics>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTable {
+    size_m: Option<[f64; 2]>,
+    color: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawObject {
+    kind: String,
+    position_m: Vec<f64>,
+    yaw_deg: Option<f64>,
+    ripeness: Option<String>,
+    hardness: Option<String>,
+    modulus_mpa: Option<f64>,
+    radius_m: Option<f64>,
+    radii_m: Option<[f64; 3]>,
+    size_m: Option<[f64; 3]>,
+    mesh: Option<String>,
+    scale: Option<f64>,
+    color: Option<[f64; 3]>,
+    label: Option<String>,
+    poisson: Option<f64>,
+}
+
+pub const DEFAULT_TABLE_SIZE_M: [f64; 2] = [0.60, 0.44];
+const DEFAULT_TABLE_COLOR: [f64; 3] = [0.62, 0.60, 0.56];
+const DEFAULT_OBJECT_COLOR: [f64; 3] = [0.70, 0.70, 0.72];
+const DEFAULT_POISSON: f64 = 0.35;
+
+impl Scene {
+    pub fn load(path: &Path, catalog: &FruitCatalog) -> Result<Scene, SceneError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+            path: shown.clone(),
+            field: "file".into(),
+            message: format!("cannot read scene: {e}"),
+        })?;
+        Self::parse(&text, path, catalog)
+    }
+
+    /// Parses scene text; `path` names the file in errors and anchors relative mesh paths.
+    pub fn parse(text: &str, path: &Path, catalog: &FruitCatalog) -> Result<Scene, SceneError> {
+        let shown = path.display().to_string();
+        let err = |field: &str, message: String| SceneError { path: shown.clone(), field: field.to_string(), message };
+        let raw: RawScene = toml::from_str(text).map_err(|e| {
+            let line = e.span().map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+            let field = line.map_or("toml".to_string(), |l| format!("line {l}"));
+            err(&field, format!("malformed TOML: {}", e.message().trim()))
+        })?;
+
+        let (camera_pose, intrinsics) = Self::camera(raw.camera, &err)?;
+        let table = Table {
+            size_m: raw.table.as_ref().and_then(|t| t.size_m).unwrap_or(DEFAULT_TABLE_SIZE_M),
+            color: raw.table.as_ref().and_then(|t| t.color).unwrap_or(DEFAULT_TABLE_COLOR),
+        };
+        if table.size_m.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(err("table.size_m", "must be finite and positive".into()));
+        }
+        check_color(&table.color).map_err(|m| err("table.color", m))?;
+
+        let base = path.parent().unwrap_or(Path::new("."));
+        let objects = raw
+            .objects
+            .into_iter()
+            .enumerate()
+            .map(|(i, o)| Self::object(i, o, &table, base, catalog, &err))
+            .collect::<Result<Vec<_>, _>>()?;
+        if objects.is_empty() {
+            return Err(err("objects", "the scene has no objects".into()));
+        }
+        Ok(Scene { name: raw.name, path: path.to_path_buf(), camera_pose, intrinsics, table, objects })
+    }
+
+    fn camera(
+        raw: Option<RawCamera>,
+        err: &impl Fn(&str, String) -> SceneError,
+    ) -> Result<(Pose, CameraIntrinsics), SceneError> {
+        let raw = raw.unwrap_or(RawCamera { position_m: None, look_at_m: None, intrinsics: None });
+        let eye = raw.position_m.unwrap_or([0.0, 0.0, 0.70]);
+        let target = raw.look_at_m.unwrap_or([0.0, 0.0, 0.0]);
+        if eye.iter().chain(&target).any(|v| !v.is_finite()) {
+            return Err(err("camera", "position_m and look_at_m must be finite".into()));
+        }
+        let pose = Pose::camera_looking_at(DVec3::from_array(eye), DVec3::from_array(target))
+            .ok_or_else(|| err("camera.look_at_m", "must differ from camera.position_m".into()))?;
+        let k = raw.intrinsics.unwrap_or_default();
+        let finite = [k.fx, k.fy, k.cx, k.cy].iter().all(|v| v.is_finite());
+        if !finite || k.fx <= 0.0 || k.fy <= 0.0 || k.width == 0 || k.height == 0 || k.width > 8192 || k.height > 8192 {
+            return Err(err("camera.intrinsics", "need 0 < width, height <= 8192 and finite fx, fy > 0, cx, cy".into()));
+        }
+        Ok((pose, k))
+    }
+
+    fn object(
+        i: usize,
+        o: RawObject,
+        table: &Table,
+        base: &Path,
+        catalog: &FruitCatalog,
+        err: &impl Fn(&str, String) -> SceneError,
+    ) -> Result<SceneObject, SceneError> {
+        let field = |name: &str| format!("objects[{i}].{name}");
+        let positive = |name: &str, v: f64| -> Result<f64, SceneError> {
+            if v.is_finite() && v > 0.0 { Ok(v) } else { Err(err(&field(name), format!("must be finite and positive, got {v}"))) }
+        };
+        let need = |name: &str, v: Option<f64>| v.ok_or_else(|| err(&field(name), format!("required for kind '{}'", o.kind)));
+        let need3 = |name: &str, v: Option<[f64; 3]>| -> Result<[f64; 3], SceneError> {
+            let v = v.ok_or_else(|| err(&field(name), format!("required for kind '{}'", o.kind)))?;
+            for x in v {
+                positive(name, x)?;
+            }
+            Ok(v)
+        };
+
+        let [x, y] = <[f64; 2]>::try_from(o.position_m.as_slice())
+            .map_err(|_| err(&field("position_m"), format!("expected [x, y] in metres, got {} numbers", o.position_m.len())))?;
+        if !(x.is_finite() && y.is_finite()) {
+            return Err(err(&field("position_m"), format!("must be finite, got [{x}, {y}]")));
+        }
+        let [hx, hy] = [table.size_m[0] / 2.0, table.size_m[1] / 2.0];
+        if x.abs() > hx || y.abs() > hy {
+            return Err(err(&field("position_m"), format!("[{x}, {y}] is off the table (|x| <= {hx}, |y| <= {hy})")));
+        }
+        let yaw_deg = o.yaw_deg.unwrap_or(0.0);
+        if !yaw_deg.is_finite() {
+            return Err(err(&field("yaw_deg"), "must be finite".into()));
+        }
+        if let Some(c) = &o.color {
+            check_color(c).map_err(|m| err(&field("color"), m))?;
+        }
+        let poisson = o.poisson.unwrap_or(DEFAULT_POISSON);
+        if !(poisson.is_finite() && (0.0..0.5).contains(&poisson)) {
+            return Err(err(&field("poisson"), format!("must lie in [0, 0.5), got {poisson}")));
+        }
+        let explicit_hardness = match (&o.hardness, o.modulus_mpa) {
+            (Some(_), Some(_)) => return Err(err(&field("hardness"), "give hardness or modulus_mpa, not both".into())),
+            (Some(h), None) => Some(Hardness::parse(h).map_err(|e| err(&field("hardness"), e.to_string()))?),
+            (None, Some(e)) => Some(Hardness::from_modulus_mpa(e).map_err(|e| err(&field("modulus_mpa"), e.to_string()))?),
+            (None, None) => None,
+        };
+
+        let kind_name = o.kind.to_ascii_lowercase();
+        let (kind, label, hardness, ripeness, color) = match kind_name.as_str() {
+            "sphere" | "ellipsoid" | "box" | "mesh" => {
+                if o.ripeness.is_some() {
+                    return Err(err(&field("ripeness"), format!("only catalog fruits have ripeness stages, not '{kind_name}'")));
+                }
+                let kind = match kind_name.as_str() {
+                    "sphere" => ObjectKind::Sphere { radius_m: positive("radius_m", need("radius_m", o.radius_m)?)? },
+                    "ellipsoid" => ObjectKind::Ellipsoid { radii_m: need3("radii_m", o.radii_m)? },
+                    "box" => ObjectKind::Box { size_m: need3("size_m", o.size_m)? },
+                    _ => {
+                        let rel = o.mesh.as_ref().ok_or_else(|| err(&field("mesh"), "required for kind 'mesh'".into()))?;
+                        let path = base.join(rel);
+                        if !path.is_file() {
+                            return Err(err(&field("mesh"), format!("mesh file '{}' not found", path.display())));
+                        }
+                        ObjectKind::Mesh { path, scale: positive("scale", o.scale.unwrap_or(1.0))? }
+                    }
+                };
+                let hardness = explicit_hardness
+                    .ok_or_else(|| err(&field("hardness"), format!("required for kind '{kind_name}' (or modulus_mpa)")))?;
+                (kind, o.label.clone().unwrap_or(kind_name.clone()), hardness, None, o.color.unwrap_or(DEFAULT_OBJECT_COLOR))
+            }
+            _ => {
+                let fruit = catalog.find_word(&kind_name).ok_or_else(|| {
+                    err(&field("kind"), format!("unknown kind '{}' (known: sphere, ellipsoid, box, mesh, {})", o.kind, catalog.names().join(", ")))
+                })?;
+                let stage_name = o.ripeness.clone().unwrap_or(fruit.default_stage.clone());
+                let stage = fruit.stage(&stage_name).ok_or_else(|| {
+                    let known: Vec<_> = fruit.stages.iter().map(|s| s.name.as_str()).collect();
+                    err(&field("ripeness"), format!("unknown ripeness stage '{stage_name}' for {} (known: {})", fruit.name, known.join(", ")))
+                })?;
+                let hardness = explicit_hardness.unwrap_or(Hardness::ModulusMpa(stage.modulus_mpa));
+                // The stage the fruit is in follows its stiffness when the scene overrides it.
+                let ripeness = fruit.stage_for_modulus(hardness.modulus_mpa()).name.clone();
+                let color = o.color.unwrap_or(fruit.stage(&ripeness).map_or(stage.color, |s| s.color));
+                let kind = ObjectKind::Fruit { name: fruit.name.clone(), shape: fruit.shape, size_m: fruit.size_m };
+                (kind, fruit.name.clone(), hardness, Some(ripeness), color)
+            }
+        };
+        Ok(SceneObject { label, kind, position_m: [x, y], yaw_deg, hardness, ripeness, color, poisson })
+    }
+}
+
+fn check_color(c: &[f64; 3]) -> Result<(), String> {
+    if c.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)) { Ok(()) } else { Err(format!("must be [r, g, b] in [0, 1], got {c:?}")) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Scene, SceneError> {
+        Scene::parse(text, Path::new("t.toml"), &FruitCatalog::builtin())
+    }
+
+    #[test]
+    fn the_documented_shape_loads() {
+        let s = parse(
+            r#"name = "demo"
+            [camera]
+            position_m = [0.0, 0.0, 0.70]
+            look_at_m = [0.0, 0.0, 0.0]
+            [[objects]]
+            kind = "banana"
+            position_m = [0.12, -0.05]
+            yaw_deg = 30
+            ripeness = "ripe"
+            [[objects]]
+            kind = "sphere"
+            radius_m = 0.03
+            position_m = [0.0, 0.0]
+            hardness = "35A"
+            [[objects]]
+            kind = "lemon"
+            position_m = [-0.1, 0.1]
+            modulus_mpa = 0.8
+            "#,
+        )
+        .unwrap();
+        assert_eq!(s.objects.len(), 3);
+        assert_eq!(s.objects[0].hardness, Hardness::ModulusMpa(0.8));
+        assert_eq!(s.objects[1].hardness, Hardness::ShoreA(35.0));
+        assert_eq!(s.objects[2].ripeness.as_deref(), Some("ripe"));
+    }
+
+    fn error_of(text: &str) -> String {
+        parse(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn bad_fields_are_named() {
+        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"pear\"\nposition_m = [0, 0]\n");
+        assert!(e.starts_with("t.toml: objects[0].kind: unknown kind 'pear'"), "{e}");
+        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"banana\"\nripeness = \"rotten\"\nposition_m = [0, 0]\n");
+        assert!(e.contains("objects[0].ripeness: unknown ripeness stage 'rotten'"), "{e}");
+        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"banana\"\nposition_m = [nan, 0]\n");
+        assert!(e.contains("objects[0].position_m: must be finite"), "{e}");
+        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"banana\"\nposition_m = [3.0, 0]\n");
+        assert!(e.contains("objects[0].position_m") && e.contains("off the table"), "{e}");
+        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"mesh\"\nmesh = \"nope.obj\"\nhardness = \"40A\"\nposition_m = [0, 0]\n");
+        assert!(e.contains("objects[0].mesh: mesh file"), "{e}");
+        let e = error_of("name = \"x\"\n[[objects]\nkind = 3\n");
+        assert!(e.starts_with("t.toml: line 2: malformed TOML"), "{e}");
+        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"sphere\"\nposition_m = [0, 0]\nhardness = \"40A\"\n");
+        assert!(e.contains("objects[0].radius_m: required"), "{e}");
+        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\ncolour = [1, 0, 0]\n");
+        assert!(e.contains("unknown field `colour`"), "{e}");
+        assert!(!e.contains('\n'), "errors are one line: {e}");
+    }
+}
