@@ -1,1 +1,211 @@
-fn main() {}
+//! `tactex`: the TactEx twin command line. Wires the simulated devices (tactex-sim) into the
+//! backend-free pipeline (tactex-core).
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use tactex_core::catalog::FruitCatalog;
+use tactex_core::estimate::PhysicsEstimator;
+use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
+use tactex_core::scene::Scene;
+use tactex_sim::SimDevices;
+
+#[derive(Parser)]
+#[command(
+    name = "tactex",
+    version,
+    about = "TactEx twin: ask a robot with an RGB-D camera and a GelSight Mini about fruit hardness"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Answer a question about the fruit on the table, e.g. "Which fruit is the softest?"
+    Ask {
+        /// Scene file (TOML); default scenes/demo.toml.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Seed of every random draw (sensor noise); same seed, same output.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Print one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+        /// Leave out wall-clock times so that the output is byte-reproducible.
+        #[arg(long)]
+        reproducible: bool,
+        /// The question.
+        prompt: String,
+    },
+    /// Scene files.
+    Scene {
+        #[command(subcommand)]
+        command: SceneCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum SceneCommand {
+    /// Validate a scene file (and its meshes) and print a summary.
+    Check { file: PathBuf },
+}
+
+fn default_scene() -> PathBuf {
+    let local = Path::new("scenes/demo.toml");
+    if local.is_file() {
+        local.to_path_buf()
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/demo.toml")
+    }
+}
+
+fn load_scene(path: &Path, catalog: &FruitCatalog) -> Result<(Scene, SimDevices, u64)> {
+    let scene = Scene::load(path, catalog)?;
+    let devices = SimDevices::from_scene(&scene, 0)?;
+    Ok((scene, devices, 0))
+}
+
+fn ask(
+    scene: Option<PathBuf>,
+    seed: u64,
+    json: bool,
+    reproducible: bool,
+    prompt: &str,
+) -> Result<()> {
+    let catalog = FruitCatalog::builtin();
+    // The prompt is checked before the scene is built so that a bad question fails fast.
+    tactex_core::query::parse(prompt, &catalog)?;
+    let path = scene.unwrap_or_else(default_scene);
+    let scene = Scene::load(&path, &catalog)?;
+    let mut sim = SimDevices::from_scene(&scene, seed)?;
+    let config = PipelineConfig {
+        measure_wall_time: !reproducible,
+        ..PipelineConfig::default()
+    };
+    let answer = pipeline::answer(
+        prompt,
+        &catalog,
+        Devices {
+            camera: &mut sim.camera,
+            tactile: &mut sim.tactile,
+            arm: &mut sim.arm,
+        },
+        &PhysicsEstimator::default(),
+        &config,
+    )?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&answer).context("serialising the answer")?
+        );
+    } else {
+        print_answer(&answer);
+    }
+    Ok(())
+}
+
+fn print_answer(a: &Answer) {
+    println!("{}\n", a.answer);
+    println!(
+        "{:<3} {:<11} {:<13} {:>24} {:>9} {:>9} {:>10}  ripeness",
+        "#", "object", "location", "position (m)", "Shore A", "Shore 00", "E (MPa)"
+    );
+    for (i, o) in a.objects.iter().enumerate() {
+        let p = o.position_m;
+        let (sa, s00, e) = match &o.hardness {
+            Some(h) => (
+                format!("{:.1}", h.shore_a),
+                format!("{:.1}", h.shore_00),
+                h.modulus_mpa.map_or("rigid".into(), |e| format!("{e:.3}")),
+            ),
+            None => ("-".into(), "-".into(), "-".into()),
+        };
+        let mark = if a.selected.contains(&i) { "*" } else { " " };
+        println!(
+            "{mark}{i:<2} {:<11} {:<13} {:>24} {sa:>9} {s00:>9} {e:>10}  {}",
+            o.label,
+            o.location,
+            format!("({:+.3}, {:+.3}, {:.3})", p[0], p[1], p[2]),
+            o.ripeness.as_deref().unwrap_or("-")
+        );
+        for w in &o.warnings {
+            println!("    warning: {w}");
+        }
+    }
+    println!("\n{:<10} {:>10} {:>12}", "stage", "wall (ms)", "robot (s)");
+    for t in &a.timing {
+        let wall = t.wall_ms.map_or("-".into(), |v| format!("{v:.1}"));
+        let sim = t.sim_s.map_or("-".into(), |v| format!("{v:.2}"));
+        println!("{:<10} {wall:>10} {sim:>12}", t.stage);
+    }
+}
+
+fn scene_check(file: &Path) -> Result<()> {
+    let catalog = FruitCatalog::builtin();
+    let (scene, sim, _) = load_scene(file, &catalog)?;
+    let world = sim
+        .world
+        .lock()
+        .map_err(|_| anyhow::anyhow!("world lock poisoned"))?;
+    println!(
+        "{}: scene '{}' is valid: {} objects on a {:.2} x {:.2} m table",
+        file.display(),
+        scene.name,
+        scene.objects.len(),
+        scene.table.size_m[0],
+        scene.table.size_m[1]
+    );
+    for (o, s) in scene.objects.iter().zip(&world.objects) {
+        let h = tactex_core::hardness::HardnessReport::from(o.hardness);
+        let e = h
+            .modulus_mpa
+            .map_or("rigid".to_string(), |e| format!("{e:.3} MPa"));
+        println!(
+            "  {:<11} at ({:+.3}, {:+.3}, {:.3}) m  {:>5} triangles  {e} ({:.1} Shore A){}",
+            o.label,
+            s.centre.x,
+            s.centre.y,
+            s.centre.z,
+            s.mesh.triangles.len(),
+            h.shore_a,
+            o.ripeness
+                .as_ref()
+                .map_or(String::new(), |r| format!(", {r}"))
+        );
+    }
+    if world.settle_shift_m > 0.01 {
+        bail!(
+            "{}: objects moved {:.3} m while settling: they overlap or rest unstably",
+            file.display(),
+            world.settle_shift_m
+        );
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Ask {
+            scene,
+            seed,
+            json,
+            reproducible,
+            prompt,
+        } => ask(scene, seed, json, reproducible, &prompt),
+        Command::Scene {
+            command: SceneCommand::Check { file },
+        } => scene_check(&file),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -42,13 +42,18 @@ pub struct FruitSpec {
 
 impl FruitSpec {
     pub fn stage(&self, name: &str) -> Option<&RipenessStage> {
-        self.stages.iter().find(|s| s.name.eq_ignore_ascii_case(name))
+        self.stages
+            .iter()
+            .find(|s| s.name.eq_ignore_ascii_case(name))
     }
 
     /// The stage a measured modulus falls in (stages are ordered hardest first).
     pub fn stage_for_modulus(&self, modulus_mpa: Option<f64>) -> &RipenessStage {
         let e = modulus_mpa.unwrap_or(f64::INFINITY);
-        self.stages.iter().find(|s| e >= s.threshold_mpa).unwrap_or_else(|| self.stages.last().expect("validated non-empty"))
+        self.stages
+            .iter()
+            .find(|s| e >= s.threshold_mpa)
+            .unwrap_or_else(|| self.stages.last().expect("validated non-empty"))
     }
 
     /// Whether explanations should speak of ripeness (more than one stage known).
@@ -69,7 +74,11 @@ pub enum CatalogError {
     #[error("{path}: malformed catalog: {message}")]
     Malformed { path: String, message: String },
     #[error("{path}: fruit '{fruit}': {message}")]
-    Invalid { path: String, fruit: String, message: String },
+    Invalid {
+        path: String,
+        fruit: String,
+        message: String,
+    },
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -84,21 +93,30 @@ pub struct FruitCatalog {
 
 impl FruitCatalog {
     pub fn builtin() -> Self {
-        Self::parse(BUILTIN_CATALOG, "scenes/fruits.toml (built in)").expect("the built-in catalog is valid")
+        Self::parse(BUILTIN_CATALOG, "scenes/fruits.toml (built in)")
+            .expect("the built-in catalog is valid")
     }
 
     pub fn load(path: &Path) -> Result<Self, CatalogError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| CatalogError::Read { path: shown.clone(), message: e.to_string() })?;
+        let text = std::fs::read_to_string(path).map_err(|e| CatalogError::Read {
+            path: shown.clone(),
+            message: e.to_string(),
+        })?;
         Self::parse(&text, &shown)
     }
 
     pub fn parse(text: &str, path: &str) -> Result<Self, CatalogError> {
-        let file: CatalogFile = toml::from_str(text)
-            .map_err(|e| CatalogError::Malformed { path: path.into(), message: e.message().to_string() })?;
+        let file: CatalogFile = toml::from_str(text).map_err(|e| CatalogError::Malformed {
+            path: path.into(),
+            message: e.message().to_string(),
+        })?;
         for f in &file.fruit {
-            let bad = |message: String| CatalogError::Invalid { path: path.into(), fruit: f.name.clone(), message };
+            let bad = |message: String| CatalogError::Invalid {
+                path: path.into(),
+                fruit: f.name.clone(),
+                message,
+            };
             if f.stages.is_empty() {
                 return Err(bad("no ripeness stages".into()));
             }
@@ -106,12 +124,21 @@ impl FruitCatalog {
                 return Err(bad("size_m must be finite and positive".into()));
             }
             if f.stage(&f.default_stage).is_none() {
-                return Err(bad(format!("default_stage '{}' is not one of its stages", f.default_stage)));
+                return Err(bad(format!(
+                    "default_stage '{}' is not one of its stages",
+                    f.default_stage
+                )));
             }
             let mut previous = f64::INFINITY;
             for s in &f.stages {
-                if !(s.modulus_mpa.is_finite() && s.modulus_mpa > 0.0) || s.threshold_mpa > s.modulus_mpa || s.threshold_mpa >= previous {
-                    return Err(bad(format!("stage '{}': thresholds must decrease and lie below the stage modulus", s.name)));
+                if !(s.modulus_mpa.is_finite() && s.modulus_mpa > 0.0)
+                    || s.threshold_mpa > s.modulus_mpa
+                    || s.threshold_mpa >= previous
+                {
+                    return Err(bad(format!(
+                        "stage '{}': thresholds must decrease and lie below the stage modulus",
+                        s.name
+                    )));
                 }
                 previous = s.threshold_mpa;
             }
@@ -123,7 +150,9 @@ impl FruitCatalog {
     }
 
     pub fn get(&self, name: &str) -> Option<&FruitSpec> {
-        self.fruits.iter().find(|f| f.name.eq_ignore_ascii_case(name))
+        self.fruits
+            .iter()
+            .find(|f| f.name.eq_ignore_ascii_case(name))
     }
 
     /// The fruit a word names (singular, plural or synonym).
@@ -143,7 +172,10 @@ mod tests {
     #[test]
     fn builtin_catalog_has_the_papers_fruits() {
         let c = FruitCatalog::builtin();
-        for name in ["mango", "lime", "lemon", "tomato", "banana", "avocado", "kiwi", "apple", "orange", "peach"] {
+        for name in [
+            "mango", "lime", "lemon", "tomato", "banana", "avocado", "kiwi", "apple", "orange",
+            "peach",
+        ] {
             assert!(c.get(name).is_some(), "{name} missing");
         }
         let banana = c.get("banana").unwrap();
@@ -156,15 +188,27 @@ mod tests {
     fn every_stage_modulus_falls_in_its_own_threshold_band() {
         for f in FruitCatalog::builtin().fruits {
             for s in &f.stages {
-                assert_eq!(f.stage_for_modulus(Some(s.modulus_mpa)).name, s.name, "{} {}", f.name, s.name);
+                assert_eq!(
+                    f.stage_for_modulus(Some(s.modulus_mpa)).name,
+                    s.name,
+                    "{} {}",
+                    f.name,
+                    s.name
+                );
             }
-            assert_eq!(f.stage_for_modulus(None).name, f.stages[0].name, "rigid reads as the hardest stage");
+            assert_eq!(
+                f.stage_for_modulus(None).name,
+                f.stages[0].name,
+                "rigid reads as the hardest stage"
+            );
         }
     }
 
     #[test]
     fn malformed_catalog_names_the_file() {
-        let e = FruitCatalog::parse("[[fruit]]\nname = 3", "x.toml").unwrap_err().to_string();
+        let e = FruitCatalog::parse("[[fruit]]\nname = 3", "x.toml")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("x.toml: malformed catalog"), "{e}");
     }
 }

@@ -66,7 +66,11 @@ pub enum EstimateError {
 
 pub trait HardnessEstimator {
     fn name(&self) -> &str;
-    fn estimate(&self, press: &PressSequence, spec: &TactileSpec) -> Result<HardnessEstimate, EstimateError>;
+    fn estimate(
+        &self,
+        press: &PressSequence,
+        spec: &TactileSpec,
+    ) -> Result<HardnessEstimate, EstimateError>;
 }
 
 /// Physics inversion of the Hertz compliance split (see the module docs).
@@ -80,7 +84,10 @@ pub struct PhysicsEstimator {
 
 impl Default for PhysicsEstimator {
     fn default() -> Self {
-        Self { object_poisson: 0.35, stride: 3 }
+        Self {
+            object_poisson: 0.35,
+            stride: 3,
+        }
     }
 }
 
@@ -95,7 +102,11 @@ impl HardnessEstimator for PhysicsEstimator {
         "physics"
     }
 
-    fn estimate(&self, press: &PressSequence, spec: &TactileSpec) -> Result<HardnessEstimate, EstimateError> {
+    fn estimate(
+        &self,
+        press: &PressSequence,
+        spec: &TactileSpec,
+    ) -> Result<HardnessEstimate, EstimateError> {
         if press.frames.len() < 2 || press.frames.len() != press.travel_mm.len() {
             return Err(EstimateError::BadSequence(format!(
                 "need at least 2 frames with one travel each, got {} frames and {} travels",
@@ -130,7 +141,11 @@ impl HardnessEstimator for PhysicsEstimator {
                         continue;
                     }
                     let slope = (f.gx[k] as f64 * dx + f.gy[k] as f64 * dy) / r;
-                    samples.push(Sample { frame: i, r_mm: r * px, slope });
+                    samples.push(Sample {
+                        frame: i,
+                        r_mm: r * px,
+                        slope,
+                    });
                 }
             }
         }
@@ -145,7 +160,11 @@ impl HardnessEstimator for PhysicsEstimator {
             let mut sxx = 0.0;
             let mut syy = 0.0;
             for s in &samples {
-                let h = Hertz { radius_mm: radius, approach_mm: approach0 + travel[s.frame], contact_modulus_mpa: 1.0 };
+                let h = Hertz {
+                    radius_mm: radius,
+                    approach_mm: approach0 + travel[s.frame],
+                    contact_modulus_mpa: 1.0,
+                };
                 let model = h.total_displacement_slope(s.r_mm);
                 sxy += model * s.slope;
                 sxx += model * model;
@@ -173,7 +192,12 @@ impl HardnessEstimator for PhysicsEstimator {
         let (mut step_lr, mut step_a0) = (0.15, 0.1);
         while step_a0 > 1e-4 {
             let mut improved = false;
-            for (dl, da) in [(step_lr, 0.0), (-step_lr, 0.0), (0.0, step_a0), (0.0, -step_a0)] {
+            for (dl, da) in [
+                (step_lr, 0.0),
+                (-step_lr, 0.0),
+                (0.0, step_a0),
+                (0.0, -step_a0),
+            ] {
                 let (lr, a0) = (best_lr + dl, (best_a0 + da).max(1e-4));
                 let (_, rss) = fit(lr, a0);
                 if rss < best_rss {
@@ -195,7 +219,11 @@ impl HardnessEstimator for PhysicsEstimator {
             .filter_map(|i| {
                 let (mut sxy, mut sxx) = (0.0, 0.0);
                 for s in samples.iter().filter(|s| s.frame == i) {
-                    let h = Hertz { radius_mm: radius, approach_mm: best_a0 + travel[i], contact_modulus_mpa: 1.0 };
+                    let h = Hertz {
+                        radius_mm: radius,
+                        approach_mm: best_a0 + travel[i],
+                        contact_modulus_mpa: 1.0,
+                    };
                     let m = h.total_displacement_slope(s.r_mm);
                     sxy += m * s.slope;
                     sxx += m * m;
@@ -205,19 +233,29 @@ impl HardnessEstimator for PhysicsEstimator {
             .collect();
         let n = per_frame.len() as f64;
         let mean = per_frame.iter().sum::<f64>() / n;
-        let share_se = (per_frame.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0) / n).sqrt();
+        let share_se =
+            (per_frame.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0) / n)
+                .sqrt();
         if !(share.is_finite() && share > 0.0) {
             return Err(EstimateError::NoImprint);
         }
 
-        let gel = Elastic { modulus_mpa: Some(spec.gel.modulus_mpa), poisson: spec.gel.poisson };
-        let to_modulus = |s: f64| object_modulus_from_share(gel, self.object_poisson, s.clamp(1e-6, 1.0));
+        let gel = Elastic {
+            modulus_mpa: Some(spec.gel.modulus_mpa),
+            poisson: spec.gel.poisson,
+        };
+        let to_modulus =
+            |s: f64| object_modulus_from_share(gel, self.object_poisson, s.clamp(1e-6, 1.0));
         let hardness = match to_modulus(share) {
             Some(e) => Hardness::ModulusMpa(e),
             None => Hardness::Rigid,
         };
         let last_approach = best_a0 + travel.last().copied().unwrap_or(0.0);
-        let last_hertz = Hertz { radius_mm: radius, approach_mm: last_approach, contact_modulus_mpa: 1.0 };
+        let last_hertz = Hertz {
+            radius_mm: radius,
+            approach_mm: last_approach,
+            contact_modulus_mpa: 1.0,
+        };
         Ok(HardnessEstimate {
             hardness,
             modulus_interval_mpa: [to_modulus(share - share_se), to_modulus(share + share_se)],

@@ -11,8 +11,20 @@ pub const LOCATION_BAND_M: f64 = 0.06;
 
 /// "left front", "centre back", "centre", ... from table coordinates (x right, y back).
 pub fn location_words(x: f64, y: f64) -> String {
-    let lr = if x < -LOCATION_BAND_M { "left" } else if x > LOCATION_BAND_M { "right" } else { "centre" };
-    let fb = if y < -LOCATION_BAND_M { "front" } else if y > LOCATION_BAND_M { "back" } else { "centre" };
+    let lr = if x < -LOCATION_BAND_M {
+        "left"
+    } else if x > LOCATION_BAND_M {
+        "right"
+    } else {
+        "centre"
+    };
+    let fb = if y < -LOCATION_BAND_M {
+        "front"
+    } else if y > LOCATION_BAND_M {
+        "back"
+    } else {
+        "centre"
+    };
     match (lr, fb) {
         ("centre", "centre") => "centre".into(),
         (lr, fb) => format!("{lr} {fb}"),
@@ -53,17 +65,22 @@ fn describe(m: &Measured) -> String {
 }
 
 fn stiffness(m: &Measured) -> f64 {
-    m.hardness.map_or(f64::NAN, |h| h.modulus_mpa.unwrap_or(f64::INFINITY))
+    m.hardness
+        .map_or(f64::NAN, |h| h.modulus_mpa.unwrap_or(f64::INFINITY))
 }
 
 fn capitalise(s: &str) -> String {
     let mut c = s.chars();
-    c.next().map_or(String::new(), |f| f.to_uppercase().collect::<String>() + c.as_str())
+    c.next().map_or(String::new(), |f| {
+        f.to_uppercase().collect::<String>() + c.as_str()
+    })
 }
 
 /// Indices of `objects` that answer the query, in answer order.
 pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Vec<usize> {
-    let measured: Vec<usize> = (0..objects.len()).filter(|&i| objects[i].hardness.is_some()).collect();
+    let measured: Vec<usize> = (0..objects.len())
+        .filter(|&i| objects[i].hardness.is_some())
+        .collect();
     match query.intent {
         Intent::Extreme => {
             let key = |i: &usize| -> f64 {
@@ -73,7 +90,9 @@ pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Ve
                     Property::Hardness => e,
                     Property::Softness => -e,
                     // Ripeness: stiffness relative to the fruit's unripe stage, lower is riper.
-                    Property::Ripeness => -catalog.get(&m.label).map_or(e, |f| e / f.stages[0].modulus_mpa),
+                    Property::Ripeness => -catalog
+                        .get(&m.label)
+                        .map_or(e, |f| e / f.stages[0].modulus_mpa),
                 }
             };
             let pick = match query.extreme {
@@ -88,7 +107,12 @@ pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Ve
 
 /// The answer text for a query over measured objects; `missing` lists asked-for kinds the
 /// camera did not find.
-pub fn explain(query: &Query, objects: &[Measured], selected: &[usize], missing: &[String]) -> String {
+pub fn explain(
+    query: &Query,
+    objects: &[Measured],
+    selected: &[usize],
+    missing: &[String],
+) -> String {
     let mut parts = Vec::new();
     if objects.is_empty() {
         parts.push("I found no fruit to touch on the table.".to_string());
@@ -103,19 +127,44 @@ pub fn explain(query: &Query, objects: &[Measured], selected: &[usize], missing:
                 (Property::Ripeness, Some(Extreme::Least)) => "least ripe",
                 (Property::Ripeness, _) => "ripest",
             };
-            let kind = if query.all || query.targets.is_empty() { "fruit".to_string() } else { query.targets.join(" or ") };
-            parts.push(format!("The {word} {kind} is {}.", describe(&objects[selected[0]])));
-            let mut ranked: Vec<&Measured> = objects.iter().filter(|m| m.hardness.is_some()).collect();
+            let kind = if query.all || query.targets.is_empty() {
+                "fruit".to_string()
+            } else {
+                query.targets.join(" or ")
+            };
+            parts.push(format!(
+                "The {word} {kind} is {}.",
+                describe(&objects[selected[0]])
+            ));
+            let mut ranked: Vec<&Measured> =
+                objects.iter().filter(|m| m.hardness.is_some()).collect();
             if ranked.len() > 1 {
                 ranked.sort_by(|a, b| stiffness(a).total_cmp(&stiffness(b)));
-                let list: Vec<String> = ranked.iter().map(|m| format!("{} ({})", m.label, describe_hardness(m.hardness.as_ref().unwrap()))).collect();
+                let list: Vec<String> = ranked
+                    .iter()
+                    .map(|m| {
+                        format!(
+                            "{} ({})",
+                            m.label,
+                            describe_hardness(m.hardness.as_ref().unwrap())
+                        )
+                    })
+                    .collect();
                 parts.push(format!("From softest to hardest: {}.", list.join(", ")));
             }
         }
         Intent::Compare if selected.len() >= 2 => {
             let (a, b) = (&objects[selected[0]], &objects[selected[1]]);
-            let rel = if stiffness(a) > stiffness(b) { "harder" } else { "softer" };
-            parts.push(capitalise(&format!("{} is {rel} than {}.", describe(a), describe(b))));
+            let rel = if stiffness(a) > stiffness(b) {
+                "harder"
+            } else {
+                "softer"
+            };
+            parts.push(capitalise(&format!(
+                "{} is {rel} than {}.",
+                describe(a),
+                describe(b)
+            )));
         }
         _ => {
             for &i in selected {
@@ -156,11 +205,18 @@ mod tests {
     fn softest_is_selected_and_explained() {
         let c = FruitCatalog::builtin();
         let q = crate::query::parse("Which fruit is the softest?", &c).unwrap();
-        let objs = [m("apple", 3.25, 0.1, 0.1), m("banana", 0.8, -0.15, -0.1), m("lime", 1.5, 0.0, 0.0)];
+        let objs = [
+            m("apple", 3.25, 0.1, 0.1),
+            m("banana", 0.8, -0.15, -0.1),
+            m("lime", 1.5, 0.0, 0.0),
+        ];
         let sel = select(&q, &objs, &c);
         assert_eq!(sel, vec![1]);
         let text = explain(&q, &objs, &sel, &[]);
-        assert!(text.starts_with("The softest fruit is the banana at the left front"), "{text}");
+        assert!(
+            text.starts_with("The softest fruit is the banana at the left front"),
+            "{text}"
+        );
         assert!(text.contains("From softest to hardest: banana"), "{text}");
         let q = crate::query::parse("Which fruit is the hardest?", &c).unwrap();
         assert_eq!(select(&q, &objs, &c), vec![0]);
@@ -171,6 +227,9 @@ mod tests {
         let c = FruitCatalog::builtin();
         let q = crate::query::parse("Identify the hardness of the kiwi", &c).unwrap();
         let text = explain(&q, &[], &[], &["kiwi".into()]);
-        assert!(text.contains("I could not find a kiwi on the table."), "{text}");
+        assert!(
+            text.contains("I could not find a kiwi on the table."),
+            "{text}"
+        );
     }
 }

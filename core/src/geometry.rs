@@ -15,7 +15,10 @@ pub struct Pose {
 }
 
 impl Pose {
-    pub const IDENTITY: Pose = Pose { position: DVec3::ZERO, rotation: DQuat::IDENTITY };
+    pub const IDENTITY: Pose = Pose {
+        position: DVec3::ZERO,
+        rotation: DQuat::IDENTITY,
+    };
 
     pub fn new(position: DVec3, rotation: DQuat) -> Self {
         Self { position, rotation }
@@ -32,13 +35,19 @@ impl Pose {
         let x = down.cross(forward).normalize();
         let y = forward.cross(x);
         let rotation = DQuat::from_mat3(&DMat3::from_cols(x, y, forward));
-        Some(Self { position: eye, rotation })
+        Some(Self {
+            position: eye,
+            rotation,
+        })
     }
 
     /// A tool pose whose z axis (the sensing direction of the tactile pad) points down, with
     /// the pad's x axis along world x.
     pub fn tool_down(position: DVec3) -> Self {
-        Self { position, rotation: DQuat::from_rotation_x(std::f64::consts::PI) }
+        Self {
+            position,
+            rotation: DQuat::from_rotation_x(std::f64::consts::PI),
+        }
     }
 
     pub fn transform_point(&self, p: DVec3) -> DVec3 {
@@ -51,7 +60,10 @@ impl Pose {
 
     pub fn inverse(&self) -> Self {
         let rotation = self.rotation.inverse();
-        Self { position: -(rotation * self.position), rotation }
+        Self {
+            position: -(rotation * self.position),
+            rotation,
+        }
     }
 }
 
@@ -68,7 +80,14 @@ pub struct CameraIntrinsics {
 
 impl Default for CameraIntrinsics {
     fn default() -> Self {
-        Self { width: 640, height: 480, fx: 608.5, fy: 606.9, cx: 309.4, cy: 213.83 }
+        Self {
+            width: 640,
+            height: 480,
+            fx: 608.5,
+            fy: 606.9,
+            cx: 309.4,
+            cy: 213.83,
+        }
     }
 }
 
@@ -94,8 +113,12 @@ mod tests {
         let k = CameraIntrinsics::default();
         let to_cam = cam.inverse();
         let (u0, v0) = k.project(to_cam.transform_point(DVec3::ZERO)).unwrap();
-        let (u1, _) = k.project(to_cam.transform_point(DVec3::new(0.1, 0.0, 0.0))).unwrap();
-        let (_, v1) = k.project(to_cam.transform_point(DVec3::new(0.0, 0.1, 0.0))).unwrap();
+        let (u1, _) = k
+            .project(to_cam.transform_point(DVec3::new(0.1, 0.0, 0.0)))
+            .unwrap();
+        let (_, v1) = k
+            .project(to_cam.transform_point(DVec3::new(0.0, 0.1, 0.0)))
+            .unwrap();
         assert!((u0 - k.cx).abs() < 1e-9 && (v0 - k.cy).abs() < 1e-9);
         assert!(u1 > u0, "world +x must be image right");
         assert!(v1 < v0, "world +y must be image up");

@@ -28,7 +28,9 @@ pub enum Hardness {
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HardnessError {
-    #[error("'{0}' is not a hardness: use e.g. \"35A\", \"55 00\", \"rigid\" or a modulus like \"0.8 MPa\"")]
+    #[error(
+        "'{0}' is not a hardness: use e.g. \"35A\", \"55 00\", \"rigid\" or a modulus like \"0.8 MPa\""
+    )]
     Unparsed(String),
     #[error("Shore value {0} is outside [0, 100]")]
     ShoreOutOfRange(f64),
@@ -58,7 +60,9 @@ pub fn shore_a_to_modulus_mpa(s: f64) -> Option<f64> {
     }
     let l40 = gent_mpa(GENT_FROM).ln();
     let k = gent_slope(GENT_FROM) / gent_mpa(GENT_FROM);
-    let l0 = shore_00_to_modulus_mpa(ZERO_A_IN_00).expect("finite below 100").ln();
+    let l0 = shore_00_to_modulus_mpa(ZERO_A_IN_00)
+        .expect("finite below 100")
+        .ln();
     let c = (l0 - l40 + GENT_FROM * k) / (GENT_FROM * GENT_FROM);
     let x = s - GENT_FROM;
     Some((l40 + k * x + c * x * x).exp())
@@ -120,15 +124,24 @@ impl Hardness {
             (n.to_string(), "mpa")
         } else if let Some(n) = compact.strip_suffix("kpa") {
             (n.to_string(), "kpa")
-        } else if let Some(n) = compact.strip_prefix("00").or_else(|| compact.strip_prefix("oo")) {
+        } else if let Some(n) = compact
+            .strip_prefix("00")
+            .or_else(|| compact.strip_prefix("oo"))
+        {
             (n.to_string(), "00")
-        } else if let Some(n) = compact.strip_suffix("00").or_else(|| compact.strip_suffix("oo")) {
+        } else if let Some(n) = compact
+            .strip_suffix("00")
+            .or_else(|| compact.strip_suffix("oo"))
+        {
             // "5500" is ambiguous without a separator; require one unless the scale is "oo".
             if compact.ends_with("00") && !t.contains(char::is_whitespace) {
                 return Err(bad());
             }
             (n.to_string(), "00")
-        } else if let Some(n) = compact.strip_suffix('a').or_else(|| compact.strip_prefix('a')) {
+        } else if let Some(n) = compact
+            .strip_suffix('a')
+            .or_else(|| compact.strip_prefix('a'))
+        {
             (n.to_string(), "a")
         } else {
             return Err(bad());
@@ -146,11 +159,19 @@ impl Hardness {
         if !(0.0..=100.0).contains(&value) {
             return Err(HardnessError::ShoreOutOfRange(value));
         }
-        Ok(if value >= 100.0 { Hardness::Rigid } else { make(value) })
+        Ok(if value >= 100.0 {
+            Hardness::Rigid
+        } else {
+            make(value)
+        })
     }
 
     pub fn from_modulus_mpa(e: f64) -> Result<Hardness, HardnessError> {
-        if e.is_finite() && e > 0.0 { Ok(Hardness::ModulusMpa(e)) } else { Err(HardnessError::BadModulus(e)) }
+        if e.is_finite() && e > 0.0 {
+            Ok(Hardness::ModulusMpa(e))
+        } else {
+            Err(HardnessError::BadModulus(e))
+        }
     }
 
     /// Young's modulus in MPa; None when rigid.
@@ -200,7 +221,11 @@ pub struct HardnessReport {
 
 impl From<Hardness> for HardnessReport {
     fn from(h: Hardness) -> Self {
-        HardnessReport { shore_a: h.shore_a(), shore_00: h.shore_00(), modulus_mpa: h.modulus_mpa() }
+        HardnessReport {
+            shore_a: h.shore_a(),
+            shore_00: h.shore_00(),
+            modulus_mpa: h.modulus_mpa(),
+        }
     }
 }
 
@@ -223,7 +248,10 @@ mod tests {
         assert!((below - at).abs() < 1e-6);
         let slope_below = (at - shore_a_to_modulus_mpa(40.0 - 1e-4).unwrap()) / 1e-4;
         assert!((slope_below - gent_slope(40.0)).abs() / gent_slope(40.0) < 1e-3);
-        assert!((shore_a_to_modulus_mpa(0.0).unwrap() - shore_00_to_modulus_mpa(40.0).unwrap()).abs() < 1e-12);
+        assert!(
+            (shore_a_to_modulus_mpa(0.0).unwrap() - shore_00_to_modulus_mpa(40.0).unwrap()).abs()
+                < 1e-12
+        );
     }
 
     #[test]
@@ -240,11 +268,20 @@ mod tests {
         assert_eq!(Hardness::parse("55 00").unwrap(), Hardness::Shore00(55.0));
         assert_eq!(Hardness::parse("55OO").unwrap(), Hardness::Shore00(55.0));
         assert_eq!(Hardness::parse("55oo").unwrap(), Hardness::Shore00(55.0));
-        assert_eq!(Hardness::parse("Shore 00 55").unwrap(), Hardness::Shore00(55.0));
+        assert_eq!(
+            Hardness::parse("Shore 00 55").unwrap(),
+            Hardness::Shore00(55.0)
+        );
         assert_eq!(Hardness::parse("rigid").unwrap(), Hardness::Rigid);
         assert_eq!(Hardness::parse("100A").unwrap(), Hardness::Rigid);
-        assert_eq!(Hardness::parse("0.8 MPa").unwrap(), Hardness::ModulusMpa(0.8));
-        assert_eq!(Hardness::parse("800 kPa").unwrap(), Hardness::ModulusMpa(0.8));
+        assert_eq!(
+            Hardness::parse("0.8 MPa").unwrap(),
+            Hardness::ModulusMpa(0.8)
+        );
+        assert_eq!(
+            Hardness::parse("800 kPa").unwrap(),
+            Hardness::ModulusMpa(0.8)
+        );
         for bad in ["", "soft", "120A", "-3A", "5500", "nanA", "0 MPa", "A"] {
             assert!(Hardness::parse(bad).is_err(), "{bad:?} must not parse");
         }

@@ -15,7 +15,8 @@ pub struct Elastic {
 impl Elastic {
     /// (1 - nu^2) / E in 1/MPa; zero for a rigid body.
     pub fn compliance(&self) -> f64 {
-        self.modulus_mpa.map_or(0.0, |e| (1.0 - self.poisson * self.poisson) / e)
+        self.modulus_mpa
+            .map_or(0.0, |e| (1.0 - self.poisson * self.poisson) / e)
     }
 }
 
@@ -54,16 +55,24 @@ impl Hertz {
     }
 
     pub fn force_n(&self) -> f64 {
-        4.0 / 3.0 * self.contact_modulus_mpa * self.radius_mm.sqrt() * self.approach_mm.max(0.0).powf(1.5)
+        4.0 / 3.0
+            * self.contact_modulus_mpa
+            * self.radius_mm.sqrt()
+            * self.approach_mm.max(0.0).powf(1.5)
     }
 
     pub fn max_pressure_mpa(&self) -> f64 {
-        2.0 * self.contact_radius_mm() * self.contact_modulus_mpa / (std::f64::consts::PI * self.radius_mm)
+        2.0 * self.contact_radius_mm() * self.contact_modulus_mpa
+            / (std::f64::consts::PI * self.radius_mm)
     }
 
     pub fn pressure_mpa(&self, r_mm: f64) -> f64 {
         let a = self.contact_radius_mm();
-        if r_mm >= a { 0.0 } else { self.max_pressure_mpa() * (1.0 - (r_mm / a).powi(2)).sqrt() }
+        if r_mm >= a {
+            0.0
+        } else {
+            self.max_pressure_mpa() * (1.0 - (r_mm / a).powi(2)).sqrt()
+        }
     }
 
     /// Sum of both bodies' normal surface displacements at distance r (Johnson eq. 3.42).
@@ -91,7 +100,8 @@ impl Hertz {
             -r_mm / self.radius_mm
         } else {
             // d/dr [(2a^2 - r^2) asin(a/r) + a sqrt(r^2 - a^2)] = -2 r asin(a/r) + 2 a sqrt(r^2 - a^2) / r
-            (-2.0 * r_mm * (a / r_mm).asin() + 2.0 * a * (r_mm * r_mm - a * a).sqrt() / r_mm) / (std::f64::consts::PI * self.radius_mm)
+            (-2.0 * r_mm * (a / r_mm).asin() + 2.0 * a * (r_mm * r_mm - a * a).sqrt() / r_mm)
+                / (std::f64::consts::PI * self.radius_mm)
         }
     }
 }
@@ -101,7 +111,11 @@ mod tests {
     use super::*;
 
     fn contact() -> Hertz {
-        Hertz { radius_mm: 10.0, approach_mm: 0.4, contact_modulus_mpa: 0.5 }
+        Hertz {
+            radius_mm: 10.0,
+            approach_mm: 0.4,
+            contact_modulus_mpa: 0.5,
+        }
     }
 
     #[test]
@@ -125,20 +139,42 @@ mod tests {
     fn slope_is_the_derivative_of_displacement() {
         let h = contact();
         for r in [0.5, 1.9, 2.5, 6.0] {
-            let numeric = (h.total_displacement_mm(r + 1e-6) - h.total_displacement_mm(r - 1e-6)) / 2e-6;
-            assert!((numeric - h.total_displacement_slope(r)).abs() < 1e-6, "r = {r}");
+            let numeric =
+                (h.total_displacement_mm(r + 1e-6) - h.total_displacement_mm(r - 1e-6)) / 2e-6;
+            assert!(
+                (numeric - h.total_displacement_slope(r)).abs() < 1e-6,
+                "r = {r}"
+            );
         }
     }
 
     #[test]
     fn compliance_share_inverts() {
-        let gel = Elastic { modulus_mpa: Some(0.3), poisson: 0.49 };
+        let gel = Elastic {
+            modulus_mpa: Some(0.3),
+            poisson: 0.49,
+        };
         for e in [0.05, 0.8, 3.25, 100.0] {
-            let share = gel_share(gel, Elastic { modulus_mpa: Some(e), poisson: 0.35 });
+            let share = gel_share(
+                gel,
+                Elastic {
+                    modulus_mpa: Some(e),
+                    poisson: 0.35,
+                },
+            );
             let back = object_modulus_from_share(gel, 0.35, share).unwrap();
             assert!((back - e).abs() / e < 1e-9);
         }
-        assert_eq!(gel_share(gel, Elastic { modulus_mpa: None, poisson: 0.3 }), 1.0);
+        assert_eq!(
+            gel_share(
+                gel,
+                Elastic {
+                    modulus_mpa: None,
+                    poisson: 0.3
+                }
+            ),
+            1.0
+        );
         assert_eq!(object_modulus_from_share(gel, 0.3, 1.0), None);
     }
 }

@@ -26,9 +26,17 @@ impl Default for PhotometricModel {
         let elevation = 35f64.to_radians();
         let light = |azimuth_deg: f64| {
             let a = azimuth_deg.to_radians();
-            DVec3::new(a.cos() * elevation.cos(), a.sin() * elevation.cos(), elevation.sin())
+            DVec3::new(
+                a.cos() * elevation.cos(),
+                a.sin() * elevation.cos(),
+                elevation.sin(),
+            )
         };
-        Self { lights: [light(90.0), light(210.0), light(330.0)], ambient: 0.45, gain: 1.0 }
+        Self {
+            lights: [light(90.0), light(210.0), light(330.0)],
+            ambient: 0.45,
+            gain: 1.0,
+        }
     }
 }
 
@@ -74,7 +82,10 @@ mod tests {
         let model = PhotometricModel::default();
         for (gx, gy) in [(0.0, 0.0), (0.3, -0.1), (-0.5, 0.4), (0.05, 0.6)] {
             let (rx, ry) = model.slope_for_gain(model.gain_for_slope(gx, gy)).unwrap();
-            assert!((rx - gx).abs() < 1e-9 && (ry - gy).abs() < 1e-9, "({gx},{gy}) -> ({rx},{ry})");
+            assert!(
+                (rx - gx).abs() < 1e-9 && (ry - gy).abs() < 1e-9,
+                "({gx},{gy}) -> ({rx},{ry})"
+            );
         }
     }
 }

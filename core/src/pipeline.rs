@@ -136,12 +136,18 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     estimator: &dyn HardnessEstimator,
     config: &PipelineConfig,
 ) -> Result<Answer, PipelineError> {
-    let Devices { camera, tactile, arm } = devices;
+    let Devices {
+        camera,
+        tactile,
+        arm,
+    } = devices;
     let mut timing = Vec::new();
     let mut lap = |stage: &str, arm: &A, start: (Instant, Option<f64>)| {
         timing.push(StageTiming {
             stage: stage.into(),
-            wall_ms: config.measure_wall_time.then(|| start.0.elapsed().as_secs_f64() * 1e3),
+            wall_ms: config
+                .measure_wall_time
+                .then(|| start.0.elapsed().as_secs_f64() * 1e3),
             sim_s: arm.sim_time_s().zip(start.1).map(|(now, then)| now - then),
         });
     };
@@ -154,7 +160,12 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     let t = start(arm);
     let targets = ground(&query, catalog, camera, config)?;
     lap("ground", arm, t);
-    let not_found: Vec<String> = query.targets.iter().filter(|k| !targets.iter().any(|t| &t.label == *k)).cloned().collect();
+    let not_found: Vec<String> = query
+        .targets
+        .iter()
+        .filter(|k| !targets.iter().any(|t| &t.label == *k))
+        .cloned()
+        .collect();
 
     let t = start(arm);
     let mut presses = Vec::new();
@@ -220,14 +231,31 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     let text = explain::explain(&query, &measured, &selected, &not_found);
     lap("explain", arm, t);
 
-    Ok(Answer { query, objects, selected, answer: text, not_found, estimator: estimator.name().into(), timing })
+    Ok(Answer {
+        query,
+        objects,
+        selected,
+        answer: text,
+        not_found,
+        estimator: estimator.name().into(),
+        timing,
+    })
 }
 
 /// Detections for the query's targets, with refined-mask centroids from the depth median.
-fn ground<C: RgbdCamera>(query: &Query, catalog: &FruitCatalog, camera: &mut C, config: &PipelineConfig) -> Result<Vec<Target>, PipelineError> {
-    let frames = (0..config.depth_frames.max(1)).map(|_| camera.capture()).collect::<Result<Vec<_>, _>>()?;
+fn ground<C: RgbdCamera>(
+    query: &Query,
+    catalog: &FruitCatalog,
+    camera: &mut C,
+    config: &PipelineConfig,
+) -> Result<Vec<Target>, PipelineError> {
+    let frames = (0..config.depth_frames.max(1))
+        .map(|_| camera.capture())
+        .collect::<Result<Vec<_>, _>>()?;
     let depths: Vec<_> = frames.iter().map(|f| &f.depth_m).collect();
-    let depth = median_depth(&depths).ok_or_else(|| PipelineError::Camera(format!("{}: depth frames differ in size", camera.name())))?;
+    let depth = median_depth(&depths).ok_or_else(|| {
+        PipelineError::Camera(format!("{}: depth frames differ in size", camera.name()))
+    })?;
     let (k, pose) = (camera.intrinsics(), camera.pose());
     let detector = ClassicalDetector::new(catalog);
     let mut targets: Vec<Target> = detector
@@ -244,21 +272,40 @@ fn ground<C: RgbdCamera>(query: &Query, catalog: &FruitCatalog, camera: &mut C, 
             let mut heights: Vec<f64> = points.iter().map(|p| p.z).collect();
             heights.sort_by(f64::total_cmp);
             let top = heights[((heights.len() - 1) as f64 * 0.98).round() as usize];
-            // Press where the object is: the mask point nearest the centroid.
+            // Press the object's crest near the centroid (a curved fruit's centroid can fall
+            // beside it): the highest mask point within 15 mm, else the nearest one.
+            let near = |p: &&DVec3| p.truncate().distance(surface.truncate());
             let touch = *points
                 .iter()
-                .min_by(|a, b| a.truncate().distance(surface.truncate()).total_cmp(&b.truncate().distance(surface.truncate())))?;
-            Some(Target { label: d.label, score: d.score, centre: DVec3::new(surface.x, surface.y, top / 2.0), surface, touch })
+                .filter(|p| near(p) <= 0.015)
+                .max_by(|a, b| a.z.total_cmp(&b.z))
+                .or_else(|| points.iter().min_by(|a, b| near(a).total_cmp(&near(b))))?;
+            Some(Target {
+                label: d.label,
+                score: d.score,
+                centre: DVec3::new(surface.x, surface.y, top / 2.0),
+                surface,
+                touch,
+            })
         })
         .collect();
     // A stable order: left to right, then front to back.
-    targets.sort_by(|a, b| (a.centre.x, a.centre.y).partial_cmp(&(b.centre.x, b.centre.y)).unwrap_or(std::cmp::Ordering::Equal));
+    targets.sort_by(|a, b| {
+        (a.centre.x, a.centre.y)
+            .partial_cmp(&(b.centre.x, b.centre.y))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
     Ok(targets)
 }
 
 /// Above the target, descend until the contact test fires, record the press frames, retract.
 /// A press that finds no contact is a warning for that object, not a failure of the question.
-fn press<T: TactileSensor, A: Arm>(target: &Target, tactile: &mut T, arm: &mut A, config: &PipelineConfig) -> Result<Result<Press, String>, PipelineError> {
+fn press<T: TactileSensor, A: Arm>(
+    target: &Target,
+    tactile: &mut T,
+    arm: &mut A,
+    config: &PipelineConfig,
+) -> Result<Result<Press, String>, PipelineError> {
     let above = |z: f64| Pose::tool_down(DVec3::new(target.touch.x, target.touch.y, z));
     let safe = above(target.touch.z + config.safe_height_m);
     arm.move_linear(&safe, config.travel_speed_m_s)?;
@@ -276,7 +323,11 @@ fn press<T: TactileSensor, A: Arm>(target: &Target, tactile: &mut T, arm: &mut A
         arm.move_linear(&above(start_z - i as f64 * step_m), config.press_speed_m_s)?;
         let frame = tactile.capture()?;
         let ssim = ssim_rgb(&frame.image, &reference.image).unwrap_or(1.0);
-        let moved = mean_moved_displacement(&track(&reference_markers, &detect_markers(&frame.image), 0.45 * pitch_px));
+        let moved = mean_moved_displacement(&track(
+            &reference_markers,
+            &detect_markers(&frame.image),
+            0.45 * pitch_px,
+        ));
         if ssim <= config.contact_ssim && moved > config.contact_marker_px {
             found = Some((i, frame, ssim, moved));
             break;
@@ -284,19 +335,29 @@ fn press<T: TactileSensor, A: Arm>(target: &Target, tactile: &mut T, arm: &mut A
     }
     let Some((contact_step, first, ssim, moved)) = found else {
         arm.move_linear(&safe, config.travel_speed_m_s)?;
-        return Ok(Err(format!("no contact within {} mm of descent", config.max_search_mm)));
+        return Ok(Err(format!(
+            "no contact within {} mm of descent",
+            config.max_search_mm
+        )));
     };
     let contact_z = arm.pose()?.position.z;
     let mut frames = vec![first];
     let mut travel_mm = vec![0.0];
     for j in 1..config.press_frames {
-        arm.move_linear(&above(start_z - (contact_step + j) as f64 * step_m), config.press_speed_m_s)?;
+        arm.move_linear(
+            &above(start_z - (contact_step + j) as f64 * step_m),
+            config.press_speed_m_s,
+        )?;
         frames.push(tactile.capture()?);
         travel_mm.push((contact_z - arm.pose()?.position.z) * 1e3);
     }
     arm.move_linear(&safe, config.travel_speed_m_s)?;
     Ok(Ok(Press {
-        sequence: PressSequence { reference, frames, travel_mm },
+        sequence: PressSequence {
+            reference,
+            frames,
+            travel_mm,
+        },
         search_mm: contact_step as f64 * config.press_step_mm,
         ssim,
         marker_px: moved,

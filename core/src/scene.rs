@@ -32,11 +32,24 @@ pub struct SceneError {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum ObjectKind {
-    Fruit { name: String, shape: FruitShape, size_m: [f64; 3] },
-    Sphere { radius_m: f64 },
-    Ellipsoid { radii_m: [f64; 3] },
-    Box { size_m: [f64; 3] },
-    Mesh { path: PathBuf, scale: f64 },
+    Fruit {
+        name: String,
+        shape: FruitShape,
+        size_m: [f64; 3],
+    },
+    Sphere {
+        radius_m: f64,
+    },
+    Ellipsoid {
+        radii_m: [f64; 3],
+    },
+    Box {
+        size_m: [f64; 3],
+    },
+    Mesh {
+        path: PathBuf,
+        scale: f64,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -132,17 +145,31 @@ impl Scene {
     /// Parses scene text; `path` names the file in errors and anchors relative mesh paths.
     pub fn parse(text: &str, path: &Path, catalog: &FruitCatalog) -> Result<Scene, SceneError> {
         let shown = path.display().to_string();
-        let err = |field: &str, message: String| SceneError { path: shown.clone(), field: field.to_string(), message };
+        let err = |field: &str, message: String| SceneError {
+            path: shown.clone(),
+            field: field.to_string(),
+            message,
+        };
         let raw: RawScene = toml::from_str(text).map_err(|e| {
-            let line = e.span().map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
             let field = line.map_or("toml".to_string(), |l| format!("line {l}"));
             err(&field, format!("malformed TOML: {}", e.message().trim()))
         })?;
 
         let (camera_pose, intrinsics) = Self::camera(raw.camera, &err)?;
         let table = Table {
-            size_m: raw.table.as_ref().and_then(|t| t.size_m).unwrap_or(DEFAULT_TABLE_SIZE_M),
-            color: raw.table.as_ref().and_then(|t| t.color).unwrap_or(DEFAULT_TABLE_COLOR),
+            size_m: raw
+                .table
+                .as_ref()
+                .and_then(|t| t.size_m)
+                .unwrap_or(DEFAULT_TABLE_SIZE_M),
+            color: raw
+                .table
+                .as_ref()
+                .and_then(|t| t.color)
+                .unwrap_or(DEFAULT_TABLE_COLOR),
         };
         if table.size_m.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
             return Err(err("table.size_m", "must be finite and positive".into()));
@@ -159,25 +186,54 @@ impl Scene {
         if objects.is_empty() {
             return Err(err("objects", "the scene has no objects".into()));
         }
-        Ok(Scene { name: raw.name, path: path.to_path_buf(), camera_pose, intrinsics, table, objects })
+        Ok(Scene {
+            name: raw.name,
+            path: path.to_path_buf(),
+            camera_pose,
+            intrinsics,
+            table,
+            objects,
+        })
     }
 
     fn camera(
         raw: Option<RawCamera>,
         err: &impl Fn(&str, String) -> SceneError,
     ) -> Result<(Pose, CameraIntrinsics), SceneError> {
-        let raw = raw.unwrap_or(RawCamera { position_m: None, look_at_m: None, intrinsics: None });
+        let raw = raw.unwrap_or(RawCamera {
+            position_m: None,
+            look_at_m: None,
+            intrinsics: None,
+        });
         let eye = raw.position_m.unwrap_or([0.0, 0.0, 0.70]);
         let target = raw.look_at_m.unwrap_or([0.0, 0.0, 0.0]);
         if eye.iter().chain(&target).any(|v| !v.is_finite()) {
-            return Err(err("camera", "position_m and look_at_m must be finite".into()));
+            return Err(err(
+                "camera",
+                "position_m and look_at_m must be finite".into(),
+            ));
         }
         let pose = Pose::camera_looking_at(DVec3::from_array(eye), DVec3::from_array(target))
-            .ok_or_else(|| err("camera.look_at_m", "must differ from camera.position_m".into()))?;
+            .ok_or_else(|| {
+                err(
+                    "camera.look_at_m",
+                    "must differ from camera.position_m".into(),
+                )
+            })?;
         let k = raw.intrinsics.unwrap_or_default();
         let finite = [k.fx, k.fy, k.cx, k.cy].iter().all(|v| v.is_finite());
-        if !finite || k.fx <= 0.0 || k.fy <= 0.0 || k.width == 0 || k.height == 0 || k.width > 8192 || k.height > 8192 {
-            return Err(err("camera.intrinsics", "need 0 < width, height <= 8192 and finite fx, fy > 0, cx, cy".into()));
+        if !finite
+            || k.fx <= 0.0
+            || k.fy <= 0.0
+            || k.width == 0
+            || k.height == 0
+            || k.width > 8192
+            || k.height > 8192
+        {
+            return Err(err(
+                "camera.intrinsics",
+                "need 0 < width, height <= 8192 and finite fx, fy > 0, cx, cy".into(),
+            ));
         }
         Ok((pose, k))
     }
@@ -192,25 +248,48 @@ impl Scene {
     ) -> Result<SceneObject, SceneError> {
         let field = |name: &str| format!("objects[{i}].{name}");
         let positive = |name: &str, v: f64| -> Result<f64, SceneError> {
-            if v.is_finite() && v > 0.0 { Ok(v) } else { Err(err(&field(name), format!("must be finite and positive, got {v}"))) }
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(err(
+                    &field(name),
+                    format!("must be finite and positive, got {v}"),
+                ))
+            }
         };
-        let need = |name: &str, v: Option<f64>| v.ok_or_else(|| err(&field(name), format!("required for kind '{}'", o.kind)));
+        let need = |name: &str, v: Option<f64>| {
+            v.ok_or_else(|| err(&field(name), format!("required for kind '{}'", o.kind)))
+        };
         let need3 = |name: &str, v: Option<[f64; 3]>| -> Result<[f64; 3], SceneError> {
-            let v = v.ok_or_else(|| err(&field(name), format!("required for kind '{}'", o.kind)))?;
+            let v =
+                v.ok_or_else(|| err(&field(name), format!("required for kind '{}'", o.kind)))?;
             for x in v {
                 positive(name, x)?;
             }
             Ok(v)
         };
 
-        let [x, y] = <[f64; 2]>::try_from(o.position_m.as_slice())
-            .map_err(|_| err(&field("position_m"), format!("expected [x, y] in metres, got {} numbers", o.position_m.len())))?;
+        let [x, y] = <[f64; 2]>::try_from(o.position_m.as_slice()).map_err(|_| {
+            err(
+                &field("position_m"),
+                format!(
+                    "expected [x, y] in metres, got {} numbers",
+                    o.position_m.len()
+                ),
+            )
+        })?;
         if !(x.is_finite() && y.is_finite()) {
-            return Err(err(&field("position_m"), format!("must be finite, got [{x}, {y}]")));
+            return Err(err(
+                &field("position_m"),
+                format!("must be finite, got [{x}, {y}]"),
+            ));
         }
         let [hx, hy] = [table.size_m[0] / 2.0, table.size_m[1] / 2.0];
         if x.abs() > hx || y.abs() > hy {
-            return Err(err(&field("position_m"), format!("[{x}, {y}] is off the table (|x| <= {hx}, |y| <= {hy})")));
+            return Err(err(
+                &field("position_m"),
+                format!("[{x}, {y}] is off the table (|x| <= {hx}, |y| <= {hy})"),
+            ));
         }
         let yaw_deg = o.yaw_deg.unwrap_or(0.0);
         if !yaw_deg.is_finite() {
@@ -221,12 +300,25 @@ impl Scene {
         }
         let poisson = o.poisson.unwrap_or(DEFAULT_POISSON);
         if !(poisson.is_finite() && (0.0..0.5).contains(&poisson)) {
-            return Err(err(&field("poisson"), format!("must lie in [0, 0.5), got {poisson}")));
+            return Err(err(
+                &field("poisson"),
+                format!("must lie in [0, 0.5), got {poisson}"),
+            ));
         }
         let explicit_hardness = match (&o.hardness, o.modulus_mpa) {
-            (Some(_), Some(_)) => return Err(err(&field("hardness"), "give hardness or modulus_mpa, not both".into())),
-            (Some(h), None) => Some(Hardness::parse(h).map_err(|e| err(&field("hardness"), e.to_string()))?),
-            (None, Some(e)) => Some(Hardness::from_modulus_mpa(e).map_err(|e| err(&field("modulus_mpa"), e.to_string()))?),
+            (Some(_), Some(_)) => {
+                return Err(err(
+                    &field("hardness"),
+                    "give hardness or modulus_mpa, not both".into(),
+                ));
+            }
+            (Some(h), None) => {
+                Some(Hardness::parse(h).map_err(|e| err(&field("hardness"), e.to_string()))?)
+            }
+            (None, Some(e)) => Some(
+                Hardness::from_modulus_mpa(e)
+                    .map_err(|e| err(&field("modulus_mpa"), e.to_string()))?,
+            ),
             (None, None) => None,
         };
 
@@ -234,48 +326,108 @@ impl Scene {
         let (kind, label, hardness, ripeness, color) = match kind_name.as_str() {
             "sphere" | "ellipsoid" | "box" | "mesh" => {
                 if o.ripeness.is_some() {
-                    return Err(err(&field("ripeness"), format!("only catalog fruits have ripeness stages, not '{kind_name}'")));
+                    return Err(err(
+                        &field("ripeness"),
+                        format!("only catalog fruits have ripeness stages, not '{kind_name}'"),
+                    ));
                 }
                 let kind = match kind_name.as_str() {
-                    "sphere" => ObjectKind::Sphere { radius_m: positive("radius_m", need("radius_m", o.radius_m)?)? },
-                    "ellipsoid" => ObjectKind::Ellipsoid { radii_m: need3("radii_m", o.radii_m)? },
-                    "box" => ObjectKind::Box { size_m: need3("size_m", o.size_m)? },
+                    "sphere" => ObjectKind::Sphere {
+                        radius_m: positive("radius_m", need("radius_m", o.radius_m)?)?,
+                    },
+                    "ellipsoid" => ObjectKind::Ellipsoid {
+                        radii_m: need3("radii_m", o.radii_m)?,
+                    },
+                    "box" => ObjectKind::Box {
+                        size_m: need3("size_m", o.size_m)?,
+                    },
                     _ => {
-                        let rel = o.mesh.as_ref().ok_or_else(|| err(&field("mesh"), "required for kind 'mesh'".into()))?;
+                        let rel = o.mesh.as_ref().ok_or_else(|| {
+                            err(&field("mesh"), "required for kind 'mesh'".into())
+                        })?;
                         let path = base.join(rel);
                         if !path.is_file() {
-                            return Err(err(&field("mesh"), format!("mesh file '{}' not found", path.display())));
+                            return Err(err(
+                                &field("mesh"),
+                                format!("mesh file '{}' not found", path.display()),
+                            ));
                         }
-                        ObjectKind::Mesh { path, scale: positive("scale", o.scale.unwrap_or(1.0))? }
+                        ObjectKind::Mesh {
+                            path,
+                            scale: positive("scale", o.scale.unwrap_or(1.0))?,
+                        }
                     }
                 };
-                let hardness = explicit_hardness
-                    .ok_or_else(|| err(&field("hardness"), format!("required for kind '{kind_name}' (or modulus_mpa)")))?;
-                (kind, o.label.clone().unwrap_or(kind_name.clone()), hardness, None, o.color.unwrap_or(DEFAULT_OBJECT_COLOR))
+                let hardness = explicit_hardness.ok_or_else(|| {
+                    err(
+                        &field("hardness"),
+                        format!("required for kind '{kind_name}' (or modulus_mpa)"),
+                    )
+                })?;
+                (
+                    kind,
+                    o.label.clone().unwrap_or(kind_name.clone()),
+                    hardness,
+                    None,
+                    o.color.unwrap_or(DEFAULT_OBJECT_COLOR),
+                )
             }
             _ => {
                 let fruit = catalog.find_word(&kind_name).ok_or_else(|| {
-                    err(&field("kind"), format!("unknown kind '{}' (known: sphere, ellipsoid, box, mesh, {})", o.kind, catalog.names().join(", ")))
+                    err(
+                        &field("kind"),
+                        format!(
+                            "unknown kind '{}' (known: sphere, ellipsoid, box, mesh, {})",
+                            o.kind,
+                            catalog.names().join(", ")
+                        ),
+                    )
                 })?;
                 let stage_name = o.ripeness.clone().unwrap_or(fruit.default_stage.clone());
                 let stage = fruit.stage(&stage_name).ok_or_else(|| {
                     let known: Vec<_> = fruit.stages.iter().map(|s| s.name.as_str()).collect();
-                    err(&field("ripeness"), format!("unknown ripeness stage '{stage_name}' for {} (known: {})", fruit.name, known.join(", ")))
+                    err(
+                        &field("ripeness"),
+                        format!(
+                            "unknown ripeness stage '{stage_name}' for {} (known: {})",
+                            fruit.name,
+                            known.join(", ")
+                        ),
+                    )
                 })?;
                 let hardness = explicit_hardness.unwrap_or(Hardness::ModulusMpa(stage.modulus_mpa));
                 // The stage the fruit is in follows its stiffness when the scene overrides it.
                 let ripeness = fruit.stage_for_modulus(hardness.modulus_mpa()).name.clone();
-                let color = o.color.unwrap_or(fruit.stage(&ripeness).map_or(stage.color, |s| s.color));
-                let kind = ObjectKind::Fruit { name: fruit.name.clone(), shape: fruit.shape, size_m: fruit.size_m };
+                let color = o
+                    .color
+                    .unwrap_or(fruit.stage(&ripeness).map_or(stage.color, |s| s.color));
+                let kind = ObjectKind::Fruit {
+                    name: fruit.name.clone(),
+                    shape: fruit.shape,
+                    size_m: fruit.size_m,
+                };
                 (kind, fruit.name.clone(), hardness, Some(ripeness), color)
             }
         };
-        Ok(SceneObject { label, kind, position_m: [x, y], yaw_deg, hardness, ripeness, color, poisson })
+        Ok(SceneObject {
+            label,
+            kind,
+            position_m: [x, y],
+            yaw_deg,
+            hardness,
+            ripeness,
+            color,
+            poisson,
+        })
     }
 }
 
 fn check_color(c: &[f64; 3]) -> Result<(), String> {
-    if c.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)) { Ok(()) } else { Err(format!("must be [r, g, b] in [0, 1], got {c:?}")) }
+    if c.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)) {
+        Ok(())
+    } else {
+        Err(format!("must be [r, g, b] in [0, 1], got {c:?}"))
+    }
 }
 
 #[cfg(test)]
@@ -323,20 +475,37 @@ mod tests {
     #[test]
     fn bad_fields_are_named() {
         let e = error_of("name = \"x\"\n[[objects]]\nkind = \"pear\"\nposition_m = [0, 0]\n");
-        assert!(e.starts_with("t.toml: objects[0].kind: unknown kind 'pear'"), "{e}");
-        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"banana\"\nripeness = \"rotten\"\nposition_m = [0, 0]\n");
-        assert!(e.contains("objects[0].ripeness: unknown ripeness stage 'rotten'"), "{e}");
+        assert!(
+            e.starts_with("t.toml: objects[0].kind: unknown kind 'pear'"),
+            "{e}"
+        );
+        let e = error_of(
+            "name = \"x\"\n[[objects]]\nkind = \"banana\"\nripeness = \"rotten\"\nposition_m = [0, 0]\n",
+        );
+        assert!(
+            e.contains("objects[0].ripeness: unknown ripeness stage 'rotten'"),
+            "{e}"
+        );
         let e = error_of("name = \"x\"\n[[objects]]\nkind = \"banana\"\nposition_m = [nan, 0]\n");
         assert!(e.contains("objects[0].position_m: must be finite"), "{e}");
         let e = error_of("name = \"x\"\n[[objects]]\nkind = \"banana\"\nposition_m = [3.0, 0]\n");
-        assert!(e.contains("objects[0].position_m") && e.contains("off the table"), "{e}");
-        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"mesh\"\nmesh = \"nope.obj\"\nhardness = \"40A\"\nposition_m = [0, 0]\n");
+        assert!(
+            e.contains("objects[0].position_m") && e.contains("off the table"),
+            "{e}"
+        );
+        let e = error_of(
+            "name = \"x\"\n[[objects]]\nkind = \"mesh\"\nmesh = \"nope.obj\"\nhardness = \"40A\"\nposition_m = [0, 0]\n",
+        );
         assert!(e.contains("objects[0].mesh: mesh file"), "{e}");
         let e = error_of("name = \"x\"\n[[objects]\nkind = 3\n");
         assert!(e.starts_with("t.toml: line 2: malformed TOML"), "{e}");
-        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"sphere\"\nposition_m = [0, 0]\nhardness = \"40A\"\n");
+        let e = error_of(
+            "name = \"x\"\n[[objects]]\nkind = \"sphere\"\nposition_m = [0, 0]\nhardness = \"40A\"\n",
+        );
         assert!(e.contains("objects[0].radius_m: required"), "{e}");
-        let e = error_of("name = \"x\"\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\ncolour = [1, 0, 0]\n");
+        let e = error_of(
+            "name = \"x\"\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\ncolour = [1, 0, 0]\n",
+        );
         assert!(e.contains("unknown field `colour`"), "{e}");
         assert!(!e.contains('\n'), "errors are one line: {e}");
     }

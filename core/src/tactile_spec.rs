@@ -41,9 +41,18 @@ impl TactileSpec {
             width_px: 320,
             height_px: 240,
             mm_per_px: 0.0634,
-            gel: GelSpec { modulus_mpa: 0.3, poisson: 0.49, thickness_mm: 4.0 },
+            gel: GelSpec {
+                modulus_mpa: 0.3,
+                poisson: 0.49,
+                thickness_mm: 4.0,
+            },
             photometric: PhotometricModel::default(),
-            markers: MarkerGrid { cols: 9, rows: 7, pitch_mm: 2.0, radius_mm: 0.25 },
+            markers: MarkerGrid {
+                cols: 9,
+                rows: 7,
+                pitch_mm: 2.0,
+                radius_mm: 0.25,
+            },
             frame_rate_hz: 25.0,
         }
     }

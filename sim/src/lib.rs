@@ -1,1 +1,38 @@
+//! tactex-sim: the simulated twin behind tactex-core's device traits.
+//!
+//! One `SimWorld` (objects settled on the table by rapier3d, the tool pose, the simulated
+//! clock) is shared by the sim devices: `SimCamera` renders RGB-D frames of it, `SimArm`
+//! moves the GelSight pad through it, and `SimGelSight` renders what the gel sees when the
+//! pad presses into an object (elastic contact -> gel fields -> shading and markers).
 
+pub mod arm;
+pub mod camera;
+pub mod contact;
+pub mod gelsight;
+pub mod layer;
+pub mod mesh;
+pub mod world;
+
+use tactex_core::scene::Scene;
+use tactex_core::tactile_spec::TactileSpec;
+
+/// The three sim devices over one shared world.
+pub struct SimDevices {
+    pub world: world::SharedWorld,
+    pub camera: camera::SimCamera,
+    pub tactile: gelsight::SimGelSight,
+    pub arm: arm::SimArm,
+}
+
+impl SimDevices {
+    pub fn from_scene(scene: &Scene, seed: u64) -> Result<Self, world::WorldError> {
+        let shared = world::SimWorld::from_scene(scene)?.shared();
+        let spec = TactileSpec::gelsight_mini();
+        Ok(Self {
+            camera: camera::SimCamera::new(shared.clone(), seed),
+            tactile: gelsight::SimGelSight::new(shared.clone(), spec.clone(), seed),
+            arm: arm::SimArm::new(shared.clone(), spec),
+            world: shared,
+        })
+    }
+}

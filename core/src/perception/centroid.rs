@@ -17,7 +17,12 @@ pub fn median_depth(frames: &[&DepthImage]) -> Option<DepthImage> {
     let mut samples = Vec::with_capacity(frames.len());
     for (i, px) in out.iter_mut().enumerate() {
         samples.clear();
-        samples.extend(frames.iter().map(|f| f.as_raw()[i]).filter(|d| *d > 0.0 && d.is_finite()));
+        samples.extend(
+            frames
+                .iter()
+                .map(|f| f.as_raw()[i])
+                .filter(|d| *d > 0.0 && d.is_finite()),
+        );
         if !samples.is_empty() {
             *px = median_f32(&mut samples);
         }
@@ -28,7 +33,11 @@ pub fn median_depth(frames: &[&DepthImage]) -> Option<DepthImage> {
 fn median_f32(v: &mut [f32]) -> f32 {
     v.sort_by(f32::total_cmp);
     let n = v.len();
-    if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
 }
 
 pub fn median(v: &mut [f64]) -> Option<f64> {
@@ -37,16 +46,26 @@ pub fn median(v: &mut [f64]) -> Option<f64> {
     }
     v.sort_by(f64::total_cmp);
     let n = v.len();
-    Some(if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) })
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
 }
 
 /// World points of the mask's pixels with valid depth.
-pub fn back_project_mask(mask: &GrayImage, depth: &DepthImage, k: &CameraIntrinsics, camera: &Pose) -> Vec<DVec3> {
+pub fn back_project_mask(
+    mask: &GrayImage,
+    depth: &DepthImage,
+    k: &CameraIntrinsics,
+    camera: &Pose,
+) -> Vec<DVec3> {
     mask.enumerate_pixels()
         .filter(|(_, _, m)| m[0] > 0)
         .filter_map(|(u, v, _)| {
             let z = depth.get_pixel(u, v)[0] as f64;
-            (z > 0.0 && z.is_finite()).then(|| camera.transform_point(k.back_project(u as f64, v as f64, z)))
+            (z > 0.0 && z.is_finite())
+                .then(|| camera.transform_point(k.back_project(u as f64, v as f64, z)))
         })
         .collect()
 }

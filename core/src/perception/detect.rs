@@ -29,10 +29,20 @@ pub struct ClassicalDetector<'a> {
 
 impl<'a> ClassicalDetector<'a> {
     pub fn new(catalog: &'a FruitCatalog) -> Self {
-        Self { catalog, min_height_m: 0.006, min_pixels: 150 }
+        Self {
+            catalog,
+            min_height_m: 0.006,
+            min_pixels: 150,
+        }
     }
 
-    pub fn detect(&self, color: &RgbImage, depth: &DepthImage, k: &CameraIntrinsics, camera: &Pose) -> Vec<Detection> {
+    pub fn detect(
+        &self,
+        color: &RgbImage,
+        depth: &DepthImage,
+        k: &CameraIntrinsics,
+        camera: &Pose,
+    ) -> Vec<Detection> {
         let (w, h) = depth.dimensions();
         let mut world = vec![None; (w * h) as usize];
         let foreground = GrayImage::from_fn(w, h, |u, v| {
@@ -57,7 +67,10 @@ impl<'a> ClassicalDetector<'a> {
             .skip(1)
             .filter(|m| m.len() >= self.min_pixels)
             .filter_map(|pixels| {
-                let points: Vec<DVec3> = pixels.iter().filter_map(|(u, v)| world[(v * w + u) as usize]).collect();
+                let points: Vec<DVec3> = pixels
+                    .iter()
+                    .filter_map(|(u, v)| world[(v * w + u) as usize])
+                    .collect();
                 let size_m = footprint(&points)?;
                 let chroma = mean_chromaticity(color, &pixels)?;
                 let (label, score) = self.classify(chroma, size_m)?;
@@ -65,9 +78,20 @@ impl<'a> ClassicalDetector<'a> {
                 let mut bbox = [u32::MAX, u32::MAX, 0, 0];
                 for &(u, v) in &pixels {
                     mask.put_pixel(u, v, Luma([255]));
-                    bbox = [bbox[0].min(u), bbox[1].min(v), bbox[2].max(u), bbox[3].max(v)];
+                    bbox = [
+                        bbox[0].min(u),
+                        bbox[1].min(v),
+                        bbox[2].max(u),
+                        bbox[3].max(v),
+                    ];
                 }
-                Some(Detection { label, score, bbox, mask, size_m })
+                Some(Detection {
+                    label,
+                    score,
+                    bbox,
+                    mask,
+                    size_m,
+                })
             })
             .collect()
     }
@@ -79,7 +103,9 @@ impl<'a> ClassicalDetector<'a> {
             .fruits
             .iter()
             .map(|f| {
-                let d_size = (0..3).map(|i| ((size[i] / f.size_m[i]).ln() / [0.15, 0.15, 0.25][i]).powi(2)).sum::<f64>();
+                let d_size = (0..3)
+                    .map(|i| ((size[i] / f.size_m[i]).ln() / [0.15, 0.15, 0.25][i]).powi(2))
+                    .sum::<f64>();
                 let d = f
                     .stages
                     .iter()
@@ -126,7 +152,10 @@ fn footprint(points: &[DVec3]) -> Option<[f64; 3]> {
         return None;
     }
     let n = points.len() as f64;
-    let (mx, my) = (points.iter().map(|p| p.x).sum::<f64>() / n, points.iter().map(|p| p.y).sum::<f64>() / n);
+    let (mx, my) = (
+        points.iter().map(|p| p.x).sum::<f64>() / n,
+        points.iter().map(|p| p.y).sum::<f64>() / n,
+    );
     let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
     for p in points {
         let (dx, dy) = (p.x - mx, p.y - my);

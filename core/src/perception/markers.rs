@@ -14,7 +14,10 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
     // Local background over a window a few marker diameters wide.
     let background = imageproc::filter::box_filter(&lum, 9, 9);
     let dark = GrayImage::from_fn(w, h, |x, y| {
-        let (l, b) = (lum.get_pixel(x, y)[0] as f64, background.get_pixel(x, y)[0] as f64);
+        let (l, b) = (
+            lum.get_pixel(x, y)[0] as f64,
+            background.get_pixel(x, y)[0] as f64,
+        );
         Luma([if l < 0.6 * b { 255 } else { 0 }])
     });
     let labels = connected_components(&dark, Connectivity::Eight, Luma([0u8]));
@@ -23,7 +26,8 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
     for (x, y, l) in labels.enumerate_pixels() {
         let id = l[0] as usize;
         if id > 0 {
-            let weight = (background.get_pixel(x, y)[0] as f64 - lum.get_pixel(x, y)[0] as f64).max(1.0);
+            let weight =
+                (background.get_pixel(x, y)[0] as f64 - lum.get_pixel(x, y)[0] as f64).max(1.0);
             let a = &mut acc[id];
             a.0 += weight * x as f64;
             a.1 += weight * y as f64;
@@ -37,13 +41,21 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
         .filter(|a| (6..=600).contains(&a.3))
         .map(|a| (a.0 / a.2, a.1 / a.2))
         .collect();
-    out.sort_by(|p, q| (p.1.round(), p.0).partial_cmp(&(q.1.round(), q.0)).unwrap_or(std::cmp::Ordering::Equal));
+    out.sort_by(|p, q| {
+        (p.1.round(), p.0)
+            .partial_cmp(&(q.1.round(), q.0))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
     out
 }
 
 /// For each reference marker, its displacement to the nearest current marker within
 /// `max_px`, or None when it was lost.
-pub fn track(reference: &[(f64, f64)], current: &[(f64, f64)], max_px: f64) -> Vec<Option<(f64, f64)>> {
+pub fn track(
+    reference: &[(f64, f64)],
+    current: &[(f64, f64)],
+    max_px: f64,
+) -> Vec<Option<(f64, f64)>> {
     reference
         .iter()
         .map(|r| {
@@ -63,8 +75,17 @@ pub const MARKER_NOISE_FLOOR_PX: f64 = 0.5;
 /// "mean marker displacement" of the contact test, taken over the markers the contact moves
 /// rather than the whole grid, so that it does not shrink with the pad's size.
 pub fn mean_moved_displacement(displacements: &[Option<(f64, f64)>]) -> f64 {
-    let moved: Vec<f64> = displacements.iter().flatten().map(|d| d.0.hypot(d.1)).filter(|m| *m > MARKER_NOISE_FLOOR_PX).collect();
-    if moved.is_empty() { 0.0 } else { moved.iter().sum::<f64>() / moved.len() as f64 }
+    let moved: Vec<f64> = displacements
+        .iter()
+        .flatten()
+        .map(|d| d.0.hypot(d.1))
+        .filter(|m| *m > MARKER_NOISE_FLOOR_PX)
+        .collect();
+    if moved.is_empty() {
+        0.0
+    } else {
+        moved.iter().sum::<f64>() / moved.len() as f64
+    }
 }
 
 #[cfg(test)]
@@ -74,14 +95,26 @@ mod tests {
 
     fn dots(centres: &[(f64, f64)]) -> RgbImage {
         RgbImage::from_fn(120, 90, |x, y| {
-            let inside = centres.iter().any(|c| (x as f64 - c.0).hypot(y as f64 - c.1) <= 3.0);
-            if inside { Rgb([30, 30, 30]) } else { Rgb([170, 150, 140]) }
+            let inside = centres
+                .iter()
+                .any(|c| (x as f64 - c.0).hypot(y as f64 - c.1) <= 3.0);
+            if inside {
+                Rgb([30, 30, 30])
+            } else {
+                Rgb([170, 150, 140])
+            }
         })
     }
 
     #[test]
     fn finds_and_tracks_dots() {
-        let rest = [(20.0, 20.0), (60.0, 20.0), (100.0, 20.0), (20.0, 60.0), (60.0, 60.0)];
+        let rest = [
+            (20.0, 20.0),
+            (60.0, 20.0),
+            (100.0, 20.0),
+            (20.0, 60.0),
+            (60.0, 60.0),
+        ];
         let found = detect_markers(&dots(&rest));
         assert_eq!(found.len(), rest.len());
         for (f, r) in found.iter().zip(&rest) {
@@ -89,7 +122,10 @@ mod tests {
         }
         let moved: Vec<_> = rest.iter().map(|r| (r.0 + 3.0, r.1 - 1.0)).collect();
         let d = track(&found, &detect_markers(&dots(&moved)), 8.0);
-        assert!(d.iter().all(|d| d.is_some_and(|d| (d.0 - 3.0).abs() < 0.3 && (d.1 + 1.0).abs() < 0.3)));
+        assert!(
+            d.iter()
+                .all(|d| d.is_some_and(|d| (d.0 - 3.0).abs() < 0.3 && (d.1 + 1.0).abs() < 0.3))
+        );
         assert!((mean_moved_displacement(&d) - 10f64.sqrt()).abs() < 0.3);
     }
 }

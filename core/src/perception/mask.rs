@@ -7,7 +7,11 @@ use imageproc::distance_transform::Norm;
 /// Binary mask (255 inside) -> inner mask.
 pub fn refine_mask(mask: &GrayImage) -> GrayImage {
     let edges = imageproc::edges::canny(mask, 50.0, 100.0);
-    let band = imageproc::morphology::dilate(&imageproc::morphology::dilate(&edges, Norm::LInf, 1), Norm::LInf, 1);
+    let band = imageproc::morphology::dilate(
+        &imageproc::morphology::dilate(&edges, Norm::LInf, 1),
+        Norm::LInf,
+        1,
+    );
     let mut inner = mask.clone();
     for (p, b) in inner.pixels_mut().zip(band.pixels()) {
         if b[0] > 0 {

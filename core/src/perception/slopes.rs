@@ -21,7 +21,11 @@ fn is_dark(p: &image::Rgb<u8>) -> bool {
 
 /// Inverts `model` against `reference`. Pixels dark in either frame (markers) are invalid, and
 /// so is a 2 px ring around them where the dot's soft edge mixes with the shading.
-pub fn recover_slopes(frame: &RgbImage, reference: &RgbImage, model: &PhotometricModel) -> Option<SlopeField> {
+pub fn recover_slopes(
+    frame: &RgbImage,
+    reference: &RgbImage,
+    model: &PhotometricModel,
+) -> Option<SlopeField> {
     if frame.dimensions() != reference.dimensions() {
         return None;
     }
@@ -57,7 +61,13 @@ pub fn recover_slopes(frame: &RgbImage, reference: &RgbImage, model: &Photometri
             None => valid[i] = false,
         }
     }
-    Some(SlopeField { width: w, height: h, gx, gy, valid })
+    Some(SlopeField {
+        width: w,
+        height: h,
+        gx,
+        gy,
+        valid,
+    })
 }
 
 #[cfg(test)]
@@ -70,11 +80,20 @@ mod tests {
         let model = PhotometricModel::default();
         let reference = RgbImage::from_pixel(16, 12, Rgb([150, 140, 130]));
         let g = model.gain_for_slope(0.2, -0.1);
-        let frame = RgbImage::from_fn(16, 12, |_, _| Rgb(std::array::from_fn(|c| (reference.get_pixel(0, 0)[c] as f64 * g[c]).round() as u8)));
+        let frame = RgbImage::from_fn(16, 12, |_, _| {
+            Rgb(std::array::from_fn(|c| {
+                (reference.get_pixel(0, 0)[c] as f64 * g[c]).round() as u8
+            }))
+        });
         let s = recover_slopes(&frame, &reference, &model).unwrap();
         let i = 6 * 16 + 8;
         assert!(s.valid[i]);
         // 8-bit quantisation of ~150 levels limits the slope to about 1/100.
-        assert!((s.gx[i] - 0.2).abs() < 0.02 && (s.gy[i] + 0.1).abs() < 0.02, "{} {}", s.gx[i], s.gy[i]);
+        assert!(
+            (s.gx[i] - 0.2).abs() < 0.02 && (s.gy[i] + 0.1).abs() < 0.02,
+            "{} {}",
+            s.gx[i],
+            s.gy[i]
+        );
     }
 }

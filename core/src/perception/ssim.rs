@@ -8,7 +8,9 @@ use image::RgbImage;
 const WIN: usize = 7;
 
 pub fn gray(img: &RgbImage) -> Vec<f64> {
-    img.pixels().map(|p| 0.2125 * p[0] as f64 + 0.7154 * p[1] as f64 + 0.0721 * p[2] as f64).collect()
+    img.pixels()
+        .map(|p| 0.2125 * p[0] as f64 + 0.7154 * p[1] as f64 + 0.0721 * p[2] as f64)
+        .collect()
 }
 
 /// Mean SSIM of two equally sized colour images (on grey levels). None if sizes differ or the
@@ -17,7 +19,13 @@ pub fn ssim_rgb(a: &RgbImage, b: &RgbImage) -> Option<f64> {
     if a.dimensions() != b.dimensions() {
         return None;
     }
-    ssim(&gray(a), &gray(b), a.width() as usize, a.height() as usize, 255.0)
+    ssim(
+        &gray(a),
+        &gray(b),
+        a.width() as usize,
+        a.height() as usize,
+        255.0,
+    )
 }
 
 pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize, data_range: f64) -> Option<f64> {
@@ -33,7 +41,8 @@ pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize, data_range: f64) -> Option
             let v = [p, q, p * p, q * q, p * q];
             for k in 0..5 {
                 sums[(y + 1) * stride + x + 1][k] =
-                    v[k] + sums[y * stride + x + 1][k] + sums[(y + 1) * stride + x][k] - sums[y * stride + x][k];
+                    v[k] + sums[y * stride + x + 1][k] + sums[(y + 1) * stride + x][k]
+                        - sums[y * stride + x][k];
             }
         }
     }
@@ -47,13 +56,15 @@ pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize, data_range: f64) -> Option
         for x0 in 0..=w - WIN {
             let (y1, x1) = (y0 + WIN, x0 + WIN);
             let s: [f64; 5] = std::array::from_fn(|k| {
-                sums[y1 * stride + x1][k] - sums[y0 * stride + x1][k] - sums[y1 * stride + x0][k] + sums[y0 * stride + x0][k]
+                sums[y1 * stride + x1][k] - sums[y0 * stride + x1][k] - sums[y1 * stride + x0][k]
+                    + sums[y0 * stride + x0][k]
             });
             let (ux, uy) = (s[0] / n, s[1] / n);
             let vx = cov_norm * (s[2] / n - ux * ux);
             let vy = cov_norm * (s[3] / n - uy * uy);
             let vxy = cov_norm * (s[4] / n - ux * uy);
-            total += ((2.0 * ux * uy + c1) * (2.0 * vxy + c2)) / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
+            total += ((2.0 * ux * uy + c1) * (2.0 * vxy + c2))
+                / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
             count += 1;
         }
     }
@@ -75,12 +86,17 @@ mod tests {
         // skimage.metrics.structural_similarity(a, b, data_range=255), scikit-image 0.24.0:
         // a = np.arange(100).reshape(10, 10) * 2.0, b = a.T -> 0.20338005833552134
         let a: Vec<f64> = (0..100).map(|i| i as f64 * 2.0).collect();
-        let b: Vec<f64> = (0..100).map(|i| ((i % 10) * 10 + i / 10) as f64 * 2.0).collect();
+        let b: Vec<f64> = (0..100)
+            .map(|i| ((i % 10) * 10 + i / 10) as f64 * 2.0)
+            .collect();
         assert!((ssim(&a, &b, 10, 10, 255.0).unwrap() - 0.20338005833552134).abs() < 1e-12);
         // i, j = np.mgrid[0:12, 0:15]; a = (i*7 + j*13) % 251; b = (i*i*3 + j*5) % 239
         // -> 0.2680080611613147; c = a + (i*j) % 5 -> 0.9987080820050751
         let grid = |f: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
-            (0..12).flat_map(|i| (0..15).map(move |j| (i, j))).map(|(i, j)| f(i, j)).collect()
+            (0..12)
+                .flat_map(|i| (0..15).map(move |j| (i, j)))
+                .map(|(i, j)| f(i, j))
+                .collect()
         };
         let a = grid(&|i, j| ((i * 7 + j * 13) % 251) as f64);
         let b = grid(&|i, j| ((i * i * 3 + j * 5) % 239) as f64);

@@ -1,0 +1,391 @@
+//! Triangle meshes: procedural fruit and primitive shapes, and OBJ / glTF files.
+
+use glam::{DQuat, DVec3};
+use std::f64::consts::PI;
+use std::path::Path;
+use tactex_core::catalog::FruitShape;
+
+#[derive(Clone, Debug, Default)]
+pub struct TriMesh {
+    pub vertices: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("{path}: cannot read mesh: {message}")]
+    Read { path: String, message: String },
+    #[error("{path}: mesh has no triangles")]
+    Empty { path: String },
+    #[error("{path}: mesh is degenerate ({message})")]
+    Degenerate { path: String, message: String },
+    #[error("{path}: unsupported mesh format (use .obj, .gltf or .glb)")]
+    Format { path: String },
+}
+
+impl TriMesh {
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        self.vertices.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+        )
+    }
+
+    /// Scales each axis so the bounding box is `size` and centres it at the origin.
+    pub fn fit_box(mut self, size: DVec3) -> Self {
+        let (lo, hi) = self.bounds();
+        let scale = size / (hi - lo).max(DVec3::splat(1e-12));
+        let centre = (lo + hi) / 2.0;
+        for v in &mut self.vertices {
+            *v = (*v - centre) * scale;
+        }
+        self
+    }
+
+    pub fn transformed(&self, rotation: DQuat, translation: DVec3) -> TriMesh {
+        TriMesh {
+            vertices: self
+                .vertices
+                .iter()
+                .map(|v| rotation * *v + translation)
+                .collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+
+    /// Area-weighted vertex normals (outward for consistently wound meshes).
+    pub fn vertex_normals(&self) -> Vec<DVec3> {
+        let mut n = vec![DVec3::ZERO; self.vertices.len()];
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| self.vertices[i as usize]);
+            let face = (b - a).cross(c - a);
+            for &i in t {
+                n[i as usize] += face;
+            }
+        }
+        n.into_iter()
+            .map(|v| v.try_normalize().unwrap_or(DVec3::Z))
+            .collect()
+    }
+
+    /// Rejects meshes that cannot be simulated: no triangles, bad indices, non-finite or flat.
+    pub fn validate(&self, path: &str) -> Result<(), MeshError> {
+        if self.triangles.is_empty() || self.vertices.len() < 4 {
+            return Err(MeshError::Empty { path: path.into() });
+        }
+        let bad = |message: &str| MeshError::Degenerate {
+            path: path.into(),
+            message: message.into(),
+        };
+        if self.vertices.iter().any(|v| !v.is_finite()) {
+            return Err(bad("non-finite vertex"));
+        }
+        if self
+            .triangles
+            .iter()
+            .flatten()
+            .any(|&i| i as usize >= self.vertices.len())
+        {
+            return Err(bad("triangle index out of range"));
+        }
+        let (lo, hi) = self.bounds();
+        let ext = hi - lo;
+        if ext.min_element() <= 1e-6 * ext.max_element().max(1e-12) {
+            return Err(bad("flat or zero-size bounding box"));
+        }
+        let area: f64 = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.vertices[i as usize]);
+                (b - a).cross(c - a).length() / 2.0
+            })
+            .sum();
+        if area <= 0.0 {
+            return Err(bad("zero surface area"));
+        }
+        Ok(())
+    }
+}
+
+/// A closed latitude-longitude surface around the x axis: `profile(u)` gives the point for
+/// u = (along in [0, 1], around in [0, 1)).
+fn lat_long(along: usize, around: usize, point: impl Fn(f64, f64) -> DVec3) -> TriMesh {
+    let mut m = TriMesh::default();
+    m.vertices.push(point(0.0, 0.0));
+    for i in 1..along {
+        for j in 0..around {
+            m.vertices
+                .push(point(i as f64 / along as f64, j as f64 / around as f64));
+        }
+    }
+    m.vertices.push(point(1.0, 0.0));
+    let ring = |i: usize, j: usize| (1 + (i - 1) * around + j % around) as u32;
+    let last = (m.vertices.len() - 1) as u32;
+    for j in 0..around {
+        m.triangles.push([0, ring(1, j + 1), ring(1, j)]);
+        m.triangles
+            .push([last, ring(along - 1, j), ring(along - 1, j + 1)]);
+    }
+    for i in 1..along - 1 {
+        for j in 0..around {
+            m.triangles
+                .push([ring(i, j), ring(i, j + 1), ring(i + 1, j + 1)]);
+            m.triangles
+                .push([ring(i, j), ring(i + 1, j + 1), ring(i + 1, j)]);
+        }
+    }
+    m
+}
+
+const ALONG: usize = 48;
+const AROUND: usize = 96;
+
+/// An ellipsoid with semi-axes `radii`.
+pub fn ellipsoid(radii: DVec3) -> TriMesh {
+    lat_long(ALONG, AROUND, |t, s| {
+        let (theta, phi) = (PI * t, 2.0 * PI * s);
+        DVec3::new(
+            -theta.cos(),
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+        ) * radii
+    })
+}
+
+/// An egg: cross-sections swell towards the -x end, fitted to the bounding box `size`.
+pub fn egg(size: DVec3) -> TriMesh {
+    lat_long(ALONG, AROUND, |t, s| {
+        let (theta, phi) = (PI * t, 2.0 * PI * s);
+        let x = -theta.cos();
+        let swell = 1.0 - 0.22 * x;
+        DVec3::new(
+            x,
+            swell * theta.sin() * phi.cos(),
+            swell * theta.sin() * phi.sin(),
+        )
+    })
+    .fit_box(size)
+}
+
+/// A banana: a tube tapering to both tips, bent along a circular arc in the x-y plane,
+/// fitted to the bounding box `size` (length, width including the bend, thickness).
+pub fn banana(size: DVec3) -> TriMesh {
+    let half_angle: f64 = 0.5;
+    let bend = ((size.y - size.z).max(0.0) / (1.0 - half_angle.cos())).max(1e-6);
+    let tube = size.z / 2.0;
+    lat_long(ALONG, AROUND, |t, s| {
+        let a = (2.0 * t - 1.0) * half_angle;
+        let taper = (1.0 - (2.0 * t - 1.0).powi(4))
+            .max(0.0)
+            .powf(0.35)
+            .max(0.05);
+        let centre = DVec3::new(bend * a.sin(), bend * (1.0 - a.cos()), 0.0);
+        let tangent = DVec3::new(a.cos(), a.sin(), 0.0);
+        let normal = DVec3::new(-a.sin(), a.cos(), 0.0);
+        let phi = 2.0 * PI * s;
+        let r = tube * taper;
+        // Tips close the tube along its tangent.
+        let tip = if t == 0.0 {
+            -tube * 0.3
+        } else if t == 1.0 {
+            tube * 0.3
+        } else {
+            0.0
+        };
+        centre + tangent * tip + (normal * phi.cos() + DVec3::Z * phi.sin()) * r
+    })
+    .fit_box(size)
+}
+
+pub fn cuboid(size: DVec3) -> TriMesh {
+    let h = size / 2.0;
+    let vertices = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { -h.x } else { h.x },
+                if i & 2 == 0 { -h.y } else { h.y },
+                if i & 4 == 0 { -h.z } else { h.z },
+            )
+        })
+        .collect();
+    let triangles = vec![
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6],
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7],
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5],
+    ];
+    TriMesh {
+        vertices,
+        triangles,
+    }
+}
+
+pub fn fruit(shape: FruitShape, size: DVec3) -> TriMesh {
+    match shape {
+        FruitShape::Ellipsoid => ellipsoid(size / 2.0),
+        FruitShape::Egg => egg(size),
+        FruitShape::Banana => banana(size),
+    }
+}
+
+/// Loads an OBJ or glTF/GLB mesh (all its triangles, node transforms applied), in metres.
+pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
+    let shown = path.display().to_string();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    let read_err = |message: String| MeshError::Read {
+        path: shown.clone(),
+        message,
+    };
+    let mesh = match ext.as_str() {
+        "obj" => {
+            let opts = tobj::LoadOptions {
+                triangulate: true,
+                single_index: true,
+                ..Default::default()
+            };
+            let (models, _) = tobj::load_obj(path, &opts).map_err(|e| read_err(e.to_string()))?;
+            let mut m = TriMesh::default();
+            for model in models {
+                let base = m.vertices.len() as u32;
+                m.vertices.extend(
+                    model
+                        .mesh
+                        .positions
+                        .chunks_exact(3)
+                        .map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)),
+                );
+                m.triangles.extend(
+                    model
+                        .mesh
+                        .indices
+                        .chunks_exact(3)
+                        .map(|t| [base + t[0], base + t[1], base + t[2]]),
+                );
+            }
+            m
+        }
+        "gltf" | "glb" => {
+            let (doc, buffers, _) = gltf::import(path).map_err(|e| read_err(e.to_string()))?;
+            let mut m = TriMesh::default();
+            let scene = doc
+                .default_scene()
+                .or_else(|| doc.scenes().next())
+                .ok_or_else(|| MeshError::Empty {
+                    path: shown.clone(),
+                })?;
+            for node in scene.nodes() {
+                gltf_node(&node, glam::DMat4::IDENTITY, &buffers, &mut m);
+            }
+            m
+        }
+        _ => return Err(MeshError::Format { path: shown }),
+    };
+    mesh.validate(&shown)?;
+    Ok(mesh)
+}
+
+fn gltf_node(
+    node: &gltf::Node,
+    parent: glam::DMat4,
+    buffers: &[gltf::buffer::Data],
+    out: &mut TriMesh,
+) {
+    let local = glam::Mat4::from_cols_array_2d(&node.transform().matrix()).as_dmat4();
+    let world = parent * local;
+    if let Some(mesh) = node.mesh() {
+        for prim in mesh.primitives() {
+            if prim.mode() != gltf::mesh::Mode::Triangles {
+                continue;
+            }
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            let Some(positions) = reader.read_positions() else {
+                continue;
+            };
+            let base = out.vertices.len() as u32;
+            out.vertices.extend(positions.map(|p| {
+                world.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+            }));
+            let count = out.vertices.len() as u32 - base;
+            match reader.read_indices() {
+                Some(idx) => {
+                    let idx: Vec<u32> = idx.into_u32().collect();
+                    out.triangles.extend(
+                        idx.chunks_exact(3)
+                            .map(|t| [base + t[0], base + t[1], base + t[2]]),
+                    );
+                }
+                None => out.triangles.extend(
+                    (0..count / 3).map(|i| [base + 3 * i, base + 3 * i + 1, base + 3 * i + 2]),
+                ),
+            }
+        }
+    }
+    for child in node.children() {
+        gltf_node(&child, world, buffers, out);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn procedural_fruit_fill_their_bounding_box() {
+        let size = DVec3::new(0.19, 0.06, 0.036);
+        for shape in [FruitShape::Ellipsoid, FruitShape::Egg, FruitShape::Banana] {
+            let (lo, hi) = fruit(shape, size).bounds();
+            assert!(((hi - lo) - size).abs().max_element() < 1e-9, "{shape:?}");
+        }
+    }
+
+    #[test]
+    fn ellipsoid_vertices_lie_on_the_surface_and_face_out() {
+        let r = DVec3::new(0.05, 0.04, 0.03);
+        let m = ellipsoid(r);
+        for v in &m.vertices {
+            assert!(((*v / r).length_squared() - 1.0).abs() < 1e-9);
+        }
+        let n = m.vertex_normals();
+        assert!(
+            m.vertices.iter().zip(&n).all(|(v, n)| v.dot(*n) > 0.0),
+            "normals point outward"
+        );
+    }
+
+    #[test]
+    fn bad_mesh_files_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let empty = dir.path().join("empty.obj");
+        std::fs::write(&empty, "# nothing\n").unwrap();
+        assert!(load(&empty).unwrap_err().to_string().contains("empty.obj"));
+        let flat = dir.path().join("flat.obj");
+        std::fs::write(
+            &flat,
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n",
+        )
+        .unwrap();
+        assert!(load(&flat).unwrap_err().to_string().contains("degenerate"));
+        let garbage = dir.path().join("bad.glb");
+        std::fs::write(&garbage, "not a gltf").unwrap();
+        assert!(
+            load(&garbage)
+                .unwrap_err()
+                .to_string()
+                .starts_with(&garbage.display().to_string())
+        );
+        assert!(load(&dir.path().join("missing.obj")).is_err());
+    }
+}
