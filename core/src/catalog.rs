@@ -63,7 +63,7 @@ impl FruitSpec {
 
     pub fn answers_to(&self, word: &str) -> bool {
         let w = word.to_ascii_lowercase();
-        w == self.name || w == self.plural || self.synonyms.iter().any(|s| *s == w)
+        w == self.name || w == self.plural || self.synonyms.contains(&w)
     }
 }
 

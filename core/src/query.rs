@@ -156,7 +156,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let extreme =
         (intent == Intent::Extreme).then_some(if least { Extreme::Least } else { Extreme::Most });
     // A superlative over one named kind ("the softest banana") ranks the instances of it.
-    let all = all && !(intent == Intent::Extreme && !targets.is_empty());
+    let all = all && (intent != Intent::Extreme || targets.is_empty());
     Ok(Query {
         intent,
         property,

@@ -75,13 +75,13 @@ impl Arm for SimArm {
                 p.x, p.y, p.z
             )));
         }
-        if let Some(c) = gel_contact(&world, target, &self.spec) {
-            if c.approach_mm > self.max_approach_mm {
-                return Err(self.refuse(format!(
-                    "target presses {:.1} mm into the {} (limit {} mm)",
-                    c.approach_mm, world.objects[c.object].label, self.max_approach_mm
-                )));
-            }
+        if let Some(c) = gel_contact(&world, target, &self.spec)
+            && c.approach_mm > self.max_approach_mm
+        {
+            return Err(self.refuse(format!(
+                "target presses {:.1} mm into the {} (limit {} mm)",
+                c.approach_mm, world.objects[c.object].label, self.max_approach_mm
+            )));
         }
         let distance = (p - world.tool.position).length();
         world.time_s += self.move_duration_s(distance, speed_m_s);

@@ -69,7 +69,7 @@ impl SimCamera {
             intrinsics,
             pose,
             clean: None,
-            rng: ChaCha8Rng::seed_from_u64(seed ^ 0xca3e_7a),
+            rng: ChaCha8Rng::seed_from_u64(seed ^ 0x00ca_3e7a),
             color_noise: 2.0,
             depth_noise_at_1m: 0.002,
             frame_rate_hz: 30.0,

@@ -59,8 +59,9 @@ fn fit_quadric(points: &[DVec3]) -> Option<[f64; 6]> {
         for r in 0..6 {
             if r != col {
                 let f = a[r][col] / a[col][col];
-                for c in col..7 {
-                    a[r][c] -= f * a[col][c];
+                let pivot_row = a[col];
+                for (x, p) in a[r].iter_mut().zip(pivot_row).skip(col) {
+                    *x -= f * p;
                 }
             }
         }

@@ -1,0 +1,277 @@
+//! End-to-end tests of `tactex ask` and `tactex scene check` on the simulated twin.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use tactex_core::catalog::FruitCatalog;
+use tactex_core::scene::Scene;
+use tactex_sim::world::SimWorld;
+
+fn repo(p: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(p)
+}
+
+fn tactex(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("runs tactex")
+}
+
+fn ask_json(scene: &str, prompt: &str) -> Value {
+    let out = tactex(&["ask", "--json", "--reproducible", "--scene", scene, prompt]);
+    assert!(
+        out.status.success(),
+        "tactex ask failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is one JSON object")
+}
+
+fn modulus(o: &Value) -> f64 {
+    o["hardness"]["modulus_mpa"]
+        .as_f64()
+        .unwrap_or(f64::INFINITY)
+}
+
+fn selected_labels(a: &Value) -> Vec<String> {
+    a["selected"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| {
+            a["objects"][i.as_u64().unwrap() as usize]["label"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect()
+}
+
+#[test]
+fn demo_scene_answers_the_softest_fruit_with_positions_hardness_and_latency() {
+    let a = ask_json("scenes/demo.toml", "Which fruit is the softest?");
+    // Ground truth of scenes/demo.toml: the ripe tomato (0.45 MPa) is the softest of six.
+    assert_eq!(selected_labels(&a), vec!["tomato"]);
+    assert_eq!(a["objects"].as_array().unwrap().len(), 6);
+    assert!(
+        a["answer"]
+            .as_str()
+            .unwrap()
+            .starts_with("The softest fruit is the tomato at the right front")
+    );
+    let stages: Vec<&str> = a["timing"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["stage"].as_str().unwrap())
+        .collect();
+    assert_eq!(stages, ["parse", "ground", "press", "hardness", "explain"]);
+    assert!(
+        a["timing"][2]["sim_s"].as_f64().unwrap() > 1.0,
+        "pressing takes robot time"
+    );
+    for o in a["objects"].as_array().unwrap() {
+        assert!(
+            o["hardness"]["shore_a"].is_number() && o["hardness"]["shore_00"].is_number(),
+            "{o}"
+        );
+        assert_eq!(o["position_m"].as_array().unwrap().len(), 3);
+    }
+}
+
+#[test]
+fn five_fruits_are_found_placed_and_ordered_by_hardness() {
+    let catalog = FruitCatalog::builtin();
+    let scene = Scene::load(&repo("tests/scenes/five.toml"), &catalog).unwrap();
+    let truth = SimWorld::from_scene(&scene).unwrap();
+
+    let a = ask_json("tests/scenes/five.toml", "Which fruit is the softest?");
+    let objects = a["objects"].as_array().unwrap();
+    assert_eq!(objects.len(), 5, "every fruit is returned");
+    let mut measured = Vec::new();
+    for o in objects {
+        let label = o["label"].as_str().unwrap();
+        let (k, t) = truth
+            .objects
+            .iter()
+            .enumerate()
+            .find(|(_, t)| t.label == label)
+            .unwrap_or_else(|| panic!("unexpected {label}"));
+        let p: Vec<f64> = o["position_m"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let err = ((p[0] - t.centre.x).powi(2)
+            + (p[1] - t.centre.y).powi(2)
+            + (p[2] - t.centre.z).powi(2))
+        .sqrt();
+        assert!(err < 0.02, "{label} is {err:.4} m from its true centre");
+        measured.push((
+            scene.objects[k].hardness.modulus_mpa().unwrap(),
+            modulus(o),
+            label.to_string(),
+        ));
+    }
+    measured.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let estimates: Vec<f64> = measured.iter().map(|m| m.1).collect();
+    assert!(
+        estimates.windows(2).all(|w| w[0] < w[1]),
+        "estimated order {measured:?}"
+    );
+    assert_eq!(selected_labels(&a), vec!["kiwi"]);
+
+    let a = ask_json("tests/scenes/five.toml", "Which fruit is the hardest?");
+    assert_eq!(selected_labels(&a), vec!["apple"]);
+    let a = ask_json(
+        "tests/scenes/five.toml",
+        "Identify the hardness of the lemon",
+    );
+    assert_eq!(selected_labels(&a), vec!["lemon"]);
+    assert_eq!(
+        a["objects"].as_array().unwrap().len(),
+        1,
+        "only the lemon is touched"
+    );
+    assert!(a["answer"].as_str().unwrap().contains("lemon"));
+}
+
+#[test]
+fn one_fruit_scene_and_a_fruit_that_is_not_there() {
+    let a = ask_json("tests/scenes/one.toml", "How hard is the mango?");
+    assert_eq!(selected_labels(&a), vec!["mango"]);
+    let e = modulus(&a["objects"][0]);
+    assert!(
+        (0.45..0.8).contains(&e),
+        "ripe mango is 0.6 MPa, estimated {e}"
+    );
+    let a = ask_json("tests/scenes/one.toml", "How hard is the kiwi?");
+    assert!(a["objects"].as_array().unwrap().is_empty());
+    assert!(
+        a["answer"]
+            .as_str()
+            .unwrap()
+            .contains("I could not find a kiwi on the table.")
+    );
+}
+
+#[test]
+fn same_scene_and_seed_give_identical_bytes() {
+    let run = |seed: &str| {
+        tactex(&[
+            "ask",
+            "--json",
+            "--reproducible",
+            "--seed",
+            seed,
+            "--scene",
+            "tests/scenes/one.toml",
+            "How hard is the mango?",
+        ])
+        .stdout
+    };
+    let first = run("7");
+    assert!(!first.is_empty());
+    assert_eq!(first, run("7"));
+    assert_ne!(first, run("8"), "the seed drives the sensor noise");
+}
+
+#[test]
+fn scene_check_loads_obj_and_gltf_meshes() {
+    let out = tactex(&["scene", "check", "scenes/meshes.toml"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.matches("pear").count(), 2, "{text}");
+    for scene in ["scenes/demo.toml", "scenes/bananas.toml"] {
+        assert!(
+            tactex(&["scene", "check", scene]).status.success(),
+            "{scene}"
+        );
+    }
+}
+
+/// Runs a failing command and returns its one-line error.
+fn fails(args: &[&str]) -> String {
+    let out = tactex(args);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "expected exit 1 for {args:?}, stderr: {err}"
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "no half-written output on stdout: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    err
+}
+
+fn bad_scene(body: &str) -> (tempfile::TempDir, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.toml");
+    std::fs::write(&path, body).unwrap();
+    (dir, path.display().to_string())
+}
+
+#[test]
+fn bad_input_gets_a_one_line_error_naming_file_and_field() {
+    let softest = "Which fruit is the softest?";
+    let e = fails(&["ask", "--scene", "no/such/scene.toml", softest]);
+    assert!(
+        e.contains("no/such/scene.toml: file: cannot read scene"),
+        "{e}"
+    );
+
+    let cases = [
+        ("name = \"x\"\n[[objects]\n", "line 2: malformed TOML"),
+        (
+            "name = \"x\"\n[[objects]]\nkind = \"durian\"\nposition_m = [0, 0]\n",
+            "objects[0].kind: unknown kind 'durian'",
+        ),
+        (
+            "name = \"x\"\n[[objects]]\nkind = \"banana\"\nripeness = \"rotten\"\nposition_m = [0, 0]\n",
+            "objects[0].ripeness: unknown ripeness stage 'rotten'",
+        ),
+        (
+            "name = \"x\"\n[[objects]]\nkind = \"lime\"\nposition_m = [nan, 0.0]\n",
+            "objects[0].position_m: must be finite",
+        ),
+        (
+            "name = \"x\"\n[[objects]]\nkind = \"lime\"\nposition_m = [0.0, 1.5]\n",
+            "objects[0].position_m: [0, 1.5] is off the table",
+        ),
+    ];
+    for (body, expected) in cases {
+        let (_dir, path) = bad_scene(body);
+        let e = fails(&["ask", "--scene", &path, softest]);
+        assert!(e.contains(&format!("{path}: {expected}")), "{e}");
+        let e = fails(&["scene", "check", &path]);
+        assert!(e.contains(expected), "{e}");
+    }
+
+    // A mesh file that exists but is not a mesh.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("junk.obj"), "v 1 2\nf 9 9 9\n").unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, "name = \"x\"\n[[objects]]\nkind = \"mesh\"\nmesh = \"junk.obj\"\nhardness = \"40A\"\nposition_m = [0, 0]\n").unwrap();
+    let e = fails(&["ask", "--scene", path.to_str().unwrap(), softest]);
+    assert!(
+        e.contains("objects[0].mesh") && e.contains("junk.obj"),
+        "{e}"
+    );
+
+    let e = fails(&["ask", "  "]);
+    assert!(e.contains("prompt: empty"), "{e}");
+    let e = fails(&["ask", "How hard is the pineapple?"]);
+    assert!(e.contains("prompt: names no known fruit"), "{e}");
+}
