@@ -63,12 +63,6 @@ fn default_scene() -> PathBuf {
     }
 }
 
-fn load_scene(path: &Path, catalog: &FruitCatalog) -> Result<(Scene, SimDevices, u64)> {
-    let scene = Scene::load(path, catalog)?;
-    let devices = SimDevices::from_scene(&scene, 0)?;
-    Ok((scene, devices, 0))
-}
-
 fn ask(
     scene: Option<PathBuf>,
     seed: u64,
@@ -146,7 +140,8 @@ fn print_answer(a: &Answer) {
 
 fn scene_check(file: &Path) -> Result<()> {
     let catalog = FruitCatalog::builtin();
-    let (scene, sim, _) = load_scene(file, &catalog)?;
+    let scene = Scene::load(file, &catalog)?;
+    let sim = SimDevices::from_scene(&scene, 0)?;
     let world = sim
         .world
         .lock()
