@@ -8,6 +8,7 @@
 pub mod arm;
 pub mod camera;
 pub mod contact;
+pub mod elastic;
 pub mod gelsight;
 pub mod layer;
 pub mod mesh;

@@ -1,0 +1,144 @@
+//! The `hertz` level: the object's surface near its lowest point is fitted by a quadric and
+//! replaced by the sphere of the same Gaussian curvature, sqrt(R1 R2); Hertz theory then
+//! gives the pressure, and each body takes its compliance share of the approach. The gel's
+//! lateral field is Johnson's half-space solution (eq. 3.41a) under that pressure.
+
+use super::grid::Grid;
+use glam::DVec2;
+use tactex_core::hertz::Hertz;
+
+/// The equivalent sphere of a contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EquivalentSphere {
+    pub centre_mm: DVec2,
+    pub radius_mm: f64,
+}
+
+/// Least-squares quadric z = c0 + c1 x + c2 y + c3 x^2 + c4 xy + c5 y^2.
+pub fn fit_quadric(points: &[(DVec2, f64)]) -> Option<[f64; 6]> {
+    let mut a = [[0.0f64; 7]; 6];
+    for (p, z) in points {
+        let row = [1.0, p.x, p.y, p.x * p.x, p.x * p.y, p.y * p.y];
+        for i in 0..6 {
+            for j in 0..6 {
+                a[i][j] += row[i] * row[j];
+            }
+            a[i][6] += row[i] * z;
+        }
+    }
+    for col in 0..6 {
+        let pivot = (col..6).max_by(|&r, &s| a[r][col].abs().total_cmp(&a[s][col].abs()))?;
+        if a[pivot][col].abs() < 1e-300 {
+            return None;
+        }
+        a.swap(col, pivot);
+        for r in 0..6 {
+            if r != col {
+                let f = a[r][col] / a[col][col];
+                let pivot_row = a[col];
+                for (x, p) in a[r].iter_mut().zip(pivot_row).skip(col) {
+                    *x -= f * p;
+                }
+            }
+        }
+    }
+    let c: [f64; 6] = std::array::from_fn(|i| a[i][6] / a[i][i]);
+    c.iter().all(|v| v.is_finite()).then_some(c)
+}
+
+/// Fits the sphere to the cells of `heights` (relative to first touch) below `level`. On a
+/// saddle or a near-cylinder the smaller curvature is capped at 1/20 of the larger.
+pub fn equivalent_sphere(grid: &Grid, heights: &[f64], level: f64) -> Option<EquivalentSphere> {
+    let lowest = (0..heights.len()).min_by(|&a, &b| heights[a].total_cmp(&heights[b]))?;
+    if !heights[lowest].is_finite() {
+        return None;
+    }
+    let apex = grid.centre(lowest % grid.nx, lowest / grid.nx);
+    // Coordinates relative to the apex keep the normal equations well conditioned.
+    let scale = grid.cell_mm * grid.nx.max(grid.ny) as f64;
+    // The central part of the dip (inside the Hertz contact, h < level / 2, or smaller)
+    // where a sphere is still close to its osculating paraboloid, with enough cells to fit.
+    let patch = |cut: f64| -> Vec<(DVec2, f64)> {
+        heights
+            .iter()
+            .enumerate()
+            .filter(|(_, h)| h.is_finite() && **h <= cut)
+            .map(|(k, h)| ((grid.centre(k % grid.nx, k / grid.nx) - apex) / scale, *h))
+            .collect()
+    };
+    let mut points = patch(level / 4.0);
+    for cut in [level / 2.0, level] {
+        if points.len() >= 24 {
+            break;
+        }
+        points = patch(cut);
+    }
+    let fallback = EquivalentSphere {
+        centre_mm: apex,
+        radius_mm: f64::INFINITY,
+    };
+    if points.len() < 6 {
+        return Some(fallback);
+    }
+    let Some(c) = fit_quadric(&points) else {
+        return Some(fallback);
+    };
+    let s2 = scale * scale;
+    let (h11, h12, h22) = (2.0 * c[3] / s2, c[4] / s2, 2.0 * c[5] / s2);
+    let mean = (h11 + h22) / 2.0;
+    let spread = (((h11 - h22) / 2.0).powi(2) + h12 * h12).sqrt();
+    let (k1, k2) = (mean + spread, mean - spread);
+    if k1 <= 0.0 {
+        return Some(fallback);
+    }
+    let det = h11 * h22 - h12 * h12;
+    let offset = if det > 0.0 {
+        let (g1, g2) = (c[1] / scale, c[2] / scale);
+        DVec2::new((-g1 * h22 + g2 * h12) / det, (-g2 * h11 + g1 * h12) / det)
+    } else {
+        DVec2::ZERO
+    };
+    let centre = (apex + offset).clamp(grid.rect().min, grid.rect().max);
+    Some(EquivalentSphere {
+        centre_mm: centre,
+        radius_mm: 1.0 / (k1 * k2.max(k1 / 20.0)).sqrt(),
+    })
+}
+
+/// The gel's radial displacement at r under the Hertz pressure (Johnson eq. 3.41a), for a
+/// gel of compliance `gel_compliance` and half-space lateral ratio `t_inf`.
+pub fn gel_radial_mm(hertz: &Hertz, r: f64, gel_compliance: f64, t_inf: f64) -> f64 {
+    let a = hertz.contact_radius_mm();
+    if a <= 0.0 || r <= 0.0 {
+        return 0.0;
+    }
+    let p0 = hertz.max_pressure_mpa();
+    let shape = if r < a {
+        1.0 - (1.0 - (r / a).powi(2)).powf(1.5)
+    } else {
+        1.0
+    };
+    2.0 / 3.0 * t_inf * gel_compliance * p0 * a * a / r * shape
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::elastic::grid::Rect;
+    use crate::elastic::surface::ObjectSurface;
+
+    #[test]
+    fn recovers_an_ellipsoids_gaussian_curvature_radius() {
+        let surface = ObjectSurface::Ellipsoid {
+            semi_axes_mm: glam::DVec3::new(30.0, 20.0, 25.0),
+            centre_mm: DVec2::new(0.5, -0.3),
+        };
+        let grid = Grid::covering(&Rect::centred(DVec2::splat(3.0)), 0.1);
+        let heights = surface.heights(&grid);
+        let s = equivalent_sphere(&grid, &heights, 0.05).unwrap();
+        // Principal radii a^2 / c and b^2 / c at the pole.
+        let expected = (900.0 / 25.0 * 400.0 / 25.0f64).sqrt();
+        assert!((s.radius_mm - expected).abs() / expected < 0.01, "{s:?}");
+        assert!((s.centre_mm - DVec2::new(0.5, -0.3)).length() < 0.01);
+    }
+}

@@ -1,0 +1,238 @@
+//! Influence coefficients: the surface displacement at one cell centre due to a unit
+//! uniform pressure on another cell, per unit compliance c = (1 - nu^2) / E.
+//!
+//! Half-space: the point-load responses are w = c / (pi r) (Boussinesq) and the radial
+//! u_r = T_inf c / (pi r) with T_inf = -(1 - 2 nu) / (2 (1 - nu)). Integrated exactly over a
+//! square cell (Love 1929; Johnson 1985 eq. 3.25 and its tangential analogue).
+//!
+//! Bonded layer of thickness h: by Hankel transform of the Fourier-space response
+//! (`crate::layer`), w = (c / pi) [1/r + C_w(r)] and u_r = (c / pi) [T_inf / r + C_u(r)] with
+//! the smooth corrections
+//!   C_w(r) = int_0^inf (K(kh) - 1) J0(kr) dk,
+//!   C_u(r) = int_0^inf (T(kh) K(kh) - T_inf) J1(kr) dk.
+//! Adding and subtracting T e^{-kb} terms with known transforms makes both integrands vanish
+//! at k = 0 and decay exponentially, so plain quadrature converges; the corrections are
+//! tabulated in r and averaged over a cell with 2 x 2 Gauss points.
+
+use crate::layer::{lateral_ratio, normal_compliance_ratio};
+use std::f64::consts::PI;
+
+/// The half-space radial-to-normal displacement ratio T_inf (negative: inward).
+pub fn half_space_lateral_ratio(nu: f64) -> f64 {
+    -(1.0 - 2.0 * nu) / (2.0 * (1.0 - nu))
+}
+
+/// t asinh(s / |t|), continuous at t = 0.
+fn t_asinh(t: f64, s: f64) -> f64 {
+    if t == 0.0 {
+        0.0
+    } else {
+        t * (s / t.abs()).asinh()
+    }
+}
+
+/// Normal displacement at offset (x, y) from the centre of a square cell of half side `a`
+/// under unit pressure, unit compliance.
+pub fn love_normal(x: f64, y: f64, a: f64) -> f64 {
+    // F(X, Y) = double antiderivative of 1 / sqrt(X^2 + Y^2).
+    let f = |u: f64, v: f64| t_asinh(u, v) + t_asinh(v, u);
+    (f(x + a, y + a) - f(x - a, y + a) - f(x + a, y - a) + f(x - a, y - a)) / PI
+}
+
+/// Displacement along x at offset (x, y) from a cell of half side `a` for a point response
+/// x / (pi r^2) (the half-space lateral kernel without its factor T_inf).
+pub fn love_lateral_x(x: f64, y: f64, a: f64) -> f64 {
+    // H(X, Y) = double antiderivative of X / (X^2 + Y^2).
+    let h = |u: f64, v: f64| {
+        let r2 = u * u + v * v;
+        let log_term = if v == 0.0 { 0.0 } else { 0.5 * v * r2.ln() };
+        let atan_term = if u == 0.0 { 0.0 } else { u * (v / u).atan() };
+        log_term + atan_term
+    };
+    (h(x + a, y + a) - h(x - a, y + a) - h(x + a, y - a) + h(x - a, y - a)) / PI
+}
+
+/// Tabulated layer corrections C_w and C_u for one thickness and Poisson ratio.
+#[derive(Clone, Debug)]
+pub struct LayerCorrection {
+    pub thickness_mm: f64,
+    pub poisson: f64,
+    dr: f64,
+    normal: Vec<f64>,
+    lateral: Vec<f64>,
+}
+
+impl LayerCorrection {
+    /// Tables out to `r_max_mm`.
+    pub fn new(thickness_mm: f64, poisson: f64, r_max_mm: f64) -> Self {
+        let h = thickness_mm;
+        let b = h;
+        let t_inf = half_space_lateral_ratio(poisson);
+        let dr = h / 48.0;
+        let n_r = (r_max_mm / dr).ceil() as usize + 2;
+        let r_max = dr * n_r as f64;
+        // Resolve both the integrand (scale 1/h) and the Bessel oscillation (period 2 pi / r).
+        let k_max = 40.0 / h;
+        let dk = (0.05 / h).min(2.0 * PI / (12.0 * r_max));
+        let n_k = ((k_max / dk).ceil() as usize).div_ceil(2) * 2;
+        let dk = k_max / n_k as f64;
+        let ks: Vec<f64> = (0..=n_k).map(|q| q as f64 * dk).collect();
+        let g_w: Vec<f64> = ks
+            .iter()
+            .map(|&k| {
+                if k == 0.0 {
+                    0.0
+                } else {
+                    normal_compliance_ratio(k * h, poisson) - 1.0 + (-k * b).exp()
+                }
+            })
+            .collect();
+        let g_u: Vec<f64> = ks
+            .iter()
+            .map(|&k| {
+                if k == 0.0 {
+                    0.0
+                } else {
+                    lateral_ratio(k * h, poisson) * normal_compliance_ratio(k * h, poisson) - t_inf
+                        + t_inf * (-k * b).exp()
+                }
+            })
+            .collect();
+        // Simpson weights.
+        let weight = |q: usize| {
+            if q == 0 || q == n_k {
+                dk / 3.0
+            } else if q % 2 == 1 {
+                4.0 * dk / 3.0
+            } else {
+                2.0 * dk / 3.0
+            }
+        };
+        let mut normal = Vec::with_capacity(n_r + 1);
+        let mut lateral = Vec::with_capacity(n_r + 1);
+        for m in 0..=n_r {
+            let r = m as f64 * dr;
+            let (mut cw, mut cu) = (0.0, 0.0);
+            for (q, &k) in ks.iter().enumerate() {
+                let w = weight(q);
+                cw += w * g_w[q] * libm::j0(k * r);
+                cu += w * g_u[q] * libm::j1(k * r);
+            }
+            let root = (b * b + r * r).sqrt();
+            cw -= 1.0 / root;
+            // int e^{-kb} J1(kr) dk = (1 - b / sqrt(b^2 + r^2)) / r = r / (root (root + b)).
+            cu -= t_inf * r / (root * (root + b));
+            normal.push(cw);
+            lateral.push(cu);
+        }
+        Self {
+            thickness_mm,
+            poisson,
+            dr,
+            normal,
+            lateral,
+        }
+    }
+
+    pub fn r_max_mm(&self) -> f64 {
+        self.dr * (self.normal.len() - 1) as f64
+    }
+
+    fn lookup(table: &[f64], dr: f64, r: f64) -> f64 {
+        let x = r / dr;
+        let i = (x.floor() as usize).min(table.len() - 2);
+        let f = (x - i as f64).min(1.0);
+        table[i] * (1.0 - f) + table[i + 1] * f
+    }
+
+    /// (C_w, C_u) at radius r (mm).
+    pub fn at(&self, r: f64) -> (f64, f64) {
+        (
+            Self::lookup(&self.normal, self.dr, r),
+            Self::lookup(&self.lateral, self.dr, r),
+        )
+    }
+}
+
+/// Influence coefficients of one cell on another at offset (x, y) mm, per unit compliance.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CellResponse {
+    pub normal: f64,
+    pub lateral_x: f64,
+    pub lateral_y: f64,
+}
+
+/// The response of a half-space (`layer` None) or a bonded layer at offset (x, y) from a
+/// loaded cell of side `cell`.
+pub fn cell_response(
+    x: f64,
+    y: f64,
+    cell: f64,
+    poisson: f64,
+    layer: Option<&LayerCorrection>,
+) -> CellResponse {
+    let a = cell / 2.0;
+    let t_inf = half_space_lateral_ratio(poisson);
+    let mut out = CellResponse {
+        normal: love_normal(x, y, a),
+        lateral_x: t_inf * love_lateral_x(x, y, a),
+        lateral_y: t_inf * love_lateral_x(y, x, a),
+    };
+    if let Some(layer) = layer {
+        // 2 x 2 Gauss-Legendre over the loaded cell of the smooth corrections.
+        let g = a / 3f64.sqrt();
+        let quarter = cell * cell / 4.0 / PI;
+        for (sx, sy) in [(-g, -g), (g, -g), (-g, g), (g, g)] {
+            let (dx, dy) = (x - sx, y - sy);
+            let r = dx.hypot(dy);
+            let (cw, cu) = layer.at(r);
+            out.normal += quarter * cw;
+            if r > 0.0 {
+                out.lateral_x += quarter * cu * dx / r;
+                out.lateral_y += quarter * cu * dy / r;
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn love_normal_matches_the_point_load_far_away_and_the_closed_form_at_the_centre() {
+        let a = 0.5;
+        // Far field: a cell of area 4a^2 acts as a point load.
+        let far = love_normal(20.0, 5.0, a);
+        let point = 4.0 * a * a / (PI * 20.0f64.hypot(5.0));
+        assert!((far - point).abs() / point < 1e-3);
+        // Centre of a square: w = (4 / pi) * 2a * ln(1 + sqrt 2) (Johnson eq. 3.25).
+        let centre = love_normal(0.0, 0.0, a);
+        let expected = 8.0 * a * (1.0 + 2f64.sqrt()).ln() / PI;
+        assert!((centre - expected).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lateral_coefficient_is_odd_and_matches_the_point_load() {
+        let a = 0.25;
+        let (x, y) = (6.0, -3.0);
+        let far = love_lateral_x(x, y, a);
+        let point = 4.0 * a * a * x / (PI * (x * x + y * y));
+        assert!((far - point).abs() / point.abs() < 1e-3);
+        assert!((love_lateral_x(-x, y, a) + far).abs() < 1e-14);
+        assert!(love_lateral_x(0.0, 1.0, a).abs() < 1e-14);
+    }
+
+    #[test]
+    fn layer_corrections_cancel_the_half_space_far_away() {
+        // A bonded layer carries load to its base within a few thicknesses, so far from the
+        // load its surface hardly moves: C_w -> -1/r.
+        let layer = LayerCorrection::new(2.0, 0.45, 40.0);
+        let (cw, _) = layer.at(30.0);
+        assert!((cw + 1.0 / 30.0).abs() < 2e-4, "C_w(30) = {cw}");
+        // Thin near-incompressible layers are much stiffer than the half-space under a
+        // load: the correction is negative at the origin.
+        assert!(layer.at(0.0).0 < 0.0);
+    }
+}

@@ -1,0 +1,115 @@
+//! Spectra of the unit-compliance influence coefficients for one grid, cached by the solver:
+//! the half-space normal and lateral responses and, for the layer, its corrections.
+
+use super::convolution::{Convolver, Spectrum, wrapped_kernel};
+use super::grid::Grid;
+use super::influence::{CellResponse, LayerCorrection, cell_response};
+use rustfft::num_complex::Complex;
+
+/// The spectra for one grid shape and cell, one Poisson ratio, and optionally one layer.
+pub struct GridKernels {
+    pub conv: Convolver,
+    pub half_space_normal: Spectrum,
+    pub half_space_lateral: [Spectrum; 2],
+    /// Layer minus half-space, when the gel is a bonded layer.
+    pub layer_normal: Option<Spectrum>,
+    pub layer_lateral: Option<[Spectrum; 2]>,
+}
+
+/// Identifies a `GridKernels`: grid shape, cell and material (bits of the f64s).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct KernelKey {
+    nx: usize,
+    ny: usize,
+    cell: u64,
+    poisson: u64,
+    thickness: Option<u64>,
+}
+
+impl KernelKey {
+    pub fn new(grid: &Grid, poisson: f64, thickness_mm: Option<f64>) -> Self {
+        Self {
+            nx: grid.nx,
+            ny: grid.ny,
+            cell: grid.cell_mm.to_bits(),
+            poisson: poisson.to_bits(),
+            thickness: thickness_mm.map(f64::to_bits),
+        }
+    }
+}
+
+/// Evaluates the responses for all offsets once, using their symmetry: normal even in both
+/// axes, lateral x odd in x and even in y, lateral y the reverse.
+fn responses(
+    grid: &Grid,
+    poisson: f64,
+    layer: Option<&LayerCorrection>,
+) -> (Vec<CellResponse>, Vec<CellResponse>) {
+    let (nx, ny, cell) = (grid.nx, grid.ny, grid.cell_mm);
+    let mut half_space = Vec::with_capacity(nx * ny);
+    let mut with_layer = Vec::with_capacity(if layer.is_some() { nx * ny } else { 0 });
+    for dj in 0..ny {
+        for di in 0..nx {
+            let (x, y) = (di as f64 * cell, dj as f64 * cell);
+            let h = cell_response(x, y, cell, poisson, None);
+            half_space.push(h);
+            if let Some(layer) = layer {
+                let l = cell_response(x, y, cell, poisson, Some(layer));
+                with_layer.push(CellResponse {
+                    normal: l.normal - h.normal,
+                    lateral_x: l.lateral_x - h.lateral_x,
+                    lateral_y: l.lateral_y - h.lateral_y,
+                });
+            }
+        }
+    }
+    (half_space, with_layer)
+}
+
+fn spectra(conv: &mut Convolver, table: &[CellResponse]) -> (Spectrum, [Spectrum; 2]) {
+    let (nx, ny) = (conv.nx, conv.ny);
+    let at = |di: i64, dj: i64| table[dj.unsigned_abs() as usize * nx + di.unsigned_abs() as usize];
+    let normal = wrapped_kernel(nx, ny, |di, dj| at(di, dj).normal);
+    let lx = wrapped_kernel(nx, ny, |di, dj| di.signum() as f64 * at(di, dj).lateral_x);
+    let ly = wrapped_kernel(nx, ny, |di, dj| dj.signum() as f64 * at(di, dj).lateral_y);
+    (
+        conv.padded_spectrum(&normal),
+        [conv.padded_spectrum(&lx), conv.padded_spectrum(&ly)],
+    )
+}
+
+impl GridKernels {
+    pub fn new(grid: &Grid, poisson: f64, layer: Option<&LayerCorrection>) -> Self {
+        let mut conv = Convolver::new(grid.nx, grid.ny);
+        let (half_space, with_layer) = responses(grid, poisson, layer);
+        let (half_space_normal, half_space_lateral) = spectra(&mut conv, &half_space);
+        let (layer_normal, layer_lateral) = if layer.is_some() {
+            let (n, l) = spectra(&mut conv, &with_layer);
+            (Some(n), Some(l))
+        } else {
+            (None, None)
+        };
+        Self {
+            conv,
+            half_space_normal,
+            half_space_lateral,
+            layer_normal,
+            layer_lateral,
+        }
+    }
+}
+
+/// sum_i w_i S_i over spectra of one shape.
+pub fn combine(terms: &[(f64, &Spectrum)]) -> Spectrum {
+    let len = terms[0].1.0.len();
+    let mut out = vec![Complex::default(); len];
+    for (w, s) in terms {
+        if *w == 0.0 {
+            continue;
+        }
+        for (o, v) in out.iter_mut().zip(&s.0) {
+            *o += v * *w;
+        }
+    }
+    Spectrum(out)
+}
