@@ -1,6 +1,11 @@
 //! `tactex`: the TactEx twin command line. Wires the simulated devices (tactex-sim) into the
 //! backend-free pipeline (tactex-core).
 
+mod bench_contact;
+mod output;
+mod plot;
+mod press;
+
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -41,11 +46,24 @@ enum Command {
         /// The question.
         prompt: String,
     },
+    /// Press the gel into one object and report force, contact and indentation.
+    Press(press::PressArgs),
+    /// Benchmarks (run them on a release build).
+    Bench {
+        #[command(subcommand)]
+        command: BenchCommand,
+    },
     /// Scene files.
     Scene {
         #[command(subcommand)]
         command: SceneCommand,
     },
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Speed and accuracy of each contact fidelity level and solver cell.
+    Contact(bench_contact::ContactBenchArgs),
 }
 
 #[derive(Subcommand)]
@@ -192,6 +210,10 @@ fn main() -> ExitCode {
             reproducible,
             prompt,
         } => ask(scene, seed, json, reproducible, &prompt),
+        Command::Press(args) => press::run(&args),
+        Command::Bench {
+            command: BenchCommand::Contact(args),
+        } => bench_contact::run(&args),
         Command::Scene {
             command: SceneCommand::Check { file },
         } => scene_check(&file),

@@ -310,3 +310,31 @@ fn press_sequence_is_warm_started_and_monotone() {
         assert!((warm.force_n / cold.force_n - 1.0).abs() < 1e-5);
     }
 }
+
+#[test]
+fn every_catalog_fruit_mesh_can_be_pressed_at_every_level() {
+    // The procedural catalog meshes, pressed on their top at each fruit's own stages.
+    let catalog = tactex_core::catalog::FruitCatalog::builtin();
+    let mut solver = ContactSolver::new();
+    for fruit in &catalog.fruits {
+        let size = glam::DVec3::from_array(fruit.size_m);
+        let mesh = tactex_sim::mesh::fruit(fruit.shape, size);
+        let surface = ObjectSurface::from_mesh_top(&mesh, 1e3);
+        let modulus = fruit.stages.last().map(|s| s.modulus_mpa);
+        let mut forces = Vec::new();
+        for fidelity in Fidelity::ALL {
+            let mut p = problem(&surface, modulus, 4.0, 1.0);
+            p.pad = Rect::centred(DVec2::new(10.15, 7.6));
+            let s = solver.solve(&p, fidelity).unwrap();
+            assert!(
+                s.force_n > 0.0 && s.force_n.is_finite(),
+                "{} {fidelity}",
+                fruit.name
+            );
+            assert!(s.gel_max_indentation_mm > 0.0 && s.gel_max_indentation_mm <= 1.0 + 1e-9);
+            forces.push(s.force_n);
+        }
+        // The thin layer is stiffer than the half-space it refines.
+        assert!(forces[3] > forces[2], "{}: {forces:?}", fruit.name);
+    }
+}

@@ -23,6 +23,8 @@ pub struct Convolver {
     col_inv: Arc<dyn Fft<f64>>,
     row: Vec<f64>,
     half: Vec<Complex<f64>>,
+    /// Row-major half spectra of the ny field rows, (nx + 1) each.
+    half_rows: Vec<Complex<f64>>,
     work: Vec<Complex<f64>>,
     scratch: Vec<Complex<f64>>,
 }
@@ -45,6 +47,7 @@ impl Convolver {
             ny,
             row: vec![0.0; 2 * nx],
             half: vec![Complex::default(); nx + 1],
+            half_rows: vec![Complex::default(); (nx + 1) * ny],
             work: vec![Complex::default(); (nx + 1) * 2 * ny],
             scratch: vec![Complex::default(); scratch_len],
             r2c,
@@ -75,15 +78,45 @@ impl Convolver {
     }
 
     pub fn spectrum_into(&mut self, field: &[f64], out: &mut Spectrum) {
+        self.forward_field(field);
+        out.0.clone_from(&self.work);
+    }
+
+    /// The zero-padded field's spectrum into `work`: real FFTs of the ny field rows (the
+    /// padding rows are zero), a blocked transpose, then the column FFTs.
+    fn forward_field(&mut self, field: &[f64]) {
         let (nx, ny) = (self.nx, self.ny);
         assert_eq!(field.len(), nx * ny);
-        self.forward_rows(|row, j| {
-            row.fill(0.0);
-            if j < ny {
-                row[..nx].copy_from_slice(&field[j * nx..(j + 1) * nx]);
+        let columns = nx + 1;
+        for j in 0..ny {
+            let src = &field[j * nx..(j + 1) * nx];
+            let dst = &mut self.half_rows[j * columns..(j + 1) * columns];
+            if src.iter().all(|v| *v == 0.0) {
+                dst.fill(Complex::default());
+                continue;
             }
-        });
-        out.0.clone_from(&self.work);
+            self.row[..nx].copy_from_slice(src);
+            self.row[nx..].fill(0.0);
+            self.r2c
+                .process_with_scratch(&mut self.row, dst, &mut self.scratch)
+                .expect("buffer sizes come from the plan");
+        }
+        let ny2 = 2 * ny;
+        transpose(&self.half_rows, columns, &mut self.work, ny2, ny, columns);
+        for c in 0..columns {
+            self.work[c * ny2 + ny..(c + 1) * ny2].fill(Complex::default());
+        }
+        self.col_fwd
+            .process_with_scratch(&mut self.work, &mut self.scratch);
+    }
+
+    /// Linear convolution of `field` with `kernel` without keeping the field's spectrum.
+    pub fn convolve(&mut self, field: &[f64], kernel: &Spectrum, out: &mut [f64]) {
+        self.forward_field(field);
+        for (w, b) in self.work.iter_mut().zip(&kernel.0) {
+            *w *= b;
+        }
+        self.inverse_into(out);
     }
 
     fn forward_rows(&mut self, fill: impl Fn(&mut [f64], usize)) {
@@ -119,31 +152,47 @@ impl Convolver {
 
     fn inverse_into(&mut self, out: &mut [f64]) {
         let (nx, ny) = (self.nx, self.ny);
-        let ny2 = 2 * ny;
+        let (ny2, columns) = (2 * ny, nx + 1);
         self.col_inv
             .process_with_scratch(&mut self.work, &mut self.scratch);
+        // Only the first ny rows of the padded result are the linear convolution.
+        transpose(&self.work, ny2, &mut self.half_rows, columns, columns, ny);
         let norm = 1.0 / (4 * nx * ny) as f64;
         for j in 0..ny {
-            for c in 0..self.columns() {
-                self.half[c] = self.work[c * ny2 + j];
-            }
+            let half = &mut self.half_rows[j * columns..(j + 1) * columns];
             // The half spectrum of a real signal has real DC and Nyquist bins; rounding can
             // leave a tiny imaginary part that realfft rejects.
-            self.half[0].im = 0.0;
-            self.half[nx].im = 0.0;
+            half[0].im = 0.0;
+            half[nx].im = 0.0;
             self.c2r
-                .process_with_scratch(&mut self.half, &mut self.row, &mut self.scratch)
+                .process_with_scratch(half, &mut self.row, &mut self.scratch)
                 .expect("buffer sizes come from the plan");
             for (o, v) in out[j * nx..(j + 1) * nx].iter_mut().zip(&self.row) {
                 *o = v * norm;
             }
         }
     }
+}
 
-    /// Linear convolution of `field` with `kernel` in one call.
-    pub fn convolve(&mut self, field: &[f64], kernel: &Spectrum, out: &mut [f64]) {
-        let spectrum = self.spectrum(field);
-        self.apply(&spectrum, kernel, out);
+/// dst[c * dst_stride + r] = src[r * src_stride + c] for r < rows, c < cols, in tiles
+/// that stay in cache.
+fn transpose(
+    src: &[Complex<f64>],
+    src_stride: usize,
+    dst: &mut [Complex<f64>],
+    dst_stride: usize,
+    rows: usize,
+    cols: usize,
+) {
+    const TILE: usize = 16;
+    for r0 in (0..rows).step_by(TILE) {
+        for c0 in (0..cols).step_by(TILE) {
+            for r in r0..(r0 + TILE).min(rows) {
+                for c in c0..(c0 + TILE).min(cols) {
+                    dst[c * dst_stride + r] = src[r * src_stride + c];
+                }
+            }
+        }
     }
 }
 

@@ -57,11 +57,9 @@ pub fn solve(
     let mut conjugate = false;
     let mut iterations = 0;
     let mut converged = false;
-    let mut spectrum = Spectrum(Vec::new());
     while iterations < settings.max_iterations {
         iterations += 1;
-        conv.spectrum_into(&p, &mut spectrum);
-        conv.apply(&spectrum, kernel, &mut u);
+        conv.convolve(&p, kernel, &mut u);
         let mut g_sum = 0.0;
         for i in 0..n {
             gap[i] = if active[i] {
@@ -82,8 +80,7 @@ pub fn solve(
             };
         }
         g_old = g_sum;
-        conv.spectrum_into(&t, &mut spectrum);
-        conv.apply(&spectrum, kernel, &mut r);
+        conv.convolve(&t, kernel, &mut r);
         let (mut num, mut den) = (0.0, 0.0);
         for i in 0..n {
             if p[i] > 0.0 {
@@ -123,8 +120,7 @@ pub fn solve(
         }
     }
     // Final contact conditions.
-    conv.spectrum_into(&p, &mut spectrum);
-    conv.apply(&spectrum, kernel, &mut u);
+    conv.convolve(&p, kernel, &mut u);
     let (mut violation, mut count) = (0.0, 0usize);
     for i in 0..n {
         if !active[i] {

@@ -1,0 +1,342 @@
+//! `tactex bench contact`: the speed/accuracy ladder of the contact solver. For each
+//! fidelity level and solver cell, the median time per press frame (an 8-frame press,
+//! warm-started) and its error against the finest `layer` solution and against Hertz.
+
+use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::plot;
+use anyhow::{Context, Result};
+use clap::Args;
+use glam::DVec2;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use std::path::PathBuf;
+use std::time::Instant;
+use tactex_core::hertz::{Elastic, Hertz, contact_modulus_mpa, gel_share};
+use tactex_core::tactile_spec::TactileSpec;
+use tactex_sim::elastic::{
+    ContactProblem, ContactSolution, ContactSolver, Fidelity, Grid, ObjectSurface, Rect,
+};
+
+#[derive(Args, Debug)]
+pub struct ContactBenchArgs {
+    /// Print the rows as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Write contact_bench.csv, contact_bench.md and contact_pareto.png here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Timed repetitions of each 8-frame press (the median is reported).
+    #[arg(long, default_value_t = 5)]
+    reps: usize,
+    /// Solver cells to time (mm, or "auto" for the default grid).
+    #[arg(long, value_delimiter = ',', default_value = "auto,0.4,0.2,0.1")]
+    cells: Vec<String>,
+    /// Finest cell (mm): the reference `layer` solution.
+    #[arg(long, default_value_t = 0.05)]
+    reference_cell_mm: f64,
+}
+
+/// The pressed object: a 10 mm sphere of 1 MPa (a ripe-fruit modulus) on the Mini's gel.
+const RADIUS_MM: f64 = 10.0;
+const OBJECT: Elastic = Elastic {
+    modulus_mpa: Some(1.0),
+    poisson: 0.45,
+};
+
+#[derive(Serialize, Clone)]
+pub struct BenchRow {
+    pub fidelity: String,
+    /// "auto" or the cell asked for.
+    pub cell: String,
+    pub cell_mm: f64,
+    pub grid: String,
+    /// Over the local contact region, or the whole pad.
+    pub domain: &'static str,
+    pub ms_per_frame: f64,
+    pub iterations_per_frame: f64,
+    pub force_err_vs_reference_pct: f64,
+    pub radius_err_vs_reference_pct: f64,
+    pub rms_gel_um_vs_reference: f64,
+    pub force_err_vs_hertz_pct: f64,
+    pub radius_err_vs_hertz_pct: f64,
+    pub rms_gel_um_vs_hertz: f64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        (v[n / 2 - 1] + v[n / 2]) / 2.0
+    }
+}
+
+struct Setup {
+    surface: ObjectSurface,
+    spec: TactileSpec,
+    pad: Rect,
+    depths: Vec<f64>,
+}
+
+impl Setup {
+    fn problem(&self, cell_mm: Option<f64>) -> ContactProblem<'_> {
+        ContactProblem {
+            surface: &self.surface,
+            object: OBJECT,
+            gel: self.spec.gel,
+            pad: self.pad,
+            approach_mm: 0.0,
+            cell_mm,
+        }
+    }
+}
+
+/// RMS difference of the gel's normal displacement over the reference grid (micrometres).
+fn rms_um(
+    solver: &mut ContactSolver,
+    s: &ContactSolution,
+    reference: &ContactSolution,
+    truth: impl Fn(DVec2) -> Option<f64>,
+) -> f64 {
+    let g: &Grid = &reference.grid;
+    let fields = solver.fields_over(s, &g.rect());
+    let mut sum = 0.0;
+    for j in 0..g.ny {
+        for i in 0..g.nx {
+            let p = g.centre(i, j);
+            let expected = truth(p).unwrap_or(reference.gel.normal_mm[j * g.nx + i]);
+            let d = fields.grid.sample(&fields.normal_mm, p) - expected;
+            sum += d * d;
+        }
+    }
+    1e3 * (sum / g.len() as f64).sqrt()
+}
+
+pub fn run(args: &ContactBenchArgs) -> Result<()> {
+    anyhow::ensure!(args.reps >= 1, "--reps: must be at least 1");
+    anyhow::ensure!(
+        args.reference_cell_mm.is_finite() && args.reference_cell_mm > 0.0,
+        "--reference-cell-mm: must be a positive number"
+    );
+    if cfg!(debug_assertions) {
+        eprintln!(
+            "note: this is a debug build; run `cargo run --release -- bench contact` for timings"
+        );
+    }
+    let spec = TactileSpec::gelsight_mini();
+    let setup = Setup {
+        surface: ObjectSurface::Sphere {
+            radius_mm: RADIUS_MM,
+            centre_mm: DVec2::ZERO,
+        },
+        pad: Rect::centred(
+            DVec2::new(spec.width_px as f64, spec.height_px as f64) * spec.mm_per_px / 2.0,
+        ),
+        depths: (1..=8).map(|k| 0.25 * k as f64).collect(),
+        spec,
+    };
+    let gel = Elastic {
+        modulus_mpa: Some(setup.spec.gel.modulus_mpa),
+        poisson: setup.spec.gel.poisson,
+    };
+    let hertz_at = |depth: f64| Hertz {
+        radius_mm: RADIUS_MM,
+        approach_mm: depth,
+        contact_modulus_mpa: contact_modulus_mpa(gel, OBJECT),
+    };
+    let share = gel_share(gel, OBJECT);
+
+    let mut cells = Vec::new();
+    for c in &args.cells {
+        cells.push(match c.trim() {
+            "auto" => None,
+            text => Some(
+                text.parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite() && *v > 0.0)
+                    .with_context(|| {
+                        format!(
+                            "--cells: {text:?} is neither \"auto\" nor a positive cell size in mm"
+                        )
+                    })?,
+            ),
+        });
+    }
+    let mut configs: Vec<(Fidelity, Option<f64>, bool)> = Vec::new();
+    for fidelity in Fidelity::ALL {
+        for cell in &cells {
+            configs.push((fidelity, *cell, false));
+        }
+    }
+    // What modelling only the touched region saves: the same solve over the whole pad.
+    for cell in &cells {
+        configs.push((Fidelity::Layer, *cell, true));
+    }
+
+    let bar = ProgressBar::new(configs.len() as u64 + 1);
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>28} [{bar:30}] {pos}/{len} {elapsed}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_message("reference layer solve");
+    let mut solver = ContactSolver::new();
+    let reference = solver.press_sequence(
+        &setup.problem(Some(args.reference_cell_mm)),
+        Fidelity::Layer,
+        &setup.depths,
+    )?;
+    bar.inc(1);
+
+    let mut rows = Vec::new();
+    for (fidelity, cell, whole_pad) in configs {
+        let label = format!(
+            "{fidelity} {}{}",
+            cell.map_or("auto".into(), |c| format!("{c} mm")),
+            if whole_pad { " (pad)" } else { "" }
+        );
+        bar.set_message(label);
+        let problem = setup.problem(cell);
+        let deepest = *setup.depths.last().expect("eight depths");
+        let mut grid = solver.plan_grid(&problem, fidelity, deepest)?;
+        if whole_pad {
+            let cell_mm = grid.map_or(0.1, |g| g.cell_mm);
+            grid = Some(Grid::covering(&setup.pad, cell_mm));
+        }
+        let mut times = Vec::with_capacity(args.reps);
+        let mut frames: Vec<ContactSolution> = Vec::new();
+        for _ in 0..args.reps {
+            frames.clear();
+            let start = Instant::now();
+            for &depth in &setup.depths {
+                let frame = ContactProblem {
+                    approach_mm: depth,
+                    ..problem
+                };
+                let s = solver.solve_on(&frame, fidelity, grid, frames.last())?;
+                frames.push(s);
+            }
+            times.push(start.elapsed().as_secs_f64() * 1e3 / setup.depths.len() as f64);
+        }
+        let n = frames.len() as f64;
+        let mut row = BenchRow {
+            fidelity: fidelity.to_string(),
+            cell: cell.map_or("auto".into(), |c| format!("{c}")),
+            cell_mm: grid.map_or(0.0, |g| g.cell_mm),
+            grid: grid.map_or("-".into(), |g| format!("{}x{}", g.nx, g.ny)),
+            domain: if whole_pad { "pad" } else { "contact" },
+            ms_per_frame: median(times),
+            iterations_per_frame: frames.iter().map(|f| f.iterations as f64).sum::<f64>() / n,
+            force_err_vs_reference_pct: 0.0,
+            radius_err_vs_reference_pct: 0.0,
+            rms_gel_um_vs_reference: 0.0,
+            force_err_vs_hertz_pct: 0.0,
+            radius_err_vs_hertz_pct: 0.0,
+            rms_gel_um_vs_hertz: 0.0,
+        };
+        for ((s, r), &depth) in frames.iter().zip(&reference).zip(&setup.depths) {
+            let h = hertz_at(depth);
+            row.force_err_vs_reference_pct += 100.0 * (s.force_n / r.force_n - 1.0).abs() / n;
+            row.radius_err_vs_reference_pct +=
+                100.0 * (s.contact_radius_mm / r.contact_radius_mm - 1.0).abs() / n;
+            row.force_err_vs_hertz_pct += 100.0 * (s.force_n / h.force_n() - 1.0).abs() / n;
+            row.radius_err_vs_hertz_pct +=
+                100.0 * (s.contact_radius_mm / h.contact_radius_mm() - 1.0).abs() / n;
+            row.rms_gel_um_vs_reference += rms_um(&mut solver, s, r, |_| None) / n;
+            row.rms_gel_um_vs_hertz += rms_um(&mut solver, s, r, |p| {
+                Some(share * h.total_displacement_mm(p.length()))
+            }) / n;
+        }
+        rows.push(row);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create", dir.display()))?;
+        write_bytes_atomic(&dir.join("contact_bench.csv"), csv(&rows).as_bytes())?;
+        write_bytes_atomic(&dir.join("contact_bench.md"), markdown(&rows).as_bytes())?;
+        write_json_atomic(&dir.join("contact_bench.json"), &rows)?;
+        let points: Vec<plot::ParetoPoint> = rows
+            .iter()
+            .map(|r| plot::ParetoPoint {
+                series: if r.domain == "pad" {
+                    format!("{} (whole pad)", r.fidelity)
+                } else {
+                    r.fidelity.clone()
+                },
+                label: r.cell.clone(),
+                x: r.ms_per_frame,
+                y: r.force_err_vs_reference_pct,
+            })
+            .collect();
+        plot::pareto(
+            &dir.join("contact_pareto.png"),
+            "Contact solver: time per press frame vs force error",
+            "median time per frame (ms)",
+            "force error vs finest layer (%)",
+            &points,
+        )?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        print!("{}", markdown(&rows));
+    }
+    Ok(())
+}
+
+fn csv(rows: &[BenchRow]) -> String {
+    let mut out = String::from(
+        "fidelity,cell,cell_mm,grid,domain,ms_per_frame,iterations_per_frame,force_err_vs_reference_pct,radius_err_vs_reference_pct,rms_gel_um_vs_reference,force_err_vs_hertz_pct,radius_err_vs_hertz_pct,rms_gel_um_vs_hertz\n",
+    );
+    for r in rows {
+        out += &format!(
+            "{},{},{:.5},{},{},{:.4},{:.1},{:.4},{:.4},{:.3},{:.4},{:.4},{:.3}\n",
+            r.fidelity,
+            r.cell,
+            r.cell_mm,
+            r.grid,
+            r.domain,
+            r.ms_per_frame,
+            r.iterations_per_frame,
+            r.force_err_vs_reference_pct,
+            r.radius_err_vs_reference_pct,
+            r.rms_gel_um_vs_reference,
+            r.force_err_vs_hertz_pct,
+            r.radius_err_vs_hertz_pct,
+            r.rms_gel_um_vs_hertz
+        );
+    }
+    out
+}
+
+fn markdown(rows: &[BenchRow]) -> String {
+    let mut out = String::from(
+        "| fidelity | cell | grid | domain | ms/frame | iter/frame | force err vs ref | radius err vs ref | RMS gel vs ref | force err vs Hertz | radius err vs Hertz | RMS gel vs Hertz |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        let cell = if r.cell == "auto" {
+            format!("auto ({:.3} mm)", r.cell_mm)
+        } else {
+            format!("{} mm", r.cell)
+        };
+        out += &format!(
+            "| {} | {cell} | {} | {} | {:.3} | {:.1} | {:.2}% | {:.2}% | {:.1} µm | {:.2}% | {:.2}% | {:.1} µm |\n",
+            r.fidelity,
+            r.grid,
+            r.domain,
+            r.ms_per_frame,
+            r.iterations_per_frame,
+            r.force_err_vs_reference_pct,
+            r.radius_err_vs_reference_pct,
+            r.rms_gel_um_vs_reference,
+            r.force_err_vs_hertz_pct,
+            r.radius_err_vs_hertz_pct,
+            r.rms_gel_um_vs_hertz
+        );
+    }
+    out
+}

@@ -1,0 +1,230 @@
+//! `tactex press` and `tactex bench contact` from the command line: the JSON contract, the
+//! maps on disk, and clear one-line errors for bad input.
+
+use std::process::Command;
+
+fn tactex(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args(args)
+        .output()
+        .expect("tactex runs")
+}
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
+
+#[test]
+fn press_reports_the_documented_fields_and_softer_means_less_force() {
+    let mut forces = Vec::new();
+    for hardness in ["20 00", "60 00", "30A", "rigid"] {
+        let v = json(&tactex(&[
+            "press",
+            "--shape",
+            "sphere",
+            "--radius-mm",
+            "10",
+            "--hardness",
+            hardness,
+            "--depth-mm",
+            "1",
+            "--json",
+        ]));
+        for field in [
+            "force_n",
+            "contact_radius_mm",
+            "contact_area_mm2",
+            "max_pressure_mpa",
+            "gel_max_indentation_mm",
+            "object_max_indentation_mm",
+            "gel_modulus_mpa",
+            "gel_poisson",
+            "object_modulus_mpa",
+            "object_poisson",
+            "iterations",
+            "residual",
+            "warnings",
+        ] {
+            assert!(v.get(field).is_some(), "{field} missing: {v}");
+        }
+        assert_eq!(v["fidelity"], "layer");
+        forces.push(v["force_n"].as_f64().unwrap());
+        if hardness == "rigid" {
+            assert!(v["object_modulus_mpa"].is_null());
+            assert_eq!(v["object_max_indentation_mm"], 0.0);
+        }
+    }
+    assert!(forces.windows(2).all(|w| w[0] < w[1]), "{forces:?}");
+}
+
+#[test]
+fn press_writes_maps_with_their_scale() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("maps");
+    let v = json(&tactex(&[
+        "press",
+        "--shape",
+        "ellipsoid",
+        "--size-mm",
+        "30,20,25",
+        "--modulus-mpa",
+        "0.8",
+        "--depth-mm",
+        "0.75",
+        "--fidelity",
+        "halfspace",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    assert!(v["force_n"].as_f64().unwrap() > 0.0);
+    let sidecar: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("maps.json")).unwrap()).unwrap();
+    for map in sidecar["maps"].as_array().unwrap() {
+        let file = out.join(map["file"].as_str().unwrap());
+        let image = image::open(&file).unwrap();
+        assert_eq!(image.color(), image::ColorType::L16, "{}", file.display());
+        assert_eq!(image.width() as u64, map["grid"]["nx"].as_u64().unwrap());
+    }
+    // The brightest gel pixel is the deepest indentation.
+    let normal = image::open(out.join("gel_normal.png"))
+        .unwrap()
+        .into_luma16();
+    let entry = &sidecar["maps"][0];
+    let top = *normal.as_raw().iter().max().unwrap() as f64;
+    let deepest = entry["offset"].as_f64().unwrap() + top * entry["scale"].as_f64().unwrap();
+    let reported = v["gel_max_indentation_mm"].as_f64().unwrap();
+    assert!((deepest - reported).abs() < 1e-3, "{deepest} vs {reported}");
+}
+
+#[test]
+fn bad_press_input_is_one_clear_line_and_a_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    let empty = dir.path().join("empty.obj");
+    std::fs::write(&empty, "# nothing\n").unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "--shape",
+                "sphere",
+                "--radius-mm",
+                "-2",
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "1",
+            ],
+            "radius-mm",
+        ),
+        (
+            vec!["--shape", "sphere", "--hardness", "30A", "--depth-mm", "-1"],
+            "depth-mm",
+        ),
+        (
+            vec![
+                "--shape",
+                "sphere",
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "NaN",
+            ],
+            "depth-mm",
+        ),
+        (
+            vec![
+                "--shape",
+                "sphere",
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "1",
+                "--fidelity",
+                "fem",
+            ],
+            "fidelity",
+        ),
+        (
+            vec![
+                "--shape",
+                "sphere",
+                "--hardness",
+                "soft-ish",
+                "--depth-mm",
+                "1",
+            ],
+            "hardness",
+        ),
+        (
+            vec![
+                "--shape",
+                "mesh",
+                "--mesh",
+                empty.to_str().unwrap(),
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "1",
+            ],
+            "empty.obj",
+        ),
+        (
+            vec!["--shape", "sphere", "--modulus-mpa", "0", "--depth-mm", "1"],
+            "modulus-mpa",
+        ),
+    ];
+    for (args, named) in cases {
+        let mut all = vec!["press"];
+        all.extend(args.iter().copied());
+        let out = tactex(&all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{all:?} succeeded");
+        assert!(
+            err.starts_with("error: ") && err.trim_end().lines().count() == 1,
+            "{all:?}: {err}"
+        );
+        assert!(err.contains(named), "{all:?}: {err}");
+        assert!(!err.contains("panicked"));
+    }
+}
+
+#[test]
+fn contact_bench_writes_its_table_and_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let v = json(&tactex(&[
+        "bench",
+        "contact",
+        "--cells",
+        "auto,0.4",
+        "--reference-cell-mm",
+        "0.2",
+        "--reps",
+        "1",
+        "--json",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]));
+    let rows = v.as_array().unwrap();
+    assert_eq!(rows.len(), 4 * 2 + 2);
+    for name in [
+        "contact_bench.csv",
+        "contact_bench.md",
+        "contact_pareto.png",
+    ] {
+        assert!(dir.path().join(name).is_file(), "{name}");
+    }
+    // The layer level refines towards its own reference; rigid is far from it.
+    let err = |fidelity: &str| {
+        rows.iter()
+            .find(|r| r["fidelity"] == fidelity && r["cell"] == "auto")
+            .unwrap()["force_err_vs_reference_pct"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!(err("layer") < 2.0 && err("rigid") > 5.0);
+}
