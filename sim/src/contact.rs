@@ -4,6 +4,7 @@
 //! indentation field. The lateral field comes from the bonded-layer transfer (`layer`).
 //! Later fidelity levels (half-space and layer solvers) replace this behind the same fields.
 
+use crate::elastic::hertz_level::fit_quadric;
 use crate::layer::lateral_displacement;
 use crate::world::SimWorld;
 use glam::{DVec2, DVec3};
@@ -35,38 +36,6 @@ pub struct GelFields {
     /// Lateral displacement along image x and y.
     pub lateral_x_mm: Vec<f64>,
     pub lateral_y_mm: Vec<f64>,
-}
-
-/// Least-squares quadric z = c0 + c1 x + c2 y + c3 x^2 + c4 xy + c5 y^2.
-fn fit_quadric(points: &[DVec3]) -> Option<[f64; 6]> {
-    let mut a = [[0.0f64; 7]; 6];
-    for p in points {
-        let row = [1.0, p.x, p.y, p.x * p.x, p.x * p.y, p.y * p.y];
-        for i in 0..6 {
-            for j in 0..6 {
-                a[i][j] += row[i] * row[j];
-            }
-            a[i][6] += row[i] * p.z;
-        }
-    }
-    // Gaussian elimination with partial pivoting.
-    for col in 0..6 {
-        let pivot = (col..6).max_by(|&r, &s| a[r][col].abs().total_cmp(&a[s][col].abs()))?;
-        if a[pivot][col].abs() < 1e-12 {
-            return None;
-        }
-        a.swap(col, pivot);
-        for r in 0..6 {
-            if r != col {
-                let f = a[r][col] / a[col][col];
-                let pivot_row = a[col];
-                for (x, p) in a[r].iter_mut().zip(pivot_row).skip(col) {
-                    *x -= f * p;
-                }
-            }
-        }
-    }
-    Some(std::array::from_fn(|i| a[i][6] / a[i][i]))
 }
 
 /// The contact the pad at `tool` makes, if any (the object pressed deepest).
@@ -102,7 +71,8 @@ pub fn gel_contact(world: &SimWorld, tool: &Pose, spec: &TactileSpec) -> Option<
             }
         }
         let (mut centre, mut gap, mut radius_mm) = (closest.truncate(), closest.z, 1e4);
-        if let Some(c) = fit_quadric(&patch) {
+        let points: Vec<(DVec2, f64)> = patch.iter().map(|p| (p.truncate(), p.z)).collect();
+        if let Some(c) = fit_quadric(&points) {
             let (h11, h12, h22) = (2.0 * c[3], c[4], 2.0 * c[5]);
             let mean = (h11 + h22) / 2.0;
             let spread = (((h11 - h22) / 2.0).powi(2) + h12 * h12).sqrt();
