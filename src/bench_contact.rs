@@ -14,7 +14,7 @@ use std::time::Instant;
 use tactex_core::hertz::{Elastic, Hertz, contact_modulus_mpa, gel_share};
 use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::elastic::{
-    ContactProblem, ContactSolution, ContactSolver, Fidelity, Grid, ObjectSurface, Rect,
+    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
 };
 
 #[derive(Args, Debug)]
@@ -52,6 +52,8 @@ pub struct BenchRow {
     pub grid: String,
     /// Over the local contact region, or the whole pad.
     pub domain: &'static str,
+    /// Each frame started from the previous one, or cold.
+    pub start: &'static str,
     pub ms_per_frame: f64,
     pub iterations_per_frame: f64,
     pub force_err_vs_reference_pct: f64,
@@ -92,15 +94,14 @@ impl Setup {
     }
 }
 
-/// RMS difference of the gel's normal displacement over the reference grid (micrometres).
+/// RMS difference of the gel's normal displacement `fields` from `truth` over the
+/// reference grid (micrometres).
 fn rms_um(
-    solver: &mut ContactSolver,
-    s: &ContactSolution,
+    fields: &GelFields,
     reference: &ContactSolution,
     truth: impl Fn(DVec2) -> Option<f64>,
 ) -> f64 {
     let g: &Grid = &reference.grid;
-    let fields = solver.fields_over(s, &g.rect());
     let mut sum = 0.0;
     for j in 0..g.ny {
         for i in 0..g.nx {
@@ -163,16 +164,19 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             ),
         });
     }
-    let mut configs: Vec<(Fidelity, Option<f64>, bool)> = Vec::new();
+    // (fidelity, cell, whole pad, warm start)
+    let mut configs: Vec<(Fidelity, Option<f64>, bool, bool)> = Vec::new();
     for fidelity in Fidelity::ALL {
         for cell in &cells {
-            configs.push((fidelity, *cell, false));
+            configs.push((fidelity, *cell, false, true));
         }
     }
     // What modelling only the touched region saves: the same solve over the whole pad.
     for cell in &cells {
-        configs.push((Fidelity::Layer, *cell, true));
+        configs.push((Fidelity::Layer, *cell, true, true));
     }
+    // What the warm start saves: each frame solved cold.
+    configs.push((Fidelity::Layer, cells[0], false, false));
 
     let bar = ProgressBar::new(configs.len() as u64 + 1);
     bar.set_style(
@@ -190,11 +194,12 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
     bar.inc(1);
 
     let mut rows = Vec::new();
-    for (fidelity, cell, whole_pad) in configs {
+    for (fidelity, cell, whole_pad, warm) in configs {
         let label = format!(
-            "{fidelity} {}{}",
+            "{fidelity} {}{}{}",
             cell.map_or("auto".into(), |c| format!("{c} mm")),
-            if whole_pad { " (pad)" } else { "" }
+            if whole_pad { " (pad)" } else { "" },
+            if warm { "" } else { " (cold)" }
         );
         bar.set_message(label);
         let problem = setup.problem(cell);
@@ -214,7 +219,8 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
                     approach_mm: depth,
                     ..problem
                 };
-                let s = solver.solve_on(&frame, fidelity, grid, frames.last())?;
+                let previous = if warm { frames.last() } else { None };
+                let s = solver.solve_on(&frame, fidelity, grid, previous)?;
                 frames.push(s);
             }
             times.push(start.elapsed().as_secs_f64() * 1e3 / setup.depths.len() as f64);
@@ -226,6 +232,7 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             cell_mm: grid.map_or(0.0, |g| g.cell_mm),
             grid: grid.map_or("-".into(), |g| format!("{}x{}", g.nx, g.ny)),
             domain: if whole_pad { "pad" } else { "contact" },
+            start: if warm { "warm" } else { "cold" },
             ms_per_frame: median(times),
             iterations_per_frame: frames.iter().map(|f| f.iterations as f64).sum::<f64>() / n,
             force_err_vs_reference_pct: 0.0,
@@ -243,8 +250,9 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             row.force_err_vs_hertz_pct += 100.0 * (s.force_n / h.force_n() - 1.0).abs() / n;
             row.radius_err_vs_hertz_pct +=
                 100.0 * (s.contact_radius_mm / h.contact_radius_mm() - 1.0).abs() / n;
-            row.rms_gel_um_vs_reference += rms_um(&mut solver, s, r, |_| None) / n;
-            row.rms_gel_um_vs_hertz += rms_um(&mut solver, s, r, |p| {
+            let fields = solver.fields_over(s, &r.grid.rect());
+            row.rms_gel_um_vs_reference += rms_um(&fields, r, |_| None) / n;
+            row.rms_gel_um_vs_hertz += rms_um(&fields, r, |p| {
                 Some(share * h.total_displacement_mm(p.length()))
             }) / n;
         }
@@ -290,16 +298,17 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
 
 fn csv(rows: &[BenchRow]) -> String {
     let mut out = String::from(
-        "fidelity,cell,cell_mm,grid,domain,ms_per_frame,iterations_per_frame,force_err_vs_reference_pct,radius_err_vs_reference_pct,rms_gel_um_vs_reference,force_err_vs_hertz_pct,radius_err_vs_hertz_pct,rms_gel_um_vs_hertz\n",
+        "fidelity,cell,cell_mm,grid,domain,start,ms_per_frame,iterations_per_frame,force_err_vs_reference_pct,radius_err_vs_reference_pct,rms_gel_um_vs_reference,force_err_vs_hertz_pct,radius_err_vs_hertz_pct,rms_gel_um_vs_hertz\n",
     );
     for r in rows {
         out += &format!(
-            "{},{},{:.5},{},{},{:.4},{:.1},{:.4},{:.4},{:.3},{:.4},{:.4},{:.3}\n",
+            "{},{},{:.5},{},{},{},{:.4},{:.1},{:.4},{:.4},{:.3},{:.4},{:.4},{:.3}\n",
             r.fidelity,
             r.cell,
             r.cell_mm,
             r.grid,
             r.domain,
+            r.start,
             r.ms_per_frame,
             r.iterations_per_frame,
             r.force_err_vs_reference_pct,
@@ -315,7 +324,7 @@ fn csv(rows: &[BenchRow]) -> String {
 
 fn markdown(rows: &[BenchRow]) -> String {
     let mut out = String::from(
-        "| fidelity | cell | grid | domain | ms/frame | iter/frame | force err vs ref | radius err vs ref | RMS gel vs ref | force err vs Hertz | radius err vs Hertz | RMS gel vs Hertz |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| fidelity | cell | grid | domain | start | ms/frame | iter/frame | force err vs ref | radius err vs ref | RMS gel vs ref | force err vs Hertz | radius err vs Hertz | RMS gel vs Hertz |\n|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         let cell = if r.cell == "auto" {
@@ -324,10 +333,11 @@ fn markdown(rows: &[BenchRow]) -> String {
             format!("{} mm", r.cell)
         };
         out += &format!(
-            "| {} | {cell} | {} | {} | {:.3} | {:.1} | {:.2}% | {:.2}% | {:.1} µm | {:.2}% | {:.2}% | {:.1} µm |\n",
+            "| {} | {cell} | {} | {} | {} | {:.3} | {:.1} | {:.2}% | {:.2}% | {:.1} µm | {:.2}% | {:.2}% | {:.1} µm |\n",
             r.fidelity,
             r.grid,
             r.domain,
+            r.start,
             r.ms_per_frame,
             r.iterations_per_frame,
             r.force_err_vs_reference_pct,

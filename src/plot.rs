@@ -14,13 +14,9 @@ fn register() {
         // The embedded DejaVu Sans (assets/fonts/README.md) under the family plotters asks for.
         let bytes: &'static [u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
         if register_font("sans-serif", FontStyle::Normal, bytes).is_err() {
-            tracing_fallback();
+            eprintln!("warning: embedded font rejected; plot text may be missing");
         }
     });
-}
-
-fn tracing_fallback() {
-    eprintln!("warning: embedded font rejected; plot text may be missing");
 }
 
 /// One point of a Pareto plot.

@@ -101,12 +101,10 @@ pub fn solve(
             } else {
                 0.0
             };
-            // Cells out of contact that overlap the object enter it.
+            // Cells out of contact that overlap the object enter it (before any cell is in
+            // contact there is no step length yet: the overlap itself seeds them).
             if new == 0.0 && gap[i] < 0.0 {
-                new = -tau.max(f64::MIN_POSITIVE) * gap[i];
-                if tau <= 0.0 {
-                    new = -gap[i] / (r[i].abs().max(1e-300) + 1.0);
-                }
+                new = -gap[i] * if tau > 0.0 { tau } else { 1.0 };
                 overlap = true;
             }
             p[i] = new;
