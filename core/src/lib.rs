@@ -19,6 +19,7 @@ pub mod photometric;
 pub mod pipeline;
 pub mod query;
 pub mod scene;
+pub mod shading_table;
 pub mod tactile_spec;
 
 pub use glam;

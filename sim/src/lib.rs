@@ -9,6 +9,7 @@ pub mod arm;
 pub mod camera;
 pub mod contact;
 pub mod elastic;
+pub mod gel_render;
 pub mod gelsight;
 pub mod layer;
 pub mod mesh;

@@ -1,0 +1,29 @@
+// Shared by every GelSight stage (prepended to each stage's source): the frame geometry and
+// render settings, laid out exactly as the Rust `RenderParams` (uniform layout, 112 bytes).
+struct RenderParams {
+    // Unit directions from the gel towards the red, green and blue lights (w unused).
+    lights: array<vec4<f32>, 3>,
+    width: u32,
+    height: u32,
+    frames: u32,
+    // 0: analytic coloured lights over the background; 1: calibrated gradient table.
+    shading: u32,
+    mm_per_px: f32,
+    ambient: f32,
+    light_gain: f32,
+    noise_sigma: f32,
+    vignette: f32,
+    marker_radius_px: f32,
+    marker_darkness: f32,
+    markers: u32,
+    mag_bins: u32,
+    dir_bins: u32,
+    mag_max: f32,
+    padding: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: RenderParams;
+
+fn pixel_count() -> u32 {
+    return params.width * params.height;
+}

@@ -1,0 +1,371 @@
+//! The WGSL compute renderer: the four stages of `shaders/` as wgpu compute pipelines, a whole
+//! batch of presses per dispatch (the frame is the third dispatch dimension), read back as
+//! RGBA8 and unpacked.
+
+use super::{
+    GelImageFields, GelRenderer, PressFrame, RenderError, RenderParams, SensorOptics, Shading,
+};
+use image::RgbImage;
+use std::sync::{Arc, Mutex};
+use wgpu::util::DeviceExt;
+
+const COMMON: &str = include_str!("../../../shaders/common.wgsl");
+
+/// Each stage's own source; the shared prelude (`common.wgsl`) goes in front of it.
+pub const SHADER_SOURCES: [(&str, &str); 4] = [
+    (
+        "gel_slopes",
+        include_str!("../../../shaders/gel_slopes.wgsl"),
+    ),
+    (
+        "gel_shading",
+        include_str!("../../../shaders/gel_shading.wgsl"),
+    ),
+    (
+        "marker_displacement",
+        include_str!("../../../shaders/marker_displacement.wgsl"),
+    ),
+    (
+        "sensor_exposure",
+        include_str!("../../../shaders/sensor_exposure.wgsl"),
+    ),
+];
+
+/// The complete WGSL module of a stage, as the device compiles it.
+pub fn shader_source(stage: &str) -> Option<String> {
+    SHADER_SOURCES
+        .iter()
+        .find(|(name, _)| *name == stage)
+        .map(|(_, body)| format!("{COMMON}\n{body}"))
+}
+
+/// Frames per dispatch at most: bounds device memory (about 2.7 MB per 320x240 frame).
+const MAX_FRAMES_PER_DISPATCH: usize = 64;
+
+pub struct GpuRenderer {
+    adapter: String,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    /// slopes, shading, marker displacement, exposure.
+    pipelines: [wgpu::ComputePipeline; 4],
+    max_binding_bytes: u64,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+impl GpuRenderer {
+    pub fn new(adapter: &wgpu::Adapter) -> Result<Self, RenderError> {
+        let info = adapter.get_info();
+        let name = format!("{} ({:?}, {:?})", info.name, info.device_type, info.backend);
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("tactex gel renderer"),
+            required_features: wgpu::Features::empty(),
+            required_limits: limits.clone(),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device {
+            adapter: name.clone(),
+            message: e.to_string(),
+        })?;
+        // Validation errors come back as a render error, never a panic.
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock().expect("error sink").push(e.to_string());
+        }));
+        let pipelines = SHADER_SOURCES.map(|(stage, _)| {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(stage),
+                source: wgpu::ShaderSource::Wgsl(
+                    shader_source(stage).expect("listed stage").into(),
+                ),
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(stage),
+                layout: None,
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        });
+        let renderer = Self {
+            adapter: name,
+            device,
+            queue,
+            pipelines,
+            max_binding_bytes: limits.max_storage_buffer_binding_size,
+            errors,
+        };
+        renderer.take_errors()?;
+        Ok(renderer)
+    }
+
+    fn take_errors(&self) -> Result<(), RenderError> {
+        let mut errors = self.errors.lock().expect("error sink");
+        if errors.is_empty() {
+            return Ok(());
+        }
+        let message = errors.join("; ");
+        errors.clear();
+        Err(RenderError::Device {
+            adapter: self.adapter.clone(),
+            message,
+        })
+    }
+
+    fn storage(&self, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+        // Zero-sized bindings are invalid: pad empty inputs to one word.
+        let contents: &[u8] = if bytes.is_empty() { &[0; 16] } else { bytes };
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+    }
+
+    fn scratch(&self, label: &str, bytes: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes.max(16),
+            usage: wgpu::BufferUsages::STORAGE | extra,
+            mapped_at_creation: false,
+        })
+    }
+
+    fn bind(&self, stage: usize, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
+        let entries: Vec<wgpu::BindGroupEntry> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(SHADER_SOURCES[stage].0),
+            layout: &self.pipelines[stage].get_bind_group_layout(0),
+            entries: &entries,
+        })
+    }
+
+    fn render_chunk(
+        &self,
+        optics: &SensorOptics,
+        frames: &[PressFrame],
+        shared: &OpticsBuffers,
+    ) -> Result<Vec<RgbImage>, RenderError> {
+        let n = optics.pixel_count();
+        let count = frames.len();
+        let params = RenderParams::new(optics, count as u32);
+        let uniform = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("render params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        let gather = |pick: fn(&GelImageFields) -> &[f32]| -> Vec<f32> {
+            let mut all = Vec::with_capacity(n * count);
+            for f in frames {
+                all.extend_from_slice(pick(f.fields));
+            }
+            all
+        };
+        let heights = self.storage("heights", bytemuck::cast_slice(&gather(|f| &f.normal_mm)));
+        let lateral_x = self.storage(
+            "lateral x",
+            bytemuck::cast_slice(&gather(|f| &f.lateral_x_mm)),
+        );
+        let lateral_y = self.storage(
+            "lateral y",
+            bytemuck::cast_slice(&gather(|f| &f.lateral_y_mm)),
+        );
+        let seeds: Vec<u32> = frames.iter().map(|f| f.seed).collect();
+        let seeds = self.storage("frame seeds", bytemuck::cast_slice(&seeds));
+        let frame_px = (n * count) as u64;
+        let slopes = self.scratch("slopes", frame_px * 8, wgpu::BufferUsages::empty());
+        let shaded = self.scratch("shaded", frame_px * 12, wgpu::BufferUsages::empty());
+        let markers = (optics.markers.len() * count) as u64;
+        let centres = self.scratch("marker centres", markers * 8, wgpu::BufferUsages::empty());
+        let pixels = self.scratch("pixels", frame_px * 4, wgpu::BufferUsages::COPY_SRC);
+        let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: frame_px * 4,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let groups = [
+            self.bind(0, &[&uniform, &heights, &slopes]),
+            self.bind(
+                1,
+                &[
+                    &uniform,
+                    &slopes,
+                    &shared.background,
+                    &shared.table,
+                    &shaded,
+                ],
+            ),
+            self.bind(
+                2,
+                &[&uniform, &lateral_x, &lateral_y, &shared.rest, &centres],
+            ),
+            self.bind(3, &[&uniform, &shaded, &centres, &seeds, &pixels]),
+        ];
+        let (w, h) = (optics.width, optics.height);
+        let tiles = [w.div_ceil(8), h.div_ceil(8), count as u32];
+        let dispatch = [
+            tiles,
+            tiles,
+            [(optics.markers.len() as u32).div_ceil(64), count as u32, 1],
+            tiles,
+        ];
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("gel render"),
+            });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("gel render"),
+                timestamp_writes: None,
+            });
+            for stage in 0..4 {
+                let [x, y, z] = dispatch[stage];
+                if x == 0 || y == 0 || z == 0 {
+                    continue;
+                }
+                pass.set_pipeline(&self.pipelines[stage]);
+                pass.set_bind_group(0, &groups[stage], &[]);
+                pass.dispatch_workgroups(x, y, z);
+            }
+        }
+        encoder.copy_buffer_to_buffer(&pixels, 0, &readback, 0, frame_px * 4);
+        self.queue.submit([encoder.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        readback.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        let device_error = |message: String| RenderError::Device {
+            adapter: self.adapter.clone(),
+            message,
+        };
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| device_error(e.to_string()))?;
+        self.take_errors()?;
+        rx.recv()
+            .map_err(|e| device_error(e.to_string()))?
+            .map_err(|e| device_error(e.to_string()))?;
+        let view = readback
+            .get_mapped_range(..)
+            .map_err(|e| device_error(e.to_string()))?;
+        let packed: &[u32] = bytemuck::cast_slice(&view);
+        let images = packed
+            .chunks_exact(n)
+            .map(|frame| {
+                let mut bytes = Vec::with_capacity(3 * n);
+                for p in frame {
+                    bytes.extend_from_slice(&p.to_le_bytes()[..3]);
+                }
+                RgbImage::from_raw(w, h, bytes).expect("sized from the frame")
+            })
+            .collect();
+        drop(view);
+        readback.unmap();
+        Ok(images)
+    }
+}
+
+/// The optics' buffers, shared by every chunk of a batch.
+struct OpticsBuffers {
+    background: wgpu::Buffer,
+    table: wgpu::Buffer,
+    rest: wgpu::Buffer,
+}
+
+impl GelRenderer for GpuRenderer {
+    fn name(&self) -> String {
+        self.adapter.clone()
+    }
+
+    fn render_batch(
+        &mut self,
+        optics: &SensorOptics,
+        frames: &[PressFrame],
+    ) -> Result<Vec<RgbImage>, RenderError> {
+        optics.check_frames(frames)?;
+        let per_frame = optics.pixel_count() as u64 * 12;
+        if per_frame > self.max_binding_bytes {
+            return Err(super::invalid(
+                "optics.size",
+                format!(
+                    "a {} x {} frame needs {per_frame} bytes per buffer; the device binds at most {}",
+                    optics.width, optics.height, self.max_binding_bytes
+                ),
+            ));
+        }
+        let chunk =
+            ((self.max_binding_bytes / per_frame) as usize).clamp(1, MAX_FRAMES_PER_DISPATCH);
+        let background: Vec<f32> = optics.background.iter().flatten().copied().collect();
+        let table: &[f32] = match &optics.shading {
+            Shading::Table(t) => &t.coefficients,
+            Shading::Lights(_) => &[],
+        };
+        let shared = OpticsBuffers {
+            background: self.storage("background", bytemuck::cast_slice(&background)),
+            table: self.storage("shading table", bytemuck::cast_slice(table)),
+            rest: self.storage("marker rest", bytemuck::cast_slice(&optics.markers)),
+        };
+        let mut out = Vec::with_capacity(frames.len());
+        for part in frames.chunks(chunk) {
+            out.extend(self.render_chunk(optics, part, &shared)?);
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wgpu::naga;
+
+    #[test]
+    fn every_shader_parses_and_validates_with_naga() {
+        for (stage, _) in SHADER_SOURCES {
+            let source = shader_source(stage).unwrap();
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("{stage}: {}", e.emit_to_string(&source)));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::empty(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{stage}: {}", e.emit_to_string(&source)));
+            assert!(
+                module.entry_points.iter().any(|e| e.name == "main"),
+                "{stage} has no main entry point"
+            );
+        }
+    }
+
+    #[test]
+    fn uniform_block_matches_the_shader_layout() {
+        let source = shader_source("gel_slopes").unwrap();
+        let module = naga::front::wgsl::parse_str(&source).unwrap();
+        let params = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some("RenderParams"))
+            .unwrap()
+            .0;
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        assert_eq!(
+            layouter[params].size as usize,
+            std::mem::size_of::<RenderParams>()
+        );
+    }
+}
