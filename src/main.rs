@@ -1,7 +1,11 @@
 //! `tactex`: the TactEx twin command line. Wires the simulated devices (tactex-sim) into the
 //! backend-free pipeline (tactex-core).
 
+mod ball_presses;
 mod bench_contact;
+mod calibrate;
+mod compare;
+mod markers;
 mod output;
 mod plot;
 mod press;
@@ -48,6 +52,13 @@ enum Command {
     },
     /// Press the gel into one object and report force, contact and indentation.
     Press(press::PressArgs),
+    /// Fit a GelSight shading table from annotated presses of a ball of known radius.
+    Calibrate(calibrate::CalibrateArgs),
+    /// Render annotated real presses through a calibration and score them against the real
+    /// frames (SSIM, mean absolute intensity error).
+    Compare(compare::CompareArgs),
+    /// Marker centroids on a tactile frame, and displacements against a reference frame.
+    Markers(markers::MarkersArgs),
     /// Benchmarks (run them on a release build).
     Bench {
         #[command(subcommand)]
@@ -211,6 +222,9 @@ fn main() -> ExitCode {
             prompt,
         } => ask(scene, seed, json, reproducible, &prompt),
         Command::Press(args) => press::run(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
+        Command::Compare(args) => compare::run(&args),
+        Command::Markers(args) => markers::run(&args),
         Command::Bench {
             command: BenchCommand::Contact(args),
         } => bench_contact::run(&args),

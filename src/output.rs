@@ -46,3 +46,12 @@ pub fn write_png16_atomic(path: &Path, width: u32, height: u32, data: Vec<u16>) 
         .context("encoding PNG")?;
     write_bytes_atomic(path, bytes.get_ref())
 }
+
+/// An 8-bit RGB PNG.
+pub fn write_png_atomic(path: &Path, image: &image::RgbImage) -> Result<()> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image
+        .write_to(&mut bytes, image::ImageFormat::Png)
+        .context("encoding PNG")?;
+    write_bytes_atomic(path, bytes.get_ref())
+}

@@ -6,6 +6,7 @@
 //! helpers), hardness estimation, the template explainer and the question pipeline that is
 //! generic over the device traits. Nothing in here knows which backend it runs against.
 
+pub mod ball_calibration;
 pub mod catalog;
 pub mod devices;
 pub mod estimate;

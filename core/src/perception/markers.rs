@@ -2,42 +2,58 @@
 //! tracking against a reference frame, and the displacement statistic of the contact test.
 
 use image::{GrayImage, Luma, RgbImage};
+use imageproc::distance_transform::Norm;
+use imageproc::morphology::{Mask, close, grayscale_dilate, grayscale_erode};
 use imageproc::region_labelling::{Connectivity, connected_components};
 
-/// Marker centroids in pixels (x, y), darkness-weighted, sorted by row then column.
+/// Radius (px) of the closing that erases the dots to estimate the gel behind them: larger
+/// than any marker at tactile-frame resolutions (GelSight Mini dots are ~4-6 px across at
+/// 320x240, FOTS's ~10 px).
+const BACKGROUND_RADIUS_PX: u8 = 8;
+
+/// Marker centroids in pixels (x, y): centroids of the dots' silhouettes (pixels much darker
+/// than the gel behind them), sorted by row then column. The gel behind a dot is estimated by a grey-level
+/// closing (the dots are small dark holes in a smooth bright field), so shading gradients and
+/// coloured glows around a contact do not bias the centroids.
 pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
     let (w, h) = img.dimensions();
     let lum = GrayImage::from_fn(w, h, |x, y| {
         let p = img.get_pixel(x, y);
         Luma([((p[0] as u32 * 54 + p[1] as u32 * 183 + p[2] as u32 * 19) >> 8) as u8])
     });
-    // Local background over a window a few marker diameters wide.
-    let background = imageproc::filter::box_filter(&lum, 9, 9);
+    let disk = Mask::disk(BACKGROUND_RADIUS_PX);
+    let background = grayscale_erode(&grayscale_dilate(&lum, &disk), &disk);
+    let darkness =
+        |x: u32, y: u32| background.get_pixel(x, y)[0] as f64 - lum.get_pixel(x, y)[0] as f64;
     let dark = GrayImage::from_fn(w, h, |x, y| {
-        let (l, b) = (
-            lum.get_pixel(x, y)[0] as f64,
-            background.get_pixel(x, y)[0] as f64,
-        );
-        Luma([if l < 0.6 * b { 255 } else { 0 }])
+        let b = background.get_pixel(x, y)[0] as f64;
+        Luma([if darkness(x, y) > 0.45 * b { 255 } else { 0 }])
     });
+    // Closing fills specular specks and notches inside a dot so they do not pull its centroid.
+    let dark = close(&dark, Norm::LInf, 2);
     let labels = connected_components(&dark, Connectivity::Eight, Luma([0u8]));
     let n = labels.pixels().map(|p| p[0]).max().unwrap_or(0) as usize;
-    let mut acc = vec![(0.0f64, 0.0f64, 0.0f64, 0usize); n + 1];
+    // Per blob: weighted sums, pixel count, and whether it touches the frame edge.
+    let mut acc = vec![(0.0f64, 0.0f64, 0.0f64, 0usize, false); n + 1];
     for (x, y, l) in labels.enumerate_pixels() {
         let id = l[0] as usize;
         if id > 0 {
-            let weight =
-                (background.get_pixel(x, y)[0] as f64 - lum.get_pixel(x, y)[0] as f64).max(1.0);
+            // The dot's silhouette, uniformly weighted: shading inside it (specks, the glow of
+            // a contact) says nothing about where its centre is.
+            let weight = 1.0;
             let a = &mut acc[id];
             a.0 += weight * x as f64;
             a.1 += weight * y as f64;
             a.2 += weight;
             a.3 += 1;
+            a.4 |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
         }
     }
     let mut out: Vec<(f64, f64)> = acc
         .iter()
         .skip(1)
+        // Specks and smudges are not dots. A dot cut by the frame edge is kept: its centroid
+        // is that of the visible part.
         .filter(|a| (6..=600).contains(&a.3))
         .map(|a| (a.0 / a.2, a.1 / a.2))
         .collect();
@@ -47,6 +63,25 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
             .unwrap_or(std::cmp::Ordering::Equal)
     });
     out
+}
+
+/// The grid pitch: the median distance from each marker to its nearest neighbour. None with
+/// fewer than two markers.
+pub fn grid_pitch_px(markers: &[(f64, f64)]) -> Option<f64> {
+    let mut nearest: Vec<f64> = markers
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| {
+            markers
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, q)| (p.0 - q.0).hypot(p.1 - q.1))
+                .min_by(f64::total_cmp)
+        })
+        .collect();
+    nearest.sort_by(f64::total_cmp);
+    nearest.get(nearest.len() / 2).copied()
 }
 
 /// For each reference marker, its displacement to the nearest current marker within

@@ -3,6 +3,7 @@
 //! frames as well as on the twin's.
 
 pub mod centroid;
+pub mod contact;
 pub mod detect;
 pub mod markers;
 pub mod mask;

@@ -29,6 +29,12 @@ pub fn ssim_rgb(a: &RgbImage, b: &RgbImage) -> Option<f64> {
 }
 
 pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize, data_range: f64) -> Option<f64> {
+    let map = ssim_map(a, b, w, h, data_range)?;
+    Some(map.iter().sum::<f64>() / map.len() as f64)
+}
+
+/// Local SSIM of each 7x7 window (row-major, (w - 6) x (h - 6)): the map skimage averages.
+pub fn ssim_map(a: &[f64], b: &[f64], w: usize, h: usize, data_range: f64) -> Option<Vec<f64>> {
     if w < WIN || h < WIN || a.len() != w * h || b.len() != w * h {
         return None;
     }
@@ -50,8 +56,7 @@ pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize, data_range: f64) -> Option
     let cov_norm = n / (n - 1.0);
     let c1 = (0.01 * data_range).powi(2);
     let c2 = (0.03 * data_range).powi(2);
-    let mut total = 0.0;
-    let mut count = 0usize;
+    let mut map = Vec::with_capacity((w - WIN + 1) * (h - WIN + 1));
     for y0 in 0..=h - WIN {
         for x0 in 0..=w - WIN {
             let (y1, x1) = (y0 + WIN, x0 + WIN);
@@ -63,12 +68,13 @@ pub fn ssim(a: &[f64], b: &[f64], w: usize, h: usize, data_range: f64) -> Option
             let vx = cov_norm * (s[2] / n - ux * ux);
             let vy = cov_norm * (s[3] / n - uy * uy);
             let vxy = cov_norm * (s[4] / n - ux * uy);
-            total += ((2.0 * ux * uy + c1) * (2.0 * vxy + c2))
-                / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
-            count += 1;
+            map.push(
+                ((2.0 * ux * uy + c1) * (2.0 * vxy + c2))
+                    / ((ux * ux + uy * uy + c1) * (vx + vy + c2)),
+            );
         }
     }
-    Some(total / count as f64)
+    Some(map)
 }
 
 #[cfg(test)]

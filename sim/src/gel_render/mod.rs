@@ -7,12 +7,14 @@
 //! shaders) and `GpuRenderer` (the WGSL compute stages in `shaders/` through wgpu). Both
 //! render batches of presses; the GPU renders a whole batch per dispatch.
 
+mod calibration;
 mod cpu;
 mod device;
 mod fields;
 mod gpu;
 mod noise;
 
+pub use calibration::{CALIBRATION_FORMAT, FitReport, GelCalibration};
 pub use cpu::CpuRenderer;
 pub use device::{DeviceChoice, RendererChoice, adapters, open_renderer};
 pub use fields::image_fields;

@@ -1,0 +1,214 @@
+//! Calibrating a tactile sensor's shading from presses of a ball of known radius, as real
+//! users do (Taxim, FOTS): inside the annotated contact circle the gel takes the ball's shape,
+//! so every pixel there has a known slope; far from the contact the gel is flat. Each such
+//! pixel is a `ShadingSample` of its colour change over the no-contact frame.
+
+use crate::shading_table::ShadingSample;
+use image::RgbImage;
+use std::path::Path;
+
+/// One annotated press: which image, where the ball touched and how large the contact was.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BallPress {
+    pub image: String,
+    /// Contact centre in pixels (x along columns, y along rows).
+    pub centre_px: [f64; 2],
+    pub contact_radius_px: f64,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum AnnotationError {
+    #[error("{path}: {message}")]
+    Read { path: String, message: String },
+    #[error("{path}:{line}: {message}")]
+    Row {
+        path: String,
+        line: usize,
+        message: String,
+    },
+}
+
+/// Reads `image,center_x_px,center_y_px,contact_radius_px` rows (a header line first).
+pub fn read_annotations(path: &Path) -> Result<Vec<BallPress>, AnnotationError> {
+    let shown = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| AnnotationError::Read {
+        path: shown.clone(),
+        message: e.to_string(),
+    })?;
+    let mut lines = text.lines().enumerate();
+    let expected = ["image", "center_x_px", "center_y_px", "contact_radius_px"];
+    match lines.next() {
+        Some((_, header))
+            if header
+                .split(',')
+                .map(str::trim)
+                .eq(expected.iter().copied()) => {}
+        _ => {
+            return Err(AnnotationError::Row {
+                path: shown,
+                line: 1,
+                message: format!("header must be {}", expected.join(",")),
+            });
+        }
+    }
+    let mut out = Vec::new();
+    for (k, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let row = |message: String| AnnotationError::Row {
+            path: shown.clone(),
+            line: k + 1,
+            message,
+        };
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        if cells.len() != 4 {
+            return Err(row(format!("{} fields, expected 4", cells.len())));
+        }
+        let number = |i: usize| -> Result<f64, AnnotationError> {
+            cells[i]
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| {
+                    row(format!(
+                        "{}: '{}' is not a non-negative number",
+                        expected[i], cells[i]
+                    ))
+                })
+        };
+        let press = BallPress {
+            image: cells[0].to_string(),
+            centre_px: [number(1)?, number(2)?],
+            contact_radius_px: number(3)?,
+        };
+        if press.contact_radius_px <= 0.0 {
+            return Err(row("contact_radius_px must be positive".into()));
+        }
+        if press.image.is_empty() || press.image.contains(['/', '\\']) {
+            return Err(row(
+                "image must be a file name in the images directory".into()
+            ));
+        }
+        out.push(press);
+    }
+    if out.is_empty() {
+        return Err(AnnotationError::Read {
+            path: shown,
+            message: "no annotated presses".into(),
+        });
+    }
+    Ok(out)
+}
+
+/// Which pixels a press contributes and how.
+#[derive(Clone, Copy, Debug)]
+pub struct SampleRule {
+    /// Pixels inside this fraction of the contact radius carry the ball's slope (the
+    /// annotated rim is uncertain by a pixel or two).
+    pub inside_fraction: f64,
+    /// Pixels beyond this many contact radii are taken as flat gel.
+    pub flat_beyond: f64,
+    /// Every n-th flat pixel along each axis (they are many and alike).
+    pub flat_stride: u32,
+}
+
+impl Default for SampleRule {
+    fn default() -> Self {
+        Self {
+            inside_fraction: 0.92,
+            flat_beyond: 3.0,
+            flat_stride: 3,
+        }
+    }
+}
+
+/// Slope of the gel's indentation (dw/dx, dw/dy) at offset (dx, dy) mm from the centre of a
+/// ball of radius `r`: the gel takes the sphere's shape, deepest at the centre.
+pub fn ball_slope(dx: f64, dy: f64, r: f64) -> Option<(f64, f64)> {
+    let rho2 = dx * dx + dy * dy;
+    (rho2 < r * r).then(|| {
+        let s = (r * r - rho2).sqrt();
+        (-dx / s, -dy / s)
+    })
+}
+
+/// Calibration samples from one press. Position (u, v) is normalised to [-1, 1].
+pub fn samples_from_ball_press(
+    image: &RgbImage,
+    background: &RgbImage,
+    press: &BallPress,
+    ball_radius_mm: f64,
+    mm_per_px: f64,
+    rule: &SampleRule,
+) -> Vec<ShadingSample> {
+    let (w, h) = image.dimensions();
+    let [cx, cy] = press.centre_px;
+    let a = press.contact_radius_px;
+    let mut out = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let (dx, dy) = (x as f64 - cx, y as f64 - cy);
+            let r = dx.hypot(dy);
+            let slope = if r < rule.inside_fraction * a {
+                ball_slope(dx * mm_per_px, dy * mm_per_px, ball_radius_mm)
+            } else if r > rule.flat_beyond * a
+                && x % rule.flat_stride == 0
+                && y % rule.flat_stride == 0
+            {
+                Some((0.0, 0.0))
+            } else {
+                None
+            };
+            let Some((gx, gy)) = slope else { continue };
+            let (p, b) = (image.get_pixel(x, y), background.get_pixel(x, y));
+            out.push(ShadingSample {
+                gx: gx as f32,
+                gy: gy as f32,
+                u: 2.0 * ((x as f32 + 0.5) / w as f32 - 0.5),
+                v: 2.0 * ((y as f32 + 0.5) / h as f32 - 0.5),
+                change: std::array::from_fn(|c| p[c] as f32 - b[c] as f32),
+            });
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ball_slope_points_inward_and_steepens_to_the_rim() {
+        let (gx, gy) = ball_slope(1.0, 0.0, 2.0).unwrap();
+        assert!((gx + 1.0 / 3f64.sqrt()).abs() < 1e-12 && gy == 0.0);
+        assert!(ball_slope(0.0, 0.0, 2.0).unwrap() == (0.0, 0.0));
+        assert!(ball_slope(2.0, 0.1, 2.0).is_none());
+    }
+
+    #[test]
+    fn annotations_errors_name_file_line_and_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.csv");
+        std::fs::write(
+            &p,
+            "image,center_x_px,center_y_px,contact_radius_px\n0001.png,76,x,38\n",
+        )
+        .unwrap();
+        let e = read_annotations(&p).unwrap_err().to_string();
+        assert!(e.contains("a.csv:2") && e.contains("center_y_px"), "{e}");
+        std::fs::write(&p, "img,x\n").unwrap();
+        assert!(
+            read_annotations(&p)
+                .unwrap_err()
+                .to_string()
+                .contains("header")
+        );
+        std::fs::write(
+            &p,
+            "image,center_x_px,center_y_px,contact_radius_px\n0001.png,76,182,38\n",
+        )
+        .unwrap();
+        assert_eq!(read_annotations(&p).unwrap()[0].contact_radius_px, 38.0);
+    }
+}

@@ -1,0 +1,352 @@
+//! `tactex compare`: sim-to-real on annotated ball presses. Each press is rebuilt in the twin
+//! (the ball at the annotated centre, pressed until the contact solver's contact radius is the
+//! annotated one, since the depth was not recorded), rendered through the calibration, and
+//! scored against the real frame: SSIM (grey, 7x7 uniform window, data range 255, as
+//! scikit-image) and mean absolute intensity error, over the whole frame and over the contact
+//! (a box of four contact radii around it), next to the score of the bare background.
+
+use crate::ball_presses::{self, Split};
+use crate::output::{write_json_atomic, write_png_atomic};
+use anyhow::{Context, Result};
+use clap::Args;
+use glam::DVec2;
+use image::RgbImage;
+use serde::Serialize;
+use std::path::PathBuf;
+use tactex_core::ball_calibration::BallPress;
+use tactex_core::hertz::Elastic;
+use tactex_core::perception::ssim::{gray, ssim};
+use tactex_core::tactile_spec::GelSpec;
+use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
+use tactex_sim::gel_render::{
+    DeviceChoice, GelCalibration, GelImageFields, PressFrame, SensorOptics, image_fields,
+    open_renderer, pad_rect, pixel_centre_mm,
+};
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// Calibration file from `tactex calibrate`.
+    #[arg(long)]
+    pub calib: PathBuf,
+    #[arg(long)]
+    pub images: PathBuf,
+    #[arg(long)]
+    pub annotations: PathBuf,
+    /// Which presses to score: eval (every third, held out of calibration), calib, or all.
+    #[arg(long, value_enum, default_value_t = Split::Eval)]
+    pub split: Split,
+    /// Contact model that rebuilds each press.
+    #[arg(long, default_value = "layer")]
+    pub fidelity: Fidelity,
+    /// Rendering device: auto, gpu or cpu.
+    #[arg(long, default_value = "auto")]
+    pub device: DeviceChoice,
+    /// Write real | rendered | difference images per press here.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Serialize, Debug, Clone, Copy, Default)]
+pub struct Scores {
+    pub ssim: f64,
+    pub mae: f64,
+    pub ssim_contact: f64,
+    pub mae_contact: f64,
+}
+
+#[derive(Serialize, Debug)]
+pub struct PressComparison {
+    pub image: String,
+    pub contact_radius_px: f64,
+    /// Travel past first touch that gives the annotated contact radius.
+    pub depth_mm: f64,
+    pub force_n: f64,
+    pub rendered: Scores,
+    /// The bare no-contact frame scored the same way: what rendering the press adds.
+    pub background_only: Scores,
+    pub warnings: Vec<String>,
+}
+
+#[derive(Serialize, Debug)]
+pub struct CompareReport {
+    pub calibration: String,
+    pub split: String,
+    pub fidelity: String,
+    pub device: String,
+    pub presses: Vec<PressComparison>,
+    pub mean: Scores,
+    pub background_only_mean: Scores,
+}
+
+/// Mean absolute difference over all channels (grey levels).
+fn mae(a: &RgbImage, b: &RgbImage, window: [u32; 4]) -> f64 {
+    let [x0, y0, x1, y1] = window;
+    let mut sum = 0.0;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
+            sum += (0..3).map(|c| p[c].abs_diff(q[c]) as f64).sum::<f64>();
+        }
+    }
+    sum / (3 * (x1 - x0) * (y1 - y0)) as f64
+}
+
+fn ssim_in(a: &RgbImage, b: &RgbImage, window: [u32; 4]) -> f64 {
+    let [x0, y0, x1, y1] = window;
+    let w = a.width() as usize;
+    let crop = |g: &[f64]| -> Vec<f64> {
+        (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .map(|(x, y)| g[y as usize * w + x as usize])
+            .collect()
+    };
+    let (ga, gb) = (crop(&gray(a)), crop(&gray(b)));
+    ssim(&ga, &gb, (x1 - x0) as usize, (y1 - y0) as usize, 255.0).unwrap_or(f64::NAN)
+}
+
+fn scores(real: &RgbImage, rendered: &RgbImage, press: &BallPress) -> Scores {
+    let (w, h) = real.dimensions();
+    let full = [0, 0, w, h];
+    let reach = 2.0 * press.contact_radius_px;
+    let [cx, cy] = press.centre_px;
+    let clip = |v: f64, hi: u32| v.round().clamp(0.0, hi as f64) as u32;
+    let contact = [
+        clip(cx - reach, w),
+        clip(cy - reach, h),
+        clip(cx + reach + 1.0, w),
+        clip(cy + reach + 1.0, h),
+    ];
+    Scores {
+        ssim: ssim_in(real, rendered, full),
+        mae: mae(real, rendered, full),
+        ssim_contact: ssim_in(real, rendered, contact),
+        mae_contact: mae(real, rendered, contact),
+    }
+}
+
+fn mean(all: impl Iterator<Item = Scores>) -> Scores {
+    let v: Vec<Scores> = all.collect();
+    let n = v.len().max(1) as f64;
+    Scores {
+        ssim: v.iter().map(|s| s.ssim).sum::<f64>() / n,
+        mae: v.iter().map(|s| s.mae).sum::<f64>() / n,
+        ssim_contact: v.iter().map(|s| s.ssim_contact).sum::<f64>() / n,
+        mae_contact: v.iter().map(|s| s.mae_contact).sum::<f64>() / n,
+    }
+}
+
+/// The press rebuilt: the travel at which the solver's contact radius is the annotated one
+/// (bisection; contact radius grows monotonically with travel), and its gel fields.
+fn rebuild(
+    solver: &mut ContactSolver,
+    press: &BallPress,
+    ball_radius_mm: f64,
+    gel: &GelSpec,
+    optics: &SensorOptics,
+    fidelity: Fidelity,
+) -> Result<(f64, f64, GelImageFields, Vec<String>)> {
+    let centre: DVec2 = pixel_centre_mm(optics, press.centre_px[0], press.centre_px[1]);
+    let surface = ObjectSurface::Sphere {
+        radius_mm: ball_radius_mm,
+        centre_mm: centre,
+    };
+    let target = press.contact_radius_px * optics.mm_per_px;
+    let problem = |approach_mm| ContactProblem {
+        surface: &surface,
+        // Steel: rigid next to the gel.
+        object: Elastic {
+            modulus_mpa: None,
+            poisson: 0.3,
+        },
+        gel: *gel,
+        pad: pad_rect(optics),
+        approach_mm,
+        cell_mm: None,
+    };
+    let (mut lo, mut hi) = (0.0, 0.95 * ball_radius_mm);
+    let radius_at = |solver: &mut ContactSolver, d: f64| -> Result<f64> {
+        Ok(solver.solve(&problem(d), fidelity)?.contact_radius_mm)
+    };
+    // Hand-marked circles can be wider than any contact the ball can make (up to a = R):
+    // such presses are taken at the deepest travel modelled, and say so.
+    let mut warnings = Vec::new();
+    let deepest = radius_at(solver, hi)?;
+    if deepest < target {
+        warnings.push(format!(
+            "annotated contact radius {target:.2} mm is beyond the {deepest:.2} mm the model reaches at {hi:.2} mm travel; pressed to that travel"
+        ));
+        lo = hi;
+    }
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        if radius_at(solver, mid)? < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo < 1e-4 * ball_radius_mm {
+            break;
+        }
+    }
+    let depth = 0.5 * (lo + hi);
+    let solution = solver.solve(&problem(depth), fidelity)?;
+    let fields = image_fields(solver, &solution, gel, optics);
+    Ok((depth, solution.force_n, fields, warnings))
+}
+
+fn side_by_side(real: &RgbImage, rendered: &RgbImage) -> RgbImage {
+    let (w, h) = real.dimensions();
+    RgbImage::from_fn(3 * w, h, |x, y| {
+        let (i, k) = (x % w, x / w);
+        match k {
+            0 => *real.get_pixel(i, y),
+            1 => *rendered.get_pixel(i, y),
+            _ => {
+                let (p, q) = (real.get_pixel(i, y), rendered.get_pixel(i, y));
+                // Difference around mid-grey, amplified 4x.
+                image::Rgb(std::array::from_fn(|c| {
+                    (128.0 + 4.0 * (p[c] as f64 - q[c] as f64)).clamp(0.0, 255.0) as u8
+                }))
+            }
+        }
+    })
+}
+
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let text = std::fs::read_to_string(&args.calib)
+        .with_context(|| format!("{}: cannot read", args.calib.display()))?;
+    let calib = GelCalibration::from_json(&text)
+        .with_context(|| format!("{}: not a usable calibration", args.calib.display()))?;
+    let optics = calib.to_optics()?;
+    let presses = ball_presses::load(
+        &args.images,
+        &args.annotations,
+        args.split,
+        (calib.width, calib.height),
+    )?;
+    let choice = open_renderer(args.device)?;
+    if let Some(note) = &choice.note {
+        eprintln!("note: {note}");
+    }
+    let mut renderer = choice.renderer;
+    let mut solver = ContactSolver::new();
+    let mut rebuilt = Vec::new();
+    for (press, _) in &presses {
+        rebuilt.push(rebuild(
+            &mut solver,
+            press,
+            calib.fit.ball_radius_mm,
+            &calib.gel,
+            &optics,
+            args.fidelity,
+        )?);
+    }
+    let flat = GelImageFields::flat(optics.width, optics.height);
+    let mut frames: Vec<PressFrame> = rebuilt
+        .iter()
+        .map(|(_, _, fields, _)| PressFrame { fields, seed: 0 })
+        .collect();
+    frames.push(PressFrame {
+        fields: &flat,
+        seed: 0,
+    });
+    let mut images = renderer.render_batch(&optics, &frames)?;
+    let background = images.pop().expect("the flat frame was rendered last");
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create", dir.display()))?;
+    }
+    let mut out = Vec::new();
+    for (((press, real), (depth, force, _, warnings)), rendered) in
+        presses.iter().zip(&rebuilt).zip(&images)
+    {
+        if let Some(dir) = &args.out {
+            write_png_atomic(&dir.join(&press.image), &side_by_side(real, rendered))?;
+        }
+        out.push(PressComparison {
+            image: press.image.clone(),
+            contact_radius_px: press.contact_radius_px,
+            depth_mm: *depth,
+            force_n: *force,
+            rendered: scores(real, rendered, press),
+            background_only: scores(real, &background, press),
+            warnings: warnings.clone(),
+        });
+    }
+    let report = CompareReport {
+        calibration: args.calib.display().to_string(),
+        split: format!("{:?}", args.split).to_lowercase(),
+        fidelity: args.fidelity.name().into(),
+        device: renderer.name(),
+        mean: mean(out.iter().map(|p| p.rendered)),
+        background_only_mean: mean(out.iter().map(|p| p.background_only)),
+        presses: out,
+    };
+    if let Some(dir) = &args.out {
+        write_json_atomic(&dir.join("compare.json"), &report)?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    println!(
+        "{:<10} {:>6} {:>9} {:>8} | {:>6} {:>6} {:>8} {:>8} | background only: {:>6} {:>6} {:>8} {:>8}",
+        "image",
+        "a (px)",
+        "depth mm",
+        "force N",
+        "SSIM",
+        "MAE",
+        "SSIM(c)",
+        "MAE(c)",
+        "SSIM",
+        "MAE",
+        "SSIM(c)",
+        "MAE(c)"
+    );
+    let line = |name: &str, a: String, d: String, f: String, r: &Scores, b: &Scores| {
+        println!(
+            "{name:<10} {a:>6} {d:>9} {f:>8} | {:>6.3} {:>6.2} {:>8.3} {:>8.2} |                   {:>6.3} {:>6.2} {:>8.3} {:>8.2}",
+            r.ssim,
+            r.mae,
+            r.ssim_contact,
+            r.mae_contact,
+            b.ssim,
+            b.mae,
+            b.ssim_contact,
+            b.mae_contact
+        )
+    };
+    for p in &report.presses {
+        line(
+            &p.image,
+            format!("{:.0}", p.contact_radius_px),
+            format!("{:.3}", p.depth_mm),
+            format!("{:.2}", p.force_n),
+            &p.rendered,
+            &p.background_only,
+        );
+        for w in &p.warnings {
+            println!("    warning: {w}");
+        }
+    }
+    line(
+        "mean",
+        String::new(),
+        String::new(),
+        String::new(),
+        &report.mean,
+        &report.background_only_mean,
+    );
+    println!(
+        "{} presses ({} split), {} contact, rendered on {}; (c): the box of 4 contact radii around the press",
+        report.presses.len(),
+        report.split,
+        report.fidelity,
+        report.device
+    );
+    Ok(())
+}

@@ -1,0 +1,202 @@
+//! Sim-to-real on real GelSight frames (FOTS; fixtures in tests/fixtures/fots with their
+//! attribution): calibration and comparison of ball presses, the contact criterion, and
+//! marker detection against the published annotations.
+
+use image::RgbImage;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use tactex_core::perception::contact::{ContactRule, contact_evidence};
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fots")
+}
+
+fn tactex(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("runs tactex")
+}
+
+fn rgb(path: &Path) -> RgbImage {
+    image::open(path).unwrap().to_rgb8()
+}
+
+/// FOTS scale: 19.58 px/mm.
+const MM_PER_PX: &str = "0.051072522982635343";
+
+#[test]
+fn calibrated_renderer_matches_held_out_real_presses() {
+    let f = fixtures();
+    let dir = tempfile::tempdir().unwrap();
+    let calib = dir.path().join("calib.json");
+    let presses = f.join("ball-presses");
+    let annotations = presses.join("annotations.csv");
+    let out = tactex(&[
+        "calibrate",
+        "--images",
+        presses.to_str().unwrap(),
+        "--annotations",
+        annotations.to_str().unwrap(),
+        "--background",
+        f.join("background.png").to_str().unwrap(),
+        "--ball-radius-mm",
+        "2.35",
+        "--mm-per-px",
+        MM_PER_PX,
+        "--out",
+        calib.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = tactex(&[
+        "compare",
+        "--calib",
+        calib.to_str().unwrap(),
+        "--images",
+        presses.to_str().unwrap(),
+        "--annotations",
+        annotations.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let n = report["presses"].as_array().unwrap().len();
+    // Fixture annotations hold 9 presses; every third (3) is held out of the calibration.
+    assert_eq!(n, 3);
+    let (mean, bare) = (&report["mean"], &report["background_only_mean"]);
+    let v = |s: &serde_json::Value, k: &str| s[k].as_f64().unwrap();
+    eprintln!("rendered {mean}\nbackground only {bare}");
+    assert!(v(mean, "ssim") >= 0.90, "{mean}");
+    // What rendering adds: the contact region looks more like the real one than the bare
+    // background does, by structure and by intensity.
+    assert!(
+        v(mean, "ssim_contact") > v(bare, "ssim_contact") + 0.01,
+        "{mean} vs {bare}"
+    );
+    assert!(
+        v(mean, "mae_contact") < 0.75 * v(bare, "mae_contact"),
+        "{mean} vs {bare}"
+    );
+}
+
+#[test]
+fn compare_rejects_a_bad_calibration_file_in_one_line() {
+    let f = fixtures();
+    let dir = tempfile::tempdir().unwrap();
+    let calib = dir.path().join("calib.json");
+    std::fs::write(&calib, "{\"format\": \"something else\"}").unwrap();
+    let presses = f.join("ball-presses");
+    let out = tactex(&[
+        "compare",
+        "--calib",
+        calib.to_str().unwrap(),
+        "--images",
+        presses.to_str().unwrap(),
+        "--annotations",
+        presses.join("annotations.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("calib.json"), "{err}");
+}
+
+/// The full shared set where this checkout has it, else the fixtures.
+fn ball_press_frames() -> Vec<PathBuf> {
+    let shared =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/real/fots-gelsight/ball-presses");
+    let dir = if shared.is_dir() {
+        shared
+    } else {
+        fixtures().join("ball-presses")
+    };
+    let mut frames: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    frames.sort();
+    frames
+}
+
+#[test]
+fn contact_criterion_fires_on_every_ball_press_and_not_on_the_background() {
+    let rule = ContactRule::default();
+    let background = rgb(&fixtures().join("background.png"));
+    for frame in ball_press_frames() {
+        let e = contact_evidence(&rgb(&frame), &background, &rule).unwrap();
+        assert!(e.contact, "{}: {e:?}", frame.display());
+    }
+    let same = contact_evidence(&background, &background, &rule).unwrap();
+    assert!(!same.contact && same.min_tile_ssim > 0.999);
+    // A later no-contact frame: camera noise of 2 grey levels and a colour drift of 15 levels
+    // in blue, about what the FOTS frames show between shots.
+    let mut state = 12345u64;
+    let mut uniform = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let drifted = RgbImage::from_fn(background.width(), background.height(), |x, y| {
+        let p = background.get_pixel(x, y);
+        image::Rgb(std::array::from_fn(|c| {
+            // Sum of 12 uniforms: near-normal with sigma 1, scaled to 2.
+            let noise = 2.0 * ((0..12).map(|_| uniform()).sum::<f64>() - 6.0);
+            let drift = if c == 2 { 15.0 } else { 0.0 };
+            (p[c] as f64 + noise + drift).round().clamp(0.0, 255.0) as u8
+        }))
+    });
+    let e = contact_evidence(&drifted, &background, &rule).unwrap();
+    assert!(!e.contact, "{e:?}");
+}
+
+#[test]
+fn markers_found_on_the_real_marker_frame_match_the_annotations() {
+    let f = fixtures().join("markers");
+    let out = tactex(&["markers", f.join("press.png").to_str().unwrap(), "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let found: Vec<(f64, f64)> = report["markers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| (m[0].as_f64().unwrap(), m[1].as_f64().unwrap()))
+        .collect();
+    let text = std::fs::read_to_string(f.join("press.csv")).unwrap();
+    let mut within = 0;
+    let mut total = 0;
+    for line in text.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|c| c.trim().parse().unwrap()).collect();
+        // Annotated position = Mx + dx, My + dy, in whole pixels truncated: the marker lies
+        // in [M, M + 1), so its centre is compared with M + 1/2 (the median offset of the
+        // detections from the raw integers is +0.48, +0.47 px, as truncation predicts).
+        let (x, y) = (v[0] + v[2] + 0.5, v[1] + v[3] + 0.5);
+        let d = found
+            .iter()
+            .map(|p| (p.0 - x).hypot(p.1 - y))
+            .fold(f64::INFINITY, f64::min);
+        total += 1;
+        within += (d <= 1.5) as usize;
+    }
+    eprintln!("{within} of {total} annotated markers found within 1.5 px");
+    assert_eq!(total, 99);
+    // 93 of 99 today; the six misses sit under the ridged indenter or carry a displacement
+    // the image does not show (one annotation is 6 px from any dot).
+    assert!(within >= 93, "{within} of {total}");
+}
