@@ -64,7 +64,7 @@ pub struct BenchRow {
     pub rms_gel_um_vs_hertz: f64,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
     if n % 2 == 1 {

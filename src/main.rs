@@ -3,6 +3,7 @@
 
 mod ball_presses;
 mod bench_contact;
+mod bench_render;
 mod calibrate;
 mod compare;
 mod markers;
@@ -75,6 +76,8 @@ enum Command {
 enum BenchCommand {
     /// Speed and accuracy of each contact fidelity level and solver cell.
     Contact(bench_contact::ContactBenchArgs),
+    /// Frames per second of full GelSight frames per fidelity level, CPU and GPU paths.
+    Render(bench_render::RenderBenchArgs),
 }
 
 #[derive(Subcommand)]
@@ -211,7 +214,27 @@ fn scene_check(file: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Software Vulkan (lavapipe) prints an error on every start without a runtime directory;
+/// give it a private one when the environment has none.
+fn ensure_runtime_dir() {
+    let usable = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_dir());
+    if usable {
+        return;
+    }
+    let dir = std::env::temp_dir().join("tactex-xdg-runtime");
+    if std::fs::create_dir_all(&dir).is_ok() {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let _ = std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700));
+        }
+        // SAFETY: called first thing in main, before any thread exists.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+    }
+}
+
 fn main() -> ExitCode {
+    ensure_runtime_dir();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Ask {
@@ -228,6 +251,9 @@ fn main() -> ExitCode {
         Command::Bench {
             command: BenchCommand::Contact(args),
         } => bench_contact::run(&args),
+        Command::Bench {
+            command: BenchCommand::Render(args),
+        } => bench_render::run(&args),
         Command::Scene {
             command: SceneCommand::Check { file },
         } => scene_check(&file),

@@ -1,7 +1,8 @@
 //! `tactex press`: one press of the GelSight gel into a primitive or a mesh at a chosen
 //! fidelity, reported as JSON or text, with the gel maps written as 16-bit PNGs.
 
-use crate::output::{write_json_atomic, write_png16_atomic};
+use crate::output::{write_json_atomic, write_png_atomic, write_png16_atomic};
+use tactex_sim::gel_render::{DeviceChoice, PressFrame, SensorOptics, image_fields, open_renderer};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use glam::{DVec2, DVec3};
@@ -64,9 +65,24 @@ pub struct PressArgs {
     /// Gel Young's modulus (MPa); GelSight Mini ~0.15-0.45.
     #[arg(long)]
     gel_modulus_mpa: Option<f64>,
-    /// Write the gel displacement and pressure maps (16-bit PNG + JSON sidecar) here.
+    /// Write the gel displacement and pressure maps (16-bit PNG + JSON sidecar) and the
+    /// rendered GelSight Mini frame (tactile.png) here.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Device that renders tactile.png: auto (a hardware GPU if there is one, else the
+    /// CPU), gpu (any Vulkan adapter, software included) or cpu.
+    #[arg(long, default_value = "auto")]
+    device: DeviceChoice,
+    /// Marker grid of the rendered frame, COLSxROWS (the Mini prints 9x7; 11x9 and others
+    /// are common on other gels); 0x0 for none.
+    #[arg(long, default_value = "9x7")]
+    marker_grid: String,
+    /// Marker pitch (mm).
+    #[arg(long, default_value_t = 2.0)]
+    marker_pitch_mm: f64,
+    /// Seed of the rendered frame's camera noise.
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
     /// Print one JSON object on stdout.
     #[arg(long)]
     json: bool,
@@ -194,7 +210,21 @@ pub fn run(args: &PressArgs) -> Result<()> {
     }
     let hardness = object(args)?;
     let surface = surface(args)?;
-    let spec = TactileSpec::gelsight_mini();
+    let mut spec = TactileSpec::gelsight_mini();
+    let (cols, rows) = args
+        .marker_grid
+        .split_once(['x', 'X'])
+        .and_then(|(c, r)| Some((c.trim().parse::<u32>().ok()?, r.trim().parse::<u32>().ok()?)))
+        .filter(|(c, r)| c * r <= 10_000)
+        .with_context(|| {
+            format!(
+                "--marker-grid: '{}' is not COLSxROWS (e.g. 9x7, 11x9)",
+                args.marker_grid
+            )
+        })?;
+    spec.markers.cols = cols;
+    spec.markers.rows = rows;
+    spec.markers.pitch_mm = positive("marker-pitch-mm", args.marker_pitch_mm)?;
     let mut gel = spec.gel;
     if let Some(t) = args.gel_thickness_mm {
         gel.thickness_mm = positive("gel-thickness-mm", t)?;
@@ -243,6 +273,24 @@ pub fn run(args: &PressArgs) -> Result<()> {
     };
     if let Some(dir) = &args.out {
         write_maps(dir, &mut solver, &solution, &pad, &report)?;
+        let choice = open_renderer(args.device)?;
+        if let Some(note) = &choice.note {
+            eprintln!("note: {note}");
+        }
+        let mut renderer = choice.renderer;
+        let optics = SensorOptics::for_spec(&spec);
+        let fields = image_fields(&mut solver, &solution, &gel, &optics);
+        let frame = renderer
+            .render_batch(
+                &optics,
+                &[PressFrame {
+                    fields: &fields,
+                    seed: args.seed,
+                }],
+            )?
+            .pop()
+            .expect("one frame rendered");
+        write_png_atomic(&dir.join("tactile.png"), &frame)?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

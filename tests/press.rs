@@ -100,6 +100,9 @@ fn press_writes_maps_with_their_scale() {
     let deepest = entry["offset"].as_f64().unwrap() + top * entry["scale"].as_f64().unwrap();
     let reported = v["gel_max_indentation_mm"].as_f64().unwrap();
     assert!((deepest - reported).abs() < 1e-3, "{deepest} vs {reported}");
+    // The rendered GelSight Mini frame: 320 x 240 RGB, the imprint at the pad's centre.
+    let tactile = image::open(out.join("tactile.png")).unwrap().into_rgb8();
+    assert_eq!(tactile.dimensions(), (320, 240));
 }
 
 #[test]
@@ -124,6 +127,19 @@ fn bad_press_input_is_one_clear_line_and_a_failure() {
         (
             vec!["--shape", "sphere", "--hardness", "30A", "--depth-mm", "-1"],
             "depth-mm",
+        ),
+        (
+            vec![
+                "--shape",
+                "sphere",
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "1",
+                "--marker-grid",
+                "11by9",
+            ],
+            "marker-grid",
         ),
         (
             vec![

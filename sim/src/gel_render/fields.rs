@@ -4,8 +4,9 @@
 //! beyond that the gel is taken as undisturbed.
 
 use super::{GelImageFields, SensorOptics};
-use crate::elastic::{ContactSolution, ContactSolver, GelFields, Rect};
+use crate::elastic::{ContactSolution, ContactSolver, Rect};
 use glam::DVec2;
+use rayon::prelude::*;
 use tactex_core::tactile_spec::GelSpec;
 
 /// Pad coordinates (mm) of pixel centre (i, j): the pad is centred on the frame, x along
@@ -22,21 +23,30 @@ pub fn pad_rect(optics: &SensorOptics) -> Rect {
     Rect::centred(DVec2::new(optics.width as f64, optics.height as f64) * optics.mm_per_px / 2.0)
 }
 
-/// Bilinear sample with zero beyond the grid's outermost cell centres.
-fn sample_or_zero(fields: &GelFields, field: &[f64], p: DVec2) -> f64 {
-    let g = &fields.grid;
-    let q = (p - g.origin_mm) / g.cell_mm - DVec2::splat(0.5);
-    let (i0, j0) = (q.x.floor(), q.y.floor());
-    let (fx, fy) = (q.x - i0, q.y - j0);
-    let at = |i: f64, j: f64| {
-        if i < 0.0 || j < 0.0 || i >= g.nx as f64 || j >= g.ny as f64 {
-            0.0
-        } else {
-            field[j as usize * g.nx + i as usize]
-        }
-    };
-    (at(i0, j0) * (1.0 - fx) + at(i0 + 1.0, j0) * fx) * (1.0 - fy)
-        + (at(i0, j0 + 1.0) * (1.0 - fx) + at(i0 + 1.0, j0 + 1.0) * fx) * fy
+/// Per pixel along one axis: the grid index left of it and the interpolation weight of each
+/// neighbour, zero where the neighbour is off the grid. Bilinear sampling is separable, so
+/// the weights are computed once per column and per row, not per pixel.
+fn axis_weights(
+    pixels: u32,
+    first_centre_mm: f64,
+    step_mm: f64,
+    grid_origin: f64,
+    cell: f64,
+    cells: usize,
+) -> Vec<(usize, f64, f64)> {
+    (0..pixels)
+        .map(|i| {
+            let q = (first_centre_mm + i as f64 * step_mm - grid_origin) / cell - 0.5;
+            let i0 = q.floor();
+            let f = q - i0;
+            let inside = |k: f64| k >= 0.0 && k < cells as f64;
+            let (w0, w1) = (
+                if inside(i0) { 1.0 - f } else { 0.0 },
+                if inside(i0 + 1.0) { f } else { 0.0 },
+            );
+            (i0.max(0.0) as usize, w0, w1)
+        })
+        .collect()
 }
 
 /// The solution's gel fields at every pixel of `optics`' frame.
@@ -59,15 +69,43 @@ pub fn image_fields(
         .intersect(&pad)
         .unwrap_or(pad);
     let fields = solver.fields_over(solution, &region);
-    let (w, h) = (optics.width as usize, optics.height as usize);
-    for j in 0..h {
-        for i in 0..w {
-            let p = pixel_centre_mm(optics, i as f64, j as f64);
-            let k = j * w + i;
-            out.normal_mm[k] = sample_or_zero(&fields, &fields.normal_mm, p) as f32;
-            out.lateral_x_mm[k] = sample_or_zero(&fields, &fields.lateral_x_mm, p) as f32;
-            out.lateral_y_mm[k] = sample_or_zero(&fields, &fields.lateral_y_mm, p) as f32;
-        }
+    let g = &fields.grid;
+    let first = pixel_centre_mm(optics, 0.0, 0.0);
+    let step = optics.mm_per_px;
+    let cols = axis_weights(optics.width, first.x, step, g.origin_mm.x, g.cell_mm, g.nx);
+    let rows = axis_weights(optics.height, first.y, step, g.origin_mm.y, g.cell_mm, g.ny);
+    let w = optics.width as usize;
+    let sources = [
+        &fields.normal_mm,
+        &fields.lateral_x_mm,
+        &fields.lateral_y_mm,
+    ];
+    let targets = [
+        &mut out.normal_mm,
+        &mut out.lateral_x_mm,
+        &mut out.lateral_y_mm,
+    ];
+    for (src, dst) in sources.into_iter().zip(targets) {
+        dst.par_chunks_mut(w)
+            .zip(&rows)
+            .for_each(|(row, &(j0, wy0, wy1))| {
+                if wy0 == 0.0 && wy1 == 0.0 {
+                    return;
+                }
+                let j1 = (j0 + 1).min(g.ny - 1);
+                let (r0, r1) = (
+                    &src[j0 * g.nx..(j0 + 1) * g.nx],
+                    &src[j1 * g.nx..(j1 + 1) * g.nx],
+                );
+                for (v, &(i0, wx0, wx1)) in row.iter_mut().zip(&cols) {
+                    if wx0 == 0.0 && wx1 == 0.0 {
+                        continue;
+                    }
+                    let i1 = (i0 + 1).min(g.nx - 1);
+                    *v = ((r0[i0] * wx0 + r0[i1] * wx1) * wy0 + (r1[i0] * wx0 + r1[i1] * wx1) * wy1)
+                        as f32;
+                }
+            });
     }
     out
 }
