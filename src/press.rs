@@ -2,7 +2,6 @@
 //! fidelity, reported as JSON or text, with the gel maps written as 16-bit PNGs.
 
 use crate::output::{write_json_atomic, write_png_atomic, write_png16_atomic};
-use tactex_sim::gel_render::{DeviceChoice, PressFrame, SensorOptics, image_fields, open_renderer};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use glam::{DVec2, DVec3};
@@ -14,6 +13,7 @@ use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::elastic::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
 };
+use tactex_sim::gel_render::{DeviceChoice, PressFrame, SensorOptics, image_fields, open_renderer};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum Shape {

@@ -56,7 +56,9 @@ impl TactileSensor for SimGelSight {
             None => GelImageFields::flat(self.spec.width_px, self.spec.height_px),
         };
         // Each frame its own noise: frame counter mixed into the device's seed.
-        let seed = self.seed.wrapping_add(self.frames.wrapping_mul(0x9e37_79b9));
+        let seed = self
+            .seed
+            .wrapping_add(self.frames.wrapping_mul(0x9e37_79b9));
         self.frames += 1;
         let image = CpuRenderer.render_one(
             &self.optics,

@@ -132,8 +132,8 @@ fn expose(
                     let noisy =
                         shaded[y * w + x][c] + p.noise_sigma * gaussian(seed, pixel, c as u32);
                     // floor(x + 1/2) clamped to [0, 255]: on that range the saturating cast's
-                // truncation is the floor, without a libm call per channel.
-                row[3 * x + c] = (noisy + 0.5).clamp(0.0, 255.0) as u8;
+                    // truncation is the floor, without a libm call per channel.
+                    row[3 * x + c] = (noisy + 0.5).clamp(0.0, 255.0) as u8;
                 }
             }
         });
