@@ -13,12 +13,19 @@ fn pcg(v: u32) -> u32 {
     return (word >> 22u) ^ word;
 }
 
-// Standard normal draw for (frame seed, pixel, channel) by Box-Muller.
-fn gaussian(seed: u32, pixel: u32, channel: u32) -> f32 {
-    let key = pcg(seed ^ pcg(pixel * 4u + channel));
-    let u1 = (f32(pcg(key) >> 8u) + 1.0) / 16777216.0;
-    let u2 = f32(pcg(key ^ 0x9e3779b9u) >> 8u) / 16777216.0;
-    return sqrt(-2.0 * log(u1)) * cos(6.28318530717958647692 * u2);
+fn unit(h: u32) -> f32 {
+    return (f32(h >> 8u) + 1.0) / 16777216.0;
+}
+
+// Three standard normal draws for (frame seed, pixel) by Box-Muller: the first pair gives red
+// and green (cosine and sine), the second blue.
+fn gaussian3(seed: u32, pixel: u32) -> vec3<f32> {
+    let key = pcg(seed ^ pcg(pixel));
+    let r1 = sqrt(-2.0 * log(unit(pcg(key))));
+    let t1 = 6.28318530717958647692 * unit(pcg(key ^ 0x9e3779b9u));
+    let r2 = sqrt(-2.0 * log(unit(pcg(key ^ 0x85ebca6bu))));
+    let t2 = 6.28318530717958647692 * unit(pcg(key ^ 0xc2b2ae35u));
+    return vec3<f32>(r1 * cos(t1), r1 * sin(t1), r2 * cos(t2));
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -39,10 +46,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             colour = colour * (1.0 - params.marker_darkness * min(reach - d, 1.0));
         }
     }
-    let seed = frame_seeds[id.z];
+    let noise = gaussian3(frame_seeds[id.z], pixel);
     var packed = 0xff000000u;
     for (var c = 0u; c < 3u; c = c + 1u) {
-        let noisy = colour[c] + params.noise_sigma * gaussian(seed, pixel, c);
+        let noisy = colour[c] + params.noise_sigma * noise[c];
         packed = packed | (u32(clamp(floor(noisy + 0.5), 0.0, 255.0)) << (8u * c));
     }
     pixels[id.z * pixel_count() + pixel] = packed;

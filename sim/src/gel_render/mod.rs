@@ -20,7 +20,7 @@ pub use device::{DeviceChoice, RendererChoice, adapters, open_renderer};
 pub use fields::image_fields;
 pub use fields::{pad_rect, pixel_centre_mm};
 pub use gpu::{GpuRenderer, SHADER_SOURCES, shader_source};
-pub use noise::gaussian;
+pub use noise::gaussian3;
 
 use image::RgbImage;
 use tactex_core::photometric::PhotometricModel;
