@@ -272,12 +272,13 @@ pub fn run(args: &PressArgs) -> Result<()> {
         warnings: solution.warnings.clone(),
     };
     if let Some(dir) = &args.out {
-        write_maps(dir, &mut solver, &solution, &pad, &report)?;
+        // The renderer first: a missing device fails before any file is written.
         let choice = open_renderer(args.device)?;
         if let Some(note) = &choice.note {
             eprintln!("note: {note}");
         }
         let mut renderer = choice.renderer;
+        write_maps(dir, &mut solver, &solution, &pad, &report)?;
         let optics = SensorOptics::for_spec(&spec);
         let fields = image_fields(&mut solver, &solution, &gel, &optics);
         let frame = renderer

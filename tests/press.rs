@@ -245,3 +245,39 @@ fn contact_bench_writes_its_table_and_plot() {
     };
     assert!(err("layer") < 2.0 && err("rigid") > 5.0);
 }
+
+#[test]
+fn asking_for_a_gpu_where_there_is_none_names_what_is_missing_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("maps");
+    // An ICD list naming no driver: the Vulkan loader then finds no adapter at all.
+    let out = Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args([
+            "press",
+            "--shape",
+            "sphere",
+            "--hardness",
+            "30A",
+            "--depth-mm",
+            "1",
+            "--device",
+            "gpu",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ])
+        .env("VK_ICD_FILENAMES", dir.path().join("no-driver.json"))
+        .env("VK_DRIVER_FILES", dir.path().join("no-driver.json"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--device gpu") && err.contains("Vulkan"),
+        "{err}"
+    );
+    assert!(
+        !out_dir.exists(),
+        "nothing is written when the device is missing"
+    );
+}
