@@ -27,3 +27,8 @@ struct RenderParams {
 fn pixel_count() -> u32 {
     return params.width * params.height;
 }
+
+// Whether an invocation of a per-pixel stage falls outside the batch (workgroups overhang).
+fn outside_frame(id: vec3<u32>) -> bool {
+    return id.x >= params.width || id.y >= params.height || id.z >= params.frames;
+}

@@ -21,7 +21,7 @@ fn table_node(m: u32, d: u32, c: u32, u: f32, v: f32) -> f32 {
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = params.width;
     let h = params.height;
-    if (id.x >= w || id.y >= h || id.z >= params.frames) {
+    if (outside_frame(id)) {
         return;
     }
     let pixel = id.y * w + id.x;

@@ -8,7 +8,7 @@
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = params.width;
     let h = params.height;
-    if (id.x >= w || id.y >= h || id.z >= params.frames) {
+    if (outside_frame(id)) {
         return;
     }
     let base = id.z * pixel_count();

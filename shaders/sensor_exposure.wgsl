@@ -31,8 +31,7 @@ fn gaussian3(seed: u32, pixel: u32) -> vec3<f32> {
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = params.width;
-    let h = params.height;
-    if (id.x >= w || id.y >= h || id.z >= params.frames) {
+    if (outside_frame(id)) {
         return;
     }
     let pixel = id.y * w + id.x;
