@@ -1,0 +1,67 @@
+//! Statistics of the paper's validation tables, each checked against scipy's values in its
+//! tests: rank tests (Mann-Whitney U), t-tests (Welch, one-sample), Levene's test
+//! (median-centred), Holm-Bonferroni, Spearman's rank correlation, and the regression metrics
+//! RMSE and R^2. Distribution functions come from statrs.
+
+mod correlation;
+mod levene;
+mod mann_whitney;
+mod multiple;
+mod ranks;
+mod t_tests;
+
+pub use correlation::{r_squared, rmse, spearman};
+pub use levene::levene_median;
+pub use mann_whitney::{MannWhitneyMethod, mann_whitney_u};
+pub use multiple::holm_bonferroni;
+pub use ranks::average_ranks;
+pub use t_tests::{one_sample_t, welch_t};
+
+/// Which way the alternative hypothesis points (the first sample larger: `Greater`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Alternative {
+    TwoSided,
+    Greater,
+    Less,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TestResult {
+    pub statistic: f64,
+    pub p_value: f64,
+    /// Degrees of freedom, where the test has them.
+    pub df: Option<f64>,
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{what}: {message}")]
+pub struct StatsError {
+    pub what: &'static str,
+    pub message: String,
+}
+
+pub(crate) fn check(what: &'static str, x: &[f64], min_len: usize) -> Result<(), StatsError> {
+    if x.len() < min_len {
+        return Err(StatsError {
+            what,
+            message: format!("needs at least {min_len} values, got {}", x.len()),
+        });
+    }
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(StatsError {
+            what,
+            message: "values must be finite".into(),
+        });
+    }
+    Ok(())
+}
+
+pub(crate) fn mean(x: &[f64]) -> f64 {
+    x.iter().sum::<f64>() / x.len() as f64
+}
+
+/// Sample variance (n - 1 in the denominator).
+pub(crate) fn variance(x: &[f64]) -> f64 {
+    let m = mean(x);
+    x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (x.len() - 1) as f64
+}
