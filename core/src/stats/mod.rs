@@ -1,6 +1,6 @@
 //! Statistics of the paper's validation tables, each checked against scipy's values in its
 //! tests: rank tests (Mann-Whitney U), t-tests (Welch, one-sample), Levene's test
-//! (median-centred), Holm-Bonferroni, Spearman's rank correlation, and the regression metrics
+//! (median-centred), Shapiro-Wilk (Royston), Holm-Bonferroni, Spearman's rank correlation, and the regression metrics
 //! RMSE and R^2. Distribution functions come from statrs.
 
 mod correlation;
@@ -8,6 +8,7 @@ mod levene;
 mod mann_whitney;
 mod multiple;
 mod ranks;
+mod shapiro_wilk;
 mod t_tests;
 
 pub use correlation::{r_squared, rmse, spearman};
@@ -15,6 +16,7 @@ pub use levene::levene_median;
 pub use mann_whitney::{MannWhitneyMethod, mann_whitney_u};
 pub use multiple::holm_bonferroni;
 pub use ranks::average_ranks;
+pub use shapiro_wilk::shapiro_wilk;
 pub use t_tests::{one_sample_t, welch_t};
 
 /// Which way the alternative hypothesis points (the first sample larger: `Greater`).
