@@ -3,6 +3,7 @@
 
 use crate::ball_presses::{self, Split};
 use crate::output::write_bytes_atomic;
+use crate::press::positive;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -12,6 +13,7 @@ use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::gel_render::{CALIBRATION_FORMAT, FitReport, GelCalibration};
 
 #[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct CalibrateArgs {
     /// Directory of the ball-press images.
     #[arg(long)]
@@ -46,14 +48,6 @@ pub struct CalibrateArgs {
     /// Attribution of the images, stored in the file.
     #[arg(long, default_value = "")]
     pub source: String,
-}
-
-fn positive(name: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        bail!("--{name}: must be a positive number, got {v}")
-    }
 }
 
 pub fn run(args: &CalibrateArgs) -> Result<()> {

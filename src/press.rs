@@ -131,7 +131,7 @@ struct PressReport {
     warnings: Vec<String>,
 }
 
-fn positive(name: &str, v: f64) -> Result<f64> {
+pub(crate) fn positive(name: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {

@@ -200,3 +200,42 @@ fn markers_found_on_the_real_marker_frame_match_the_annotations() {
     // the image does not show (one annotation is 6 px from any dot).
     assert!(within >= 93, "{within} of {total}");
 }
+
+#[test]
+fn calibrate_rejects_bad_input_in_one_line_and_writes_nothing() {
+    let f = fixtures();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("calib.json");
+    let bad_csv = dir.path().join("bad.csv");
+    std::fs::write(
+        &bad_csv,
+        "image,center_x_px,center_y_px,contact_radius_px\n0001.png,76,182\n",
+    )
+    .unwrap();
+    let good_csv = f.join("ball-presses/annotations.csv");
+    for (annotations, radius, expect) in [
+        (&good_csv, "-1", "--ball-radius-mm"),
+        (&bad_csv, "2.35", "bad.csv:2"),
+    ] {
+        let run = tactex(&[
+            "calibrate",
+            "--images",
+            f.join("ball-presses").to_str().unwrap(),
+            "--annotations",
+            annotations.to_str().unwrap(),
+            "--background",
+            f.join("background.png").to_str().unwrap(),
+            "--ball-radius-mm",
+            radius,
+            "--mm-per-px",
+            MM_PER_PX,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(run.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(expect), "{err}");
+        assert!(!out.exists());
+    }
+}

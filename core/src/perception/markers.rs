@@ -12,9 +12,9 @@ use imageproc::region_labelling::{Connectivity, connected_components};
 const BACKGROUND_RADIUS_PX: u8 = 8;
 
 /// Marker centroids in pixels (x, y): centroids of the dots' silhouettes (pixels much darker
-/// than the gel behind them), sorted by row then column. The gel behind a dot is estimated by a grey-level
-/// closing (the dots are small dark holes in a smooth bright field), so shading gradients and
-/// coloured glows around a contact do not bias the centroids.
+/// than the gel behind them), sorted by row then column. The gel behind a dot is estimated by
+/// a grey-level closing (the dots are small dark holes in a smooth bright field), so shading
+/// gradients and coloured glows around a contact do not bias the centroids.
 pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
     let (w, h) = img.dimensions();
     let lum = GrayImage::from_fn(w, h, |x, y| {
@@ -33,20 +33,16 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
     let dark = close(&dark, Norm::LInf, 2);
     let labels = connected_components(&dark, Connectivity::Eight, Luma([0u8]));
     let n = labels.pixels().map(|p| p[0]).max().unwrap_or(0) as usize;
-    // Per blob: weighted sums, pixel count, and whether it touches the frame edge.
-    let mut acc = vec![(0.0f64, 0.0f64, 0.0f64, 0usize, false); n + 1];
+    // Per blob: sums of x and y over its silhouette, and its pixel count. Uniform weights:
+    // shading inside a dot (specks, the glow of a contact) says nothing about its centre.
+    let mut acc = vec![(0.0f64, 0.0f64, 0usize); n + 1];
     for (x, y, l) in labels.enumerate_pixels() {
         let id = l[0] as usize;
         if id > 0 {
-            // The dot's silhouette, uniformly weighted: shading inside it (specks, the glow of
-            // a contact) says nothing about where its centre is.
-            let weight = 1.0;
             let a = &mut acc[id];
-            a.0 += weight * x as f64;
-            a.1 += weight * y as f64;
-            a.2 += weight;
-            a.3 += 1;
-            a.4 |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
+            a.0 += x as f64;
+            a.1 += y as f64;
+            a.2 += 1;
         }
     }
     let mut out: Vec<(f64, f64)> = acc
@@ -54,8 +50,8 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
         .skip(1)
         // Specks and smudges are not dots. A dot cut by the frame edge is kept: its centroid
         // is that of the visible part.
-        .filter(|a| (6..=600).contains(&a.3))
-        .map(|a| (a.0 / a.2, a.1 / a.2))
+        .filter(|a| (6..=600).contains(&a.2))
+        .map(|a| (a.0 / a.2 as f64, a.1 / a.2 as f64))
         .collect();
     out.sort_by(|p, q| {
         (p.1.round(), p.0)
