@@ -35,6 +35,9 @@ pub struct PressArgs {
     /// Ellipsoid or box size X,Y,Z (mm; full extents); default a cube or ball of 2 radii.
     #[arg(long, value_delimiter = ',')]
     size_mm: Option<Vec<f64>>,
+    /// Turn of an ellipsoid or box about the pressing axis (degrees).
+    #[arg(long, default_value_t = 0.0)]
+    yaw_deg: f64,
     /// Mesh file (.obj, .gltf, .glb) for --shape mesh, pressed at the middle of its top.
     #[arg(long)]
     mesh: Option<PathBuf>,
@@ -162,10 +165,12 @@ fn surface(args: &PressArgs) -> Result<ObjectSurface> {
         Shape::Ellipsoid => ObjectSurface::Ellipsoid {
             semi_axes_mm: size(args.radius_mm)? / 2.0,
             centre_mm: DVec2::ZERO,
+            yaw_rad: args.yaw_deg.to_radians(),
         },
         Shape::Box => ObjectSurface::Box {
             size_mm: size(args.radius_mm)?.truncate(),
             centre_mm: DVec2::ZERO,
+            yaw_rad: args.yaw_deg.to_radians(),
         },
         Shape::Mesh => {
             let path = args

@@ -13,6 +13,8 @@ pub mod gel_render;
 pub mod gelsight;
 pub mod layer;
 pub mod mesh;
+pub mod press_protocol;
+pub mod tactile_sample;
 pub mod world;
 
 use tactex_core::scene::Scene;

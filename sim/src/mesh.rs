@@ -143,7 +143,11 @@ const AROUND: usize = 96;
 
 /// An ellipsoid with semi-axes `radii`.
 pub fn ellipsoid(radii: DVec3) -> TriMesh {
-    lat_long(ALONG, AROUND, |t, s| {
+    ellipsoid_at(radii, 1)
+}
+
+fn ellipsoid_at(radii: DVec3, detail: usize) -> TriMesh {
+    lat_long(ALONG * detail, AROUND * detail, |t, s| {
         let (theta, phi) = (PI * t, 2.0 * PI * s);
         DVec3::new(
             -theta.cos(),
@@ -155,7 +159,11 @@ pub fn ellipsoid(radii: DVec3) -> TriMesh {
 
 /// An egg: cross-sections swell towards the -x end, fitted to the bounding box `size`.
 pub fn egg(size: DVec3) -> TriMesh {
-    lat_long(ALONG, AROUND, |t, s| {
+    egg_at(size, 1)
+}
+
+fn egg_at(size: DVec3, detail: usize) -> TriMesh {
+    lat_long(ALONG * detail, AROUND * detail, |t, s| {
         let (theta, phi) = (PI * t, 2.0 * PI * s);
         let x = -theta.cos();
         let swell = 1.0 - 0.22 * x;
@@ -171,10 +179,14 @@ pub fn egg(size: DVec3) -> TriMesh {
 /// A banana: a tube tapering to both tips, bent along a circular arc in the x-y plane,
 /// fitted to the bounding box `size` (length, width including the bend, thickness).
 pub fn banana(size: DVec3) -> TriMesh {
+    banana_at(size, 1)
+}
+
+fn banana_at(size: DVec3, detail: usize) -> TriMesh {
     let half_angle: f64 = 0.5;
     let bend = ((size.y - size.z).max(0.0) / (1.0 - half_angle.cos())).max(1e-6);
     let tube = size.z / 2.0;
-    lat_long(ALONG, AROUND, |t, s| {
+    lat_long(ALONG * detail, AROUND * detail, |t, s| {
         let a = (2.0 * t - 1.0) * half_angle;
         let taper = (1.0 - (2.0 * t - 1.0).powi(4))
             .max(0.0)
@@ -230,11 +242,57 @@ pub fn cuboid(size: DVec3) -> TriMesh {
 }
 
 pub fn fruit(shape: FruitShape, size: DVec3) -> TriMesh {
+    fruit_detailed(shape, size, 1)
+}
+
+/// A fruit tessellated `detail` times finer along and around than the scene meshes: contact
+/// solvers that read the mesh's facets need them well below the contact's size.
+pub fn fruit_detailed(shape: FruitShape, size: DVec3, detail: usize) -> TriMesh {
+    let detail = detail.max(1);
     match shape {
-        FruitShape::Ellipsoid => ellipsoid(size / 2.0),
-        FruitShape::Egg => egg(size),
-        FruitShape::Banana => banana(size),
+        FruitShape::Ellipsoid => ellipsoid_at(size / 2.0, detail),
+        FruitShape::Egg => egg_at(size, detail),
+        FruitShape::Banana => banana_at(size, detail),
     }
+}
+
+/// One smooth random lobe of a blob: r *= 1 + amplitude * cos(l theta + phase_t) cos(m phi +
+/// phase_p).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lobe {
+    pub l: u32,
+    pub m: u32,
+    pub amplitude: f64,
+    pub phase_theta: f64,
+    pub phase_phi: f64,
+}
+
+/// A smooth star-shaped random body: an ellipsoid whose radius is modulated by low-order
+/// lobes (the total modulation is kept under 1/2 so that it stays star-shaped), fitted to
+/// `size`. Unseen shapes for hardness models trained on primitives and fruit.
+pub fn blob(size: DVec3, lobes: &[Lobe], detail: usize) -> TriMesh {
+    let total: f64 = lobes.iter().map(|l| l.amplitude.abs()).sum();
+    let norm = if total > 0.45 { 0.45 / total } else { 1.0 };
+    let detail = detail.max(1);
+    lat_long(ALONG * detail, AROUND * detail, |t, s| {
+        let (theta, phi) = (PI * t, 2.0 * PI * s);
+        let r = 1.0
+            + norm
+                * lobes
+                    .iter()
+                    .map(|l| {
+                        l.amplitude
+                            * (l.l as f64 * theta + l.phase_theta).cos()
+                            * (l.m as f64 * phi + l.phase_phi).cos()
+                    })
+                    .sum::<f64>();
+        DVec3::new(
+            -theta.cos(),
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+        ) * r
+    })
+    .fit_box(size)
 }
 
 /// Loads an OBJ or glTF/GLB mesh (all its triangles, node transforms applied), in metres.

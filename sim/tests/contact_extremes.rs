@@ -64,19 +64,22 @@ fn surface_strategy() -> impl Strategy<Value = ObjectSurface> {
     prop_oneof![
         (0.3f64..300.0, centre.clone()).prop_map(|(radius_mm, centre_mm)| ObjectSurface::Sphere {
             radius_mm,
-            centre_mm
+            centre_mm,
+            yaw_rad: 0.0,
         }),
         (0.5f64..80.0, 0.5f64..80.0, 0.5f64..80.0, centre.clone()).prop_map(
             |(a, b, c, centre_mm)| {
                 ObjectSurface::Ellipsoid {
                     semi_axes_mm: DVec3::new(a, b, c),
                     centre_mm,
+                    yaw_rad: 0.0,
                 }
             }
         ),
         (0.5f64..40.0, 0.5f64..40.0, centre).prop_map(|(x, y, centre_mm)| ObjectSurface::Box {
             size_mm: DVec2::new(x, y),
-            centre_mm
+            centre_mm,
+            yaw_rad: 0.0,
         }),
     ]
 }
@@ -130,6 +133,7 @@ fn zero_depth_gives_exactly_zero_force() {
     let surface = ObjectSurface::Sphere {
         radius_mm: 10.0,
         centre_mm: DVec2::ZERO,
+        yaw_rad: 0.0,
     };
     for fidelity in Fidelity::ALL {
         let s = solver
@@ -189,6 +193,7 @@ fn an_object_larger_than_the_pad_loads_all_of_it() {
     let surface = ObjectSurface::Box {
         size_mm: DVec2::new(50.0, 50.0),
         centre_mm: DVec2::ZERO,
+        yaw_rad: 0.0,
     };
     let s = solver
         .solve(&problem(&surface, None, 0.5), Fidelity::Layer)
@@ -209,6 +214,7 @@ fn a_solver_that_does_not_converge_says_so_with_its_residual() {
     let surface = ObjectSurface::Sphere {
         radius_mm: 10.0,
         centre_mm: DVec2::ZERO,
+        yaw_rad: 0.0,
     };
     let s = solver
         .solve(&problem(&surface, Some(1.0), 1.0), Fidelity::Layer)
@@ -229,6 +235,7 @@ fn bad_input_is_refused_with_the_field_named() {
     let bad_radius = ObjectSurface::Sphere {
         radius_mm: -1.0,
         centre_mm: DVec2::ZERO,
+        yaw_rad: 0.0,
     };
     let err = solver
         .solve(&problem(&bad_radius, Some(1.0), 1.0), Fidelity::Layer)
@@ -237,6 +244,7 @@ fn bad_input_is_refused_with_the_field_named() {
     let sphere = ObjectSurface::Sphere {
         radius_mm: 5.0,
         centre_mm: DVec2::ZERO,
+        yaw_rad: 0.0,
     };
     for (depth, modulus) in [
         (f64::NAN, Some(1.0)),

@@ -69,6 +69,7 @@ fn presses(optics: &SensorOptics) -> Vec<GelImageFields> {
             &ObjectSurface::Ellipsoid {
                 semi_axes_mm: glam::DVec3::new(5.0, 3.0, 4.0),
                 centre_mm: DVec2::new(-3.0, 2.0),
+                yaw_rad: 0.0,
             },
             Some(0.2),
             1.2,
@@ -79,6 +80,7 @@ fn presses(optics: &SensorOptics) -> Vec<GelImageFields> {
             &ObjectSurface::Box {
                 size_mm: DVec2::new(3.0, 2.0),
                 centre_mm: DVec2::new(2.0, 3.0),
+                yaw_rad: 0.4,
             },
             None,
             0.3,

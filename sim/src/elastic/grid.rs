@@ -40,6 +40,10 @@ impl Rect {
     pub fn contains(&self, other: &Rect) -> bool {
         other.min.cmpge(self.min).all() && other.max.cmple(self.max).all()
     }
+
+    pub fn contains_point(&self, p: DVec2) -> bool {
+        p.cmpge(self.min).all() && p.cmple(self.max).all()
+    }
 }
 
 /// A row-major grid of `nx` x `ny` square cells of side `cell_mm`; cell (i, j) is centred at

@@ -132,6 +132,7 @@ mod tests {
         let surface = ObjectSurface::Ellipsoid {
             semi_axes_mm: glam::DVec3::new(30.0, 20.0, 25.0),
             centre_mm: DVec2::new(0.5, -0.3),
+            yaw_rad: 0.0,
         };
         let grid = Grid::covering(&Rect::centred(DVec2::splat(3.0)), 0.1);
         let heights = surface.heights(&grid);

@@ -67,6 +67,12 @@ impl fmt::Display for Fidelity {
     }
 }
 
+impl serde::Serialize for Fidelity {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
 impl FromStr for Fidelity {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {

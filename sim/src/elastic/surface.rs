@@ -13,16 +13,30 @@ use tactex_core::geometry::Pose;
 pub enum ObjectSurface {
     /// A sphere whose lowest point touches the gel plane at `centre_mm`.
     Sphere { radius_mm: f64, centre_mm: DVec2 },
-    /// An ellipsoid with semi-axes (x, y, z), lowest point on the gel plane at `centre_mm`.
+    /// An ellipsoid with semi-axes (x, y, z), lowest point on the gel plane at `centre_mm`,
+    /// its x axis turned by `yaw_rad` from the pad's x axis.
     Ellipsoid {
         semi_axes_mm: DVec3,
         centre_mm: DVec2,
+        yaw_rad: f64,
     },
     /// A flat-bottomed box (a flat punch with sharp edges) of footprint `size_mm` resting on
-    /// the gel plane, centred at `centre_mm`.
-    Box { size_mm: DVec2, centre_mm: DVec2 },
+    /// the gel plane, centred at `centre_mm`, turned by `yaw_rad`.
+    Box {
+        size_mm: DVec2,
+        centre_mm: DVec2,
+        yaw_rad: f64,
+    },
     /// Any triangle mesh, already in the pad frame (mm).
     Mesh(TriMesh),
+}
+
+fn check_finite(name: &str, v: f64) -> Result<(), String> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{name} must be finite, got {v}"))
+    }
 }
 
 fn check_positive(name: &str, v: f64) -> Result<(), String> {
@@ -63,19 +77,45 @@ impl ObjectSurface {
         })
     }
 
+    /// The footprint corners of a box, counter-clockwise (empty for other shapes).
+    pub fn corners(&self) -> Vec<DVec2> {
+        match self {
+            ObjectSurface::Box {
+                size_mm,
+                centre_mm,
+                yaw_rad,
+            } => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .iter()
+                .map(|(sx, sy)| {
+                    *centre_mm
+                        + DVec2::from_angle(*yaw_rad)
+                            .rotate(DVec2::new(sx * size_mm.x, sy * size_mm.y) / 2.0)
+                })
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
     /// Rejects shapes no solver can use (non-positive or non-finite sizes, empty meshes).
     pub fn validate(&self) -> Result<(), String> {
         match self {
             ObjectSurface::Sphere { radius_mm, .. } => check_positive("radius_mm", *radius_mm),
-            ObjectSurface::Ellipsoid { semi_axes_mm, .. } => {
+            ObjectSurface::Ellipsoid {
+                semi_axes_mm,
+                yaw_rad,
+                ..
+            } => {
                 for (name, v) in ["x", "y", "z"].iter().zip(semi_axes_mm.to_array()) {
                     check_positive(&format!("semi_axes_mm.{name}"), v)?;
                 }
-                Ok(())
+                check_finite("yaw_rad", *yaw_rad)
             }
-            ObjectSurface::Box { size_mm, .. } => {
+            ObjectSurface::Box {
+                size_mm, yaw_rad, ..
+            } => {
                 check_positive("size_mm.x", size_mm.x)?;
-                check_positive("size_mm.y", size_mm.y)
+                check_positive("size_mm.y", size_mm.y)?;
+                check_finite("yaw_rad", *yaw_rad)
             }
             ObjectSurface::Mesh(mesh) => {
                 if mesh.triangles.is_empty() {
@@ -112,13 +152,18 @@ impl ObjectSurface {
             ObjectSurface::Ellipsoid {
                 semi_axes_mm: s,
                 centre_mm,
+                yaw_rad,
             } => {
-                let d = p - *centre_mm;
+                let d = to_body(p - *centre_mm, *yaw_rad);
                 let rho2 = (d.x / s.x).powi(2) + (d.y / s.y).powi(2);
                 (rho2 <= 1.0).then(|| s.z * rho2 / (1.0 + (1.0 - rho2).sqrt()))
             }
-            ObjectSurface::Box { size_mm, centre_mm } => {
-                let d = (p - *centre_mm).abs();
+            ObjectSurface::Box {
+                size_mm,
+                centre_mm,
+                yaw_rad,
+            } => {
+                let d = to_body(p - *centre_mm, *yaw_rad).abs();
                 (d.x <= size_mm.x / 2.0 && d.y <= size_mm.y / 2.0).then_some(0.0)
             }
             ObjectSurface::Mesh(_) => {
@@ -149,20 +194,37 @@ impl ObjectSurface {
     /// not above the region at all.
     pub fn lowest_over(&self, region: &Rect) -> Option<f64> {
         match self {
-            ObjectSurface::Sphere { centre_mm, .. } | ObjectSurface::Box { centre_mm, .. } => {
+            ObjectSurface::Sphere { centre_mm, .. } => {
                 self.height_at(centre_mm.clamp(region.min, region.max))
             }
             ObjectSurface::Ellipsoid {
                 semi_axes_mm: s,
                 centre_mm,
+                yaw_rad,
             } => {
-                // Height grows with the elliptic radius; clamp in scaled coordinates.
-                let scale = s.truncate();
-                let q = ((DVec2::ZERO).clamp(
-                    (region.min - *centre_mm) / scale,
-                    (region.max - *centre_mm) / scale,
-                )) * scale;
-                self.height_at(*centre_mm + q)
+                if region.contains_point(*centre_mm) {
+                    return Some(0.0);
+                }
+                if *yaw_rad == 0.0 {
+                    // Height grows with the elliptic radius; clamp in scaled coordinates.
+                    let scale = s.truncate();
+                    let q = ((DVec2::ZERO).clamp(
+                        (region.min - *centre_mm) / scale,
+                        (region.max - *centre_mm) / scale,
+                    )) * scale;
+                    return self.height_at(*centre_mm + q);
+                }
+                // Turned: the lowest point over the region lies on its boundary.
+                boundary_points(region)
+                    .filter_map(|p| self.height_at(p))
+                    .min_by(f64::total_cmp)
+            }
+            ObjectSurface::Box { centre_mm, .. } => {
+                // Flat: the region sees height 0 wherever it overlaps the footprint.
+                let inside = region.contains_point(*centre_mm)
+                    || boundary_points(region).any(|p| self.height_at(p).is_some())
+                    || self.corners().iter().any(|c| region.contains_point(*c));
+                inside.then_some(0.0)
             }
             ObjectSurface::Mesh(mesh) => clipped_polygons(mesh, region, f64::INFINITY)
                 .flatten()
@@ -192,13 +254,29 @@ impl ObjectSurface {
             ObjectSurface::Ellipsoid {
                 semi_axes_mm: s,
                 centre_mm,
+                yaw_rad,
             } => {
                 let t = (level / s.z).min(1.0);
                 let rho = (2.0 * t - t * t).sqrt();
-                (level > 0.0).then(|| disc(*centre_mm, s.truncate() * rho))?
+                // Half-extents of the turned ellipse of semi-axes a, b.
+                let (a, b) = (s.x * rho, s.y * rho);
+                let (sin, cos) = yaw_rad.sin_cos();
+                let half = DVec2::new(
+                    (a * a * cos * cos + b * b * sin * sin).sqrt(),
+                    (a * a * sin * sin + b * b * cos * cos).sqrt(),
+                );
+                (level > 0.0).then(|| disc(*centre_mm, half))?
             }
-            ObjectSurface::Box { size_mm, centre_mm } => {
-                (level > 0.0).then(|| disc(*centre_mm, *size_mm / 2.0))?
+            ObjectSurface::Box {
+                size_mm, yaw_rad, ..
+            } => {
+                let (sin, cos) = yaw_rad.sin_cos();
+                let half = DVec2::new(
+                    size_mm.x * cos.abs() + size_mm.y * sin.abs(),
+                    size_mm.x * sin.abs() + size_mm.y * cos.abs(),
+                ) / 2.0;
+                let centre = (self.corners()[0] + self.corners()[2]) / 2.0;
+                (level > 0.0).then(|| disc(centre, half))?
             }
             ObjectSurface::Mesh(mesh) => {
                 let mut bounds: Option<Rect> = None;
@@ -216,6 +294,27 @@ impl ObjectSurface {
             }
         }
     }
+}
+
+/// A pad-frame offset in the body frame of a shape turned by `yaw`.
+fn to_body(d: DVec2, yaw: f64) -> DVec2 {
+    DVec2::from_angle(-yaw).rotate(d)
+}
+
+/// Points along a rectangle's edges, dense enough (4096 per edge) for the minimum of a
+/// smooth height over them to be within a micrometre on any pad-sized region.
+fn boundary_points(region: &Rect) -> impl Iterator<Item = DVec2> + '_ {
+    const N: usize = 4096;
+    let corners = [
+        region.min,
+        DVec2::new(region.max.x, region.min.y),
+        region.max,
+        DVec2::new(region.min.x, region.max.y),
+    ];
+    (0..4).flat_map(move |e| {
+        let (a, b) = (corners[e], corners[(e + 1) % 4]);
+        (0..N).map(move |k| a + (b - a) * (k as f64 / N as f64))
+    })
 }
 
 /// Sutherland-Hodgman clip of a polygon by the half-space `keep`, interpolating along edges.
@@ -301,6 +400,100 @@ fn rasterise_lower_envelope(mesh: &TriMesh, grid: &Grid) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::mesh;
+
+    #[test]
+    fn a_quarter_turn_swaps_the_axes_of_ellipsoids_and_boxes() {
+        let c = DVec2::new(0.7, -0.4);
+        let turned = ObjectSurface::Ellipsoid {
+            semi_axes_mm: DVec3::new(6.0, 3.0, 4.0),
+            centre_mm: c,
+            yaw_rad: std::f64::consts::FRAC_PI_2,
+        };
+        let swapped = ObjectSurface::Ellipsoid {
+            semi_axes_mm: DVec3::new(3.0, 6.0, 4.0),
+            centre_mm: c,
+            yaw_rad: 0.0,
+        };
+        let box_turned = ObjectSurface::Box {
+            size_mm: DVec2::new(5.0, 2.0),
+            centre_mm: c,
+            yaw_rad: std::f64::consts::FRAC_PI_2,
+        };
+        let box_swapped = ObjectSurface::Box {
+            size_mm: DVec2::new(2.0, 5.0),
+            centre_mm: c,
+            yaw_rad: 0.0,
+        };
+        for k in 0..400 {
+            let p = c + DVec2::new((k % 20) as f64 * 0.61 - 6.0, (k / 20) as f64 * 0.61 - 6.0);
+            let (a, b) = (turned.height_at(p), swapped.height_at(p));
+            assert_eq!(a.is_some(), b.is_some(), "{p}");
+            if let (Some(a), Some(b)) = (a, b) {
+                assert!((a - b).abs() < 1e-9, "{p}: {a} vs {b}");
+            }
+            // Points exactly on the box edge may fall either way after the turn's rounding.
+            let d = (p - c).abs();
+            if (d.x - 1.0).abs() > 1e-9 && (d.y - 2.5).abs() > 1e-9 {
+                assert_eq!(box_turned.height_at(p), box_swapped.height_at(p), "{p}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_turned_shapes_dip_lies_inside_its_bounds() {
+        let pad = Rect::centred(DVec2::new(10.0, 7.6));
+        let shapes = [
+            ObjectSurface::Ellipsoid {
+                semi_axes_mm: DVec3::new(8.0, 3.0, 5.0),
+                centre_mm: DVec2::new(1.0, 0.5),
+                yaw_rad: 0.6,
+            },
+            ObjectSurface::Box {
+                size_mm: DVec2::new(6.0, 2.0),
+                centre_mm: DVec2::new(-1.0, 0.5),
+                yaw_rad: 0.3,
+            },
+        ];
+        for shape in &shapes {
+            assert_eq!(shape.lowest_over(&pad), Some(0.0));
+            let level = 0.8;
+            let bounds = shape.below_level_bounds(level, &pad).unwrap();
+            let grid = Grid::covering(&pad, 0.05);
+            let heights = shape.heights(&grid);
+            let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+            for j in 0..grid.ny {
+                for i in 0..grid.nx {
+                    if heights[j * grid.nx + i] < level {
+                        let p = grid.centre(i, j);
+                        lo = lo.min(p);
+                        hi = hi.max(p);
+                    }
+                }
+            }
+            // Tight: the dip's cells reach the bounds to within a cell.
+            assert!(bounds.min.cmple(lo + 1e-9).all() && bounds.max.cmpge(hi - 1e-9).all());
+            assert!(
+                (bounds.min - lo).max_element() < 0.06 && (hi - bounds.max).min_element() > -0.06
+            );
+        }
+        // A turned ellipsoid off the pad: its lowest point over the pad is on the pad's edge.
+        let off = ObjectSurface::Ellipsoid {
+            semi_axes_mm: DVec3::new(8.0, 3.0, 5.0),
+            centre_mm: DVec2::new(13.0, 0.0),
+            yaw_rad: 0.5,
+        };
+        let lowest = off.lowest_over(&pad).unwrap();
+        let grid = Grid::covering(&pad, 0.02);
+        let heights = off.heights(&grid);
+        let sampled = (0..heights.len())
+            .filter(|&k| pad.contains_point(grid.centre(k % grid.nx, k / grid.nx)))
+            .map(|k| heights[k])
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            lowest <= sampled + 1e-9 && sampled - lowest < 0.05,
+            "{lowest} vs {sampled}"
+        );
+    }
 
     #[test]
     fn a_mesh_sphere_matches_the_analytic_sphere_near_its_apex() {

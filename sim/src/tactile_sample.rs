@@ -1,0 +1,458 @@
+//! Randomised presses for synthetic pretraining data: an object (primitive, catalog fruit or
+//! random blob) of any hardness from the soft end of Shore 00 to the hard end of Shore A,
+//! placed under the pad with the paper's pose jitter, pressed by a sensor whose gel, lighting,
+//! markers and noise are randomised. Each sample is drawn from (seed, index, attempt) alone, so
+//! any shard of a data set can be generated anywhere, in any order.
+
+use crate::elastic::{Fidelity, ObjectSurface};
+use crate::gel_render::{SensorOptics, Shading, synthetic_background};
+use crate::mesh::{self, Lobe};
+use glam::{DQuat, DVec2, DVec3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+use std::fmt;
+use std::str::FromStr;
+use tactex_core::catalog::FruitCatalog;
+use tactex_core::hardness::shore_a_to_modulus_mpa;
+use tactex_core::hardness::{modulus_to_shore_00, modulus_to_shore_a, shore_00_to_modulus_mpa};
+use tactex_core::hertz::Elastic;
+use tactex_core::photometric::PhotometricModel;
+use tactex_core::tactile_spec::{GelSpec, TactileSpec};
+
+/// The kinds of object a data set draws from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeFamily {
+    Sphere,
+    Ellipsoid,
+    Box,
+    Fruit,
+    Blob,
+}
+
+impl ShapeFamily {
+    pub const ALL: [ShapeFamily; 5] = [
+        ShapeFamily::Sphere,
+        ShapeFamily::Ellipsoid,
+        ShapeFamily::Box,
+        ShapeFamily::Fruit,
+        ShapeFamily::Blob,
+    ];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            ShapeFamily::Sphere => "sphere",
+            ShapeFamily::Ellipsoid => "ellipsoid",
+            ShapeFamily::Box => "box",
+            ShapeFamily::Fruit => "fruit",
+            ShapeFamily::Blob => "blob",
+        }
+    }
+}
+
+impl fmt::Display for ShapeFamily {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ShapeFamily {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        ShapeFamily::ALL
+            .into_iter()
+            .find(|f| f.name() == s.trim().to_ascii_lowercase())
+            .ok_or_else(|| {
+                format!("unknown shape family {s:?} (use sphere, ellipsoid, box, fruit or blob)")
+            })
+    }
+}
+
+/// The object's shape as drawn (mm), enough to rebuild it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ShapeDraw {
+    Sphere {
+        radius_mm: f64,
+    },
+    Ellipsoid {
+        semi_axes_mm: [f64; 3],
+    },
+    Box {
+        footprint_mm: [f64; 2],
+    },
+    Fruit {
+        fruit: String,
+        size_mm: [f64; 3],
+    },
+    Blob {
+        size_mm: [f64; 3],
+        /// (l, m, amplitude, phase_theta, phase_phi) of each lobe.
+        lobes: Vec<[f64; 5]>,
+    },
+}
+
+/// The randomised sensor.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SensorDraw {
+    pub gel: GelSpec,
+    pub lighting: PhotometricModel,
+    /// Per-channel scale of the synthetic background.
+    pub background_gain: [f64; 3],
+    pub marker_grid: [u32; 2],
+    pub marker_pitch_mm: f64,
+    pub marker_radius_mm: f64,
+    pub noise_sigma: f64,
+    pub vignette: f64,
+}
+
+/// One randomised press.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SampleDraw {
+    pub index: u64,
+    pub attempt: u32,
+    pub family: ShapeFamily,
+    pub shape: ShapeDraw,
+    pub modulus_mpa: f64,
+    pub shore_a: f64,
+    pub shore_00: f64,
+    pub object_poisson: f64,
+    /// Where the object's top sits in the pad frame (mm) and its turn (degrees).
+    pub offset_mm: [f64; 2],
+    pub yaw_deg: f64,
+    pub fidelity: Fidelity,
+    pub sensor: SensorDraw,
+    /// Where first touch falls between two press steps (mm).
+    pub phase_mm: f64,
+    /// Seed of the frames' camera noise.
+    pub noise_seed: u32,
+}
+
+/// What a data set draws from.
+#[derive(Clone, Debug)]
+pub struct SampleSpace {
+    pub families: Vec<ShapeFamily>,
+    pub fidelity: Fidelity,
+    /// Hardness range as moduli (MPa), drawn log-uniformly.
+    pub modulus_mpa: [f64; 2],
+    /// Pose jitter: offsets within +-`offset_mm`, yaw in [0, `yaw_max_deg`].
+    pub offset_mm: f64,
+    pub yaw_max_deg: f64,
+    pub step_mm: f64,
+}
+
+impl Default for SampleSpace {
+    /// Every family at the `layer` level, Shore 00 10 to Shore A 90, the paper's jitter
+    /// (x-y within +-5 mm, yaw 0-45 degrees) and step (0.25 mm).
+    fn default() -> Self {
+        Self {
+            families: ShapeFamily::ALL.to_vec(),
+            fidelity: Fidelity::Layer,
+            modulus_mpa: [
+                shore_00_to_modulus_mpa(10.0).expect("finite"),
+                shore_a_to_modulus_mpa(90.0).expect("finite"),
+            ],
+            offset_mm: 5.0,
+            yaw_max_deg: 45.0,
+            step_mm: 0.25,
+        }
+    }
+}
+
+/// The stream a sample's draws come from: the data set's seed, the sample's index and the
+/// attempt (a redraw after a press that found no contact) mixed into one ChaCha seed.
+fn sample_rng(seed: u64, index: u64, attempt: u32) -> ChaCha8Rng {
+    let mut key = [0u8; 32];
+    key[..8].copy_from_slice(&seed.to_le_bytes());
+    key[8..16].copy_from_slice(&index.to_le_bytes());
+    key[16..20].copy_from_slice(&attempt.to_le_bytes());
+    key[20..32].copy_from_slice(b"tactex-press");
+    ChaCha8Rng::from_seed(key)
+}
+
+fn log_uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
+    (rng.random_range(lo.ln()..=hi.ln())).exp()
+}
+
+impl SampleSpace {
+    pub fn draw(&self, catalog: &FruitCatalog, seed: u64, index: u64, attempt: u32) -> SampleDraw {
+        let mut rng = sample_rng(seed, index, attempt);
+        let family = self.families[rng.random_range(0..self.families.len())];
+        let shape = match family {
+            ShapeFamily::Sphere => ShapeDraw::Sphere {
+                radius_mm: log_uniform(&mut rng, 3.0, 60.0),
+            },
+            ShapeFamily::Ellipsoid => ShapeDraw::Ellipsoid {
+                semi_axes_mm: [
+                    log_uniform(&mut rng, 4.0, 60.0),
+                    log_uniform(&mut rng, 4.0, 60.0),
+                    log_uniform(&mut rng, 4.0, 40.0),
+                ],
+            },
+            ShapeFamily::Box => ShapeDraw::Box {
+                footprint_mm: [
+                    log_uniform(&mut rng, 2.0, 25.0),
+                    log_uniform(&mut rng, 2.0, 25.0),
+                ],
+            },
+            ShapeFamily::Fruit => {
+                let names = catalog.names();
+                let fruit = catalog
+                    .get(names[rng.random_range(0..names.len())])
+                    .expect("a catalog name");
+                let scale = rng.random_range(0.9..1.1);
+                ShapeDraw::Fruit {
+                    fruit: fruit.name.clone(),
+                    size_mm: fruit.size_m.map(|v| v * 1e3 * scale),
+                }
+            }
+            ShapeFamily::Blob => {
+                let lobes = (0..rng.random_range(2..=4))
+                    .map(|_| {
+                        [
+                            rng.random_range(1..=4) as f64,
+                            rng.random_range(1..=4) as f64,
+                            rng.random_range(-0.2..0.2),
+                            rng.random_range(0.0..std::f64::consts::TAU),
+                            rng.random_range(0.0..std::f64::consts::TAU),
+                        ]
+                    })
+                    .collect();
+                ShapeDraw::Blob {
+                    size_mm: [
+                        log_uniform(&mut rng, 20.0, 120.0),
+                        log_uniform(&mut rng, 20.0, 90.0),
+                        log_uniform(&mut rng, 15.0, 80.0),
+                    ],
+                    lobes,
+                }
+            }
+        };
+        let modulus_mpa = log_uniform(&mut rng, self.modulus_mpa[0], self.modulus_mpa[1]);
+        let object_poisson = rng.random_range(0.3..0.49);
+        let offset_mm = [
+            rng.random_range(-self.offset_mm..=self.offset_mm),
+            rng.random_range(-self.offset_mm..=self.offset_mm),
+        ];
+        let yaw_deg = rng.random_range(0.0..=self.yaw_max_deg);
+
+        // The GelSight Mini's gel: E ~ 0.15-0.45 MPa, ~4 mm thick.
+        let gel = GelSpec {
+            modulus_mpa: rng.random_range(0.15..0.45),
+            poisson: 0.49,
+            thickness_mm: rng.random_range(3.5..4.5),
+        };
+        let elevation = rng.random_range(25f64..45.0).to_radians();
+        let turn = rng.random_range(-15.0..15.0);
+        let light = |azimuth_deg: f64| {
+            let a = (azimuth_deg + turn).to_radians();
+            DVec3::new(
+                a.cos() * elevation.cos(),
+                a.sin() * elevation.cos(),
+                elevation.sin(),
+            )
+        };
+        let lighting = PhotometricModel {
+            lights: [light(90.0), light(210.0), light(330.0)],
+            ambient: rng.random_range(0.35..0.55),
+            gain: rng.random_range(0.8..1.2),
+        };
+        let sensor = SensorDraw {
+            gel,
+            lighting,
+            background_gain: std::array::from_fn(|_| rng.random_range(0.9..1.1)),
+            marker_grid: if rng.random_bool(0.5) {
+                [9, 7]
+            } else {
+                [11, 9]
+            },
+            marker_pitch_mm: rng.random_range(1.6..2.2),
+            marker_radius_mm: rng.random_range(0.2..0.3),
+            noise_sigma: rng.random_range(0.3..1.5),
+            vignette: rng.random_range(0.4..0.7),
+        };
+        SampleDraw {
+            index,
+            attempt,
+            family,
+            shape,
+            modulus_mpa,
+            shore_a: modulus_to_shore_a(modulus_mpa),
+            shore_00: modulus_to_shore_00(modulus_mpa),
+            object_poisson,
+            offset_mm,
+            yaw_deg,
+            fidelity: self.fidelity,
+            sensor,
+            phase_mm: rng.random_range(0.0..self.step_mm),
+            noise_seed: rng.random(),
+        }
+    }
+}
+
+/// Facets of sample meshes this many times finer than the scene meshes.
+const MESH_DETAIL: usize = 4;
+
+impl SampleDraw {
+    pub fn object(&self) -> Elastic {
+        Elastic {
+            modulus_mpa: Some(self.modulus_mpa),
+            poisson: self.object_poisson,
+        }
+    }
+
+    /// The object's surface over the pad, its top at `offset_mm`, turned by `yaw_deg`.
+    pub fn surface(&self, catalog: &FruitCatalog) -> ObjectSurface {
+        let centre_mm = DVec2::from_array(self.offset_mm);
+        let yaw_rad = self.yaw_deg.to_radians();
+        let placed = |m: &mesh::TriMesh| {
+            let ObjectSurface::Mesh(top) = ObjectSurface::from_mesh_top(m, 1.0) else {
+                unreachable!("from_mesh_top gives a mesh")
+            };
+            // The highest point of an irregular body need not sit over its bounding box's
+            // middle: centre the pad on it, as the robot centres on the top it sees.
+            let apex = top
+                .vertices
+                .iter()
+                .min_by(|a, b| a.z.total_cmp(&b.z))
+                .map_or(DVec2::ZERO, |v| v.truncate());
+            let centred = top.transformed(DQuat::IDENTITY, -apex.extend(0.0));
+            ObjectSurface::Mesh(
+                centred.transformed(DQuat::from_rotation_z(yaw_rad), centre_mm.extend(0.0)),
+            )
+        };
+        match &self.shape {
+            ShapeDraw::Sphere { radius_mm } => ObjectSurface::Sphere {
+                radius_mm: *radius_mm,
+                centre_mm,
+            },
+            ShapeDraw::Ellipsoid { semi_axes_mm } => ObjectSurface::Ellipsoid {
+                semi_axes_mm: DVec3::from_array(*semi_axes_mm),
+                centre_mm,
+                yaw_rad,
+            },
+            ShapeDraw::Box { footprint_mm } => ObjectSurface::Box {
+                size_mm: DVec2::from_array(*footprint_mm),
+                centre_mm,
+                yaw_rad,
+            },
+            ShapeDraw::Fruit { fruit, size_mm } => {
+                let shape = catalog
+                    .get(fruit)
+                    .map(|f| f.shape)
+                    .unwrap_or(tactex_core::catalog::FruitShape::Ellipsoid);
+                placed(&mesh::fruit_detailed(
+                    shape,
+                    DVec3::from_array(*size_mm),
+                    MESH_DETAIL,
+                ))
+            }
+            ShapeDraw::Blob { size_mm, lobes } => {
+                let lobes: Vec<Lobe> = lobes
+                    .iter()
+                    .map(|l| Lobe {
+                        l: l[0] as u32,
+                        m: l[1] as u32,
+                        amplitude: l[2],
+                        phase_theta: l[3],
+                        phase_phi: l[4],
+                    })
+                    .collect();
+                placed(&mesh::blob(
+                    DVec3::from_array(*size_mm),
+                    &lobes,
+                    MESH_DETAIL,
+                ))
+            }
+        }
+    }
+
+    /// The sensor as drawn: GelSight Mini geometry with the randomised gel and optics.
+    pub fn spec(&self) -> TactileSpec {
+        let mut spec = TactileSpec::gelsight_mini();
+        spec.gel = self.sensor.gel;
+        spec.photometric = self.sensor.lighting;
+        spec.markers.cols = self.sensor.marker_grid[0];
+        spec.markers.rows = self.sensor.marker_grid[1];
+        spec.markers.pitch_mm = self.sensor.marker_pitch_mm;
+        spec.markers.radius_mm = self.sensor.marker_radius_mm;
+        spec
+    }
+
+    pub fn optics(&self) -> SensorOptics {
+        let spec = self.spec();
+        let mut optics = SensorOptics::for_spec(&spec);
+        optics.background = synthetic_background(spec.width_px, spec.height_px)
+            .into_iter()
+            .map(|p| std::array::from_fn(|c| p[c] * self.sensor.background_gain[c] as f32))
+            .collect();
+        optics.shading = Shading::Lights(self.sensor.lighting);
+        optics.noise_sigma = self.sensor.noise_sigma as f32;
+        optics.vignette = self.sensor.vignette as f32;
+        optics
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_draw_depends_only_on_seed_index_and_attempt() {
+        let space = SampleSpace::default();
+        let catalog = FruitCatalog::builtin();
+        let a = space.draw(&catalog, 3, 17, 0);
+        let b = space.draw(&catalog, 3, 17, 0);
+        assert_eq!(a, b);
+        assert_ne!(a, space.draw(&catalog, 3, 18, 0));
+        assert_ne!(a, space.draw(&catalog, 3, 17, 1));
+        assert_ne!(a, space.draw(&catalog, 4, 17, 0));
+    }
+
+    #[test]
+    fn draws_cover_every_family_and_the_hardness_range_within_the_jitter() {
+        let space = SampleSpace::default();
+        let catalog = FruitCatalog::builtin();
+        let draws: Vec<SampleDraw> = (0..400).map(|i| space.draw(&catalog, 1, i, 0)).collect();
+        for family in ShapeFamily::ALL {
+            assert!(draws.iter().any(|d| d.family == family), "{family}");
+        }
+        let soft = draws
+            .iter()
+            .map(|d| d.shore_00)
+            .fold(f64::INFINITY, f64::min);
+        let hard = draws.iter().map(|d| d.shore_a).fold(0.0, f64::max);
+        assert!(
+            soft < 20.0 && hard > 80.0,
+            "Shore 00 {soft}, Shore A {hard}"
+        );
+        for d in &draws {
+            assert!(d.offset_mm.iter().all(|o| o.abs() <= 5.0));
+            assert!((0.0..=45.0).contains(&d.yaw_deg));
+            assert!((0.0..0.25).contains(&d.phase_mm));
+            d.surface(&catalog).validate().unwrap();
+            d.optics().validate().unwrap();
+        }
+    }
+
+    #[test]
+    fn every_family_puts_its_top_at_the_drawn_offset() {
+        let catalog = FruitCatalog::builtin();
+        for family in ShapeFamily::ALL {
+            let space = SampleSpace {
+                families: vec![family],
+                ..SampleSpace::default()
+            };
+            let d = space.draw(&catalog, 5, 0, 0);
+            let surface = d.surface(&catalog);
+            let pad = crate::elastic::Rect::centred(DVec2::new(10.1, 7.6));
+            let lowest = surface.lowest_over(&pad).expect("object over the pad");
+            assert!(lowest.abs() < 1e-6, "{family}: lowest {lowest}");
+            // The apex sits at the drawn offset.
+            let offset = DVec2::from_array(d.offset_mm);
+            let apex = surface.height_at(offset).expect("object under its offset");
+            assert!(apex.abs() < 1e-3, "{family}: height {apex} at the offset");
+        }
+    }
+}
