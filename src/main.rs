@@ -3,10 +3,13 @@
 
 mod ball_presses;
 mod bench_contact;
+mod bench_datagen;
 mod bench_render;
 mod calibrate;
 mod compare;
+mod datagen_tactile;
 mod markers;
+mod npz;
 mod output;
 mod plot;
 mod press;
@@ -60,6 +63,11 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Marker centroids on a tactile frame, and displacements against a reference frame.
     Markers(markers::MarkersArgs),
+    /// Synthetic data sets.
+    Datagen {
+        #[command(subcommand)]
+        command: DatagenCommand,
+    },
     /// Benchmarks (run them on a release build).
     Bench {
         #[command(subcommand)]
@@ -78,6 +86,15 @@ enum BenchCommand {
     Contact(bench_contact::ContactBenchArgs),
     /// Frames per second of full GelSight frames per fidelity level, CPU and GPU paths.
     Render(bench_render::RenderBenchArgs),
+    /// Press sequences per second of `datagen tactile` for each fidelity level.
+    Datagen(bench_datagen::DatagenBenchArgs),
+}
+
+#[derive(Subcommand)]
+enum DatagenCommand {
+    /// Press sequences (8 frames from first contact, 0.25 mm apart) of randomised objects
+    /// and sensors, with hardness labels: pretraining data for tactile hardness models.
+    Tactile(datagen_tactile::TactileDatagenArgs),
 }
 
 #[derive(Subcommand)]
@@ -248,12 +265,18 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Markers(args) => markers::run(&args),
+        Command::Datagen {
+            command: DatagenCommand::Tactile(args),
+        } => datagen_tactile::run(&args),
         Command::Bench {
             command: BenchCommand::Contact(args),
         } => bench_contact::run(&args),
         Command::Bench {
             command: BenchCommand::Render(args),
         } => bench_render::run(&args),
+        Command::Bench {
+            command: BenchCommand::Datagen(args),
+        } => bench_datagen::run(&args),
         Command::Scene {
             command: SceneCommand::Check { file },
         } => scene_check(&file),

@@ -8,7 +8,9 @@
 //! renderer to draw in batches. Frame k of the descent has noise seed `frame_seed(seed, k)`,
 //! so the recorded first frame is the very frame the criterion fired on.
 
-use crate::elastic::{ContactError, ContactProblem, ContactSolver, Fidelity, ObjectSurface};
+use crate::elastic::{
+    ContactError, ContactProblem, ContactSolution, ContactSolver, Fidelity, Grid, ObjectSurface,
+};
 use crate::gel_render::{
     CpuRenderer, GelImageFields, GelRenderer, PressFrame, RenderError, SensorOptics, image_fields,
     pad_rect,
@@ -107,38 +109,52 @@ pub fn frame_seed(seed: u32, k: usize) -> u32 {
     (z ^ (z >> 31)) as u32
 }
 
+/// One frame of the descent: the solve on `grid` (warm-started from the previous frame of
+/// the same grid) and the gel fields at the frame's pixels.
+struct SolvedFrame {
+    fields: GelImageFields,
+    solution: Option<ContactSolution>,
+}
+
+impl SolvedFrame {
+    fn facts(&self) -> (f64, f64, f64) {
+        self.solution.as_ref().map_or((0.0, 0.0, 0.0), |s| {
+            (s.force_n, s.contact_radius_mm, s.gel_max_indentation_mm)
+        })
+    }
+}
+
+fn problem_at<'a>(setup: &PressSetup<'a>, approach_mm: f64) -> ContactProblem<'a> {
+    ContactProblem {
+        surface: setup.surface,
+        object: setup.object,
+        gel: setup.gel,
+        pad: pad_rect(setup.optics),
+        approach_mm,
+        cell_mm: setup.cell_mm,
+    }
+}
+
 fn solve_frame(
     solver: &mut ContactSolver,
     setup: &PressSetup,
     approach_mm: f64,
-) -> Result<(GelImageFields, f64, f64, f64, Vec<String>), PressError> {
+    grid: Option<Grid>,
+    warm: Option<&ContactSolution>,
+) -> Result<SolvedFrame, PressError> {
     let optics = setup.optics;
     if approach_mm <= 0.0 {
-        return Ok((
-            GelImageFields::flat(optics.width, optics.height),
-            0.0,
-            0.0,
-            0.0,
-            Vec::new(),
-        ));
+        return Ok(SolvedFrame {
+            fields: GelImageFields::flat(optics.width, optics.height),
+            solution: None,
+        });
     }
-    let problem = ContactProblem {
-        surface: setup.surface,
-        object: setup.object,
-        gel: setup.gel,
-        pad: pad_rect(optics),
-        approach_mm,
-        cell_mm: setup.cell_mm,
-    };
-    let solution = solver.solve(&problem, setup.fidelity)?;
+    let solution = solver.solve_on(&problem_at(setup, approach_mm), setup.fidelity, grid, warm)?;
     let fields = image_fields(solver, &solution, &setup.gel, optics);
-    Ok((
+    Ok(SolvedFrame {
         fields,
-        solution.force_n,
-        solution.contact_radius_mm,
-        solution.gel_max_indentation_mm,
-        solution.warnings,
-    ))
+        solution: Some(solution),
+    })
 }
 
 /// Runs the search and records the press (see the module docs).
@@ -185,18 +201,22 @@ pub fn plan_press(
     let test = ContactTest::with_noise_floor(&reference, &second, &protocol.rule)
         .ok_or_else(|| PressError::Invalid("frame smaller than one SSIM tile".into()))?;
 
+    // Each search step solves on the grid its deepest recorded frame would need, so that
+    // once contact fires the recorded frames share one grid (and its kernels) with warm starts.
+    let deepest = (protocol.frames - 1) as f64 * step;
     let mut found = None;
     for k in 1..=protocol.max_search_steps {
         let a = approach(k);
         if a <= 0.0 {
             continue;
         }
-        let (fields, force, radius, gel_depth, warnings) = solve_frame(solver, setup, a)?;
+        let grid = solver.plan_grid(&problem_at(setup, a), setup.fidelity, a + deepest)?;
+        let frame = solve_frame(solver, setup, a, grid, None)?;
         let seed = frame_seed(setup.seed, k);
         let image = CpuRenderer.render_one(
             setup.optics,
             &PressFrame {
-                fields: &fields,
+                fields: &frame.fields,
                 seed,
             },
         );
@@ -204,47 +224,42 @@ pub fn plan_press(
             .evidence(&image)
             .expect("frames of one optics have one size");
         if evidence.contact {
-            found = Some((
-                k,
-                evidence,
-                PressedFrame {
-                    fields,
-                    seed,
-                    approach_mm: a,
-                    travel_mm: 0.0,
-                    force_n: force,
-                    contact_radius_mm: radius,
-                    gel_max_indentation_mm: gel_depth,
-                },
-                warnings,
-            ));
+            found = Some((k, evidence, grid, frame));
             break;
         }
     }
-    let Some((first_step, contact, first, mut warnings)) = found else {
+    let Some((first_step, contact, grid, first)) = found else {
         return Err(PressError::NoContact {
             travel_mm: approach(protocol.max_search_steps),
         });
     };
-    let mut frames = vec![first];
-    for j in 1..protocol.frames {
+    let mut warnings: Vec<String> = Vec::new();
+    let mut frames = Vec::with_capacity(protocol.frames);
+    let mut first = Some(first);
+    let mut previous: Option<ContactSolution> = None;
+    for j in 0..protocol.frames {
         let k = first_step + j;
         let a = approach(k);
-        let (fields, force, radius, gel_depth, more) = solve_frame(solver, setup, a)?;
-        for w in more {
-            if !warnings.contains(&w) {
-                warnings.push(w);
+        let frame = match first.take() {
+            Some(f) => f,
+            None => solve_frame(solver, setup, a, grid, previous.as_ref())?,
+        };
+        let (force_n, contact_radius_mm, gel_max_indentation_mm) = frame.facts();
+        for w in frame.solution.iter().flat_map(|s| &s.warnings) {
+            if !warnings.contains(w) {
+                warnings.push(w.clone());
             }
         }
         frames.push(PressedFrame {
-            fields,
+            fields: frame.fields,
             seed: frame_seed(setup.seed, k),
             approach_mm: a,
             travel_mm: j as f64 * step,
-            force_n: force,
-            contact_radius_mm: radius,
-            gel_max_indentation_mm: gel_depth,
+            force_n,
+            contact_radius_mm,
+            gel_max_indentation_mm,
         });
+        previous = frame.solution;
     }
     Ok(PlannedPress {
         reference_seed,

@@ -241,7 +241,8 @@ impl SampleSpace {
         let gel = GelSpec {
             modulus_mpa: rng.random_range(0.15..0.45),
             poisson: 0.49,
-            thickness_mm: rng.random_range(3.5..4.5),
+            // On a 0.05 mm ladder: the layer model's tables are cached per thickness.
+            thickness_mm: (rng.random_range(3.5f64..4.5) / 0.05).round() * 0.05,
         };
         let elevation = rng.random_range(25f64..45.0).to_radians();
         let turn = rng.random_range(-15.0..15.0);
@@ -291,6 +292,37 @@ impl SampleSpace {
     }
 }
 
+/// Deepest the pad can reach into a sample (mm): the protocol's search plus its frames, with
+/// room to spare.
+const REACH_MM: f64 = 12.0;
+
+/// The triangles the pad can touch: those with a corner above the pad (plus a margin) and
+/// within its reach. Rasterising the rest on every solve would only cost time.
+fn near_the_pad(mesh: &mesh::TriMesh) -> mesh::TriMesh {
+    let spec = TactileSpec::gelsight_mini();
+    let half = DVec2::new(spec.width_px as f64, spec.height_px as f64) * spec.mm_per_px / 2.0
+        + DVec2::splat(REACH_MM);
+    let keep: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .filter(|t| {
+            let v = t.map(|i| mesh.vertices[i as usize]);
+            let lo = v[0].min(v[1]).min(v[2]);
+            let hi = v[0].max(v[1]).max(v[2]);
+            lo.z <= REACH_MM
+                && lo.x <= half.x
+                && hi.x >= -half.x
+                && lo.y <= half.y
+                && hi.y >= -half.y
+        })
+        .copied()
+        .collect();
+    mesh::TriMesh {
+        vertices: mesh.vertices.clone(),
+        triangles: keep,
+    }
+}
+
 /// Facets of sample meshes this many times finer than the scene meshes.
 const MESH_DETAIL: usize = 4;
 
@@ -317,10 +349,13 @@ impl SampleDraw {
                 .iter()
                 .min_by(|a, b| a.z.total_cmp(&b.z))
                 .map_or(DVec2::ZERO, |v| v.truncate());
-            let centred = top.transformed(DQuat::IDENTITY, -apex.extend(0.0));
-            ObjectSurface::Mesh(
-                centred.transformed(DQuat::from_rotation_z(yaw_rad), centre_mm.extend(0.0)),
-            )
+            let placed = top
+                .transformed(DQuat::from_rotation_z(yaw_rad), centre_mm.extend(0.0))
+                .transformed(
+                    DQuat::IDENTITY,
+                    -(DQuat::from_rotation_z(yaw_rad) * apex.extend(0.0)),
+                );
+            ObjectSurface::Mesh(near_the_pad(&placed))
         };
         match &self.shape {
             ShapeDraw::Sphere { radius_mm } => ObjectSurface::Sphere {

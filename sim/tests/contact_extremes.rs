@@ -65,7 +65,6 @@ fn surface_strategy() -> impl Strategy<Value = ObjectSurface> {
         (0.3f64..300.0, centre.clone()).prop_map(|(radius_mm, centre_mm)| ObjectSurface::Sphere {
             radius_mm,
             centre_mm,
-            yaw_rad: 0.0,
         }),
         (0.5f64..80.0, 0.5f64..80.0, 0.5f64..80.0, centre.clone()).prop_map(
             |(a, b, c, centre_mm)| {
@@ -133,7 +132,6 @@ fn zero_depth_gives_exactly_zero_force() {
     let surface = ObjectSurface::Sphere {
         radius_mm: 10.0,
         centre_mm: DVec2::ZERO,
-        yaw_rad: 0.0,
     };
     for fidelity in Fidelity::ALL {
         let s = solver
@@ -214,7 +212,6 @@ fn a_solver_that_does_not_converge_says_so_with_its_residual() {
     let surface = ObjectSurface::Sphere {
         radius_mm: 10.0,
         centre_mm: DVec2::ZERO,
-        yaw_rad: 0.0,
     };
     let s = solver
         .solve(&problem(&surface, Some(1.0), 1.0), Fidelity::Layer)
@@ -235,7 +232,6 @@ fn bad_input_is_refused_with_the_field_named() {
     let bad_radius = ObjectSurface::Sphere {
         radius_mm: -1.0,
         centre_mm: DVec2::ZERO,
-        yaw_rad: 0.0,
     };
     let err = solver
         .solve(&problem(&bad_radius, Some(1.0), 1.0), Fidelity::Layer)
@@ -244,7 +240,6 @@ fn bad_input_is_refused_with_the_field_named() {
     let sphere = ObjectSurface::Sphere {
         radius_mm: 5.0,
         centre_mm: DVec2::ZERO,
-        yaw_rad: 0.0,
     };
     for (depth, modulus) in [
         (f64::NAN, Some(1.0)),

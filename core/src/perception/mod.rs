@@ -4,6 +4,7 @@
 
 pub mod centroid;
 pub mod contact;
+pub mod depth;
 pub mod detect;
 pub mod markers;
 pub mod mask;

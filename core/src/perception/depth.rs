@@ -1,0 +1,159 @@
+//! The gel's indentation map from its slopes: least-squares integration (Frankot and
+//! Chellappa 1988) on the mirror extension of the frame, which makes the slope field
+//! continuous across the frame's edges and the solve a Poisson problem with Neumann
+//! boundaries, so an imprint touching the edge is not wrapped onto the opposite side.
+
+use super::slopes::SlopeField;
+use rustfft::FftPlanner;
+use rustfft::num_complex::Complex;
+
+/// Indentation (mm, into the gel) per pixel, row-major, zero where the gel is undisturbed
+/// (the median of the frame's border). Slopes of invalid pixels (markers) count as zero.
+pub fn integrate_slopes(field: &SlopeField, mm_per_px: f64) -> Vec<f64> {
+    let (w, h) = (field.width, field.height);
+    let (w2, h2) = (2 * w, 2 * h);
+    // Mirror extension: gx is odd across vertical edges and even across horizontal ones,
+    // gy the other way round.
+    let mut px = vec![Complex::new(0.0, 0.0); w2 * h2];
+    let mut py = vec![Complex::new(0.0, 0.0); w2 * h2];
+    for y in 0..h2 {
+        let (sy, yy) = if y < h { (1.0, y) } else { (-1.0, h2 - 1 - y) };
+        for x in 0..w2 {
+            let (sx, xx) = if x < w { (1.0, x) } else { (-1.0, w2 - 1 - x) };
+            let k = yy * w + xx;
+            if field.valid[k] {
+                px[y * w2 + x].re = sx * field.gx[k] as f64 * mm_per_px;
+                py[y * w2 + x].re = sy * field.gy[k] as f64 * mm_per_px;
+            }
+        }
+    }
+    let mut planner = FftPlanner::<f64>::new();
+    fft2(&mut planner, &mut px, w2, h2, false);
+    fft2(&mut planner, &mut py, w2, h2, false);
+    let freq = |k: usize, n: usize| {
+        let signed = if k <= n / 2 {
+            k as f64
+        } else {
+            k as f64 - n as f64
+        };
+        2.0 * std::f64::consts::PI * signed / n as f64
+    };
+    let mut z = vec![Complex::new(0.0, 0.0); w2 * h2];
+    for v in 0..h2 {
+        let wy = freq(v, h2);
+        for u in 0..w2 {
+            let wx = freq(u, w2);
+            let d = wx * wx + wy * wy;
+            if d > 0.0 {
+                let k = v * w2 + u;
+                // Z = -j (wx Px + wy Py) / (wx^2 + wy^2)
+                let num = px[k] * wx + py[k] * wy;
+                z[k] = Complex::new(num.im, -num.re) / d;
+            }
+        }
+    }
+    fft2(&mut planner, &mut z, w2, h2, true);
+    let scale = 1.0 / (w2 * h2) as f64;
+    let mut depth: Vec<f64> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| z[y * w2 + x].re * scale)
+        .collect();
+    let mut border: Vec<f64> = (0..w)
+        .flat_map(|x| [depth[x], depth[(h - 1) * w + x]])
+        .chain((0..h).flat_map(|y| [depth[y * w], depth[y * w + w - 1]]))
+        .collect();
+    border.sort_by(f64::total_cmp);
+    let zero = border[border.len() / 2];
+    depth.iter_mut().for_each(|d| *d -= zero);
+    depth
+}
+
+fn fft2(
+    planner: &mut FftPlanner<f64>,
+    data: &mut [Complex<f64>],
+    w: usize,
+    h: usize,
+    inverse: bool,
+) {
+    let row = if inverse {
+        planner.plan_fft_inverse(w)
+    } else {
+        planner.plan_fft_forward(w)
+    };
+    for r in data.chunks_mut(w) {
+        row.process(r);
+    }
+    let col = if inverse {
+        planner.plan_fft_inverse(h)
+    } else {
+        planner.plan_fft_forward(h)
+    };
+    let mut column = vec![Complex::new(0.0, 0.0); h];
+    for x in 0..w {
+        for y in 0..h {
+            column[y] = data[y * w + x];
+        }
+        col.process(&mut column);
+        for y in 0..h {
+            data[y * w + x] = column[y];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Slopes of a known surface by central differences, integrated back.
+    fn round_trip(surface: impl Fn(f64, f64) -> f64, w: usize, h: usize, mm_per_px: f64) -> f64 {
+        let at = |x: f64, y: f64| surface(x * mm_per_px, y * mm_per_px);
+        let mut field = SlopeField {
+            width: w,
+            height: h,
+            gx: vec![0.0; w * h],
+            gy: vec![0.0; w * h],
+            valid: vec![true; w * h],
+        };
+        for y in 0..h {
+            for x in 0..w {
+                let (xf, yf) = (x as f64, y as f64);
+                field.gx[y * w + x] = ((at(xf + 0.5, yf) - at(xf - 0.5, yf)) / mm_per_px) as f32;
+                field.gy[y * w + x] = ((at(xf, yf + 0.5) - at(xf, yf - 0.5)) / mm_per_px) as f32;
+            }
+        }
+        let depth = integrate_slopes(&field, mm_per_px);
+        let mut worst: f64 = 0.0;
+        for y in 0..h {
+            for x in 0..w {
+                worst = worst.max((depth[y * w + x] - at(x as f64, y as f64)).abs());
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn a_hertzian_dimple_integrates_back_to_its_depth() {
+        // A spherical cap of radius 10 mm pressed 0.5 mm, centred in a 160 x 120 frame.
+        let (r, d, px) = (10.0, 0.5, 0.0634);
+        let (cx, cy) = (80.0 * px, 60.0 * px);
+        let a2 = 2.0 * r * d;
+        let cap = |x: f64, y: f64| {
+            let q = (x - cx).powi(2) + (y - cy).powi(2);
+            if q < a2 { d - q / (2.0 * r) } else { 0.0 }
+        };
+        let err = round_trip(cap, 160, 120, px);
+        assert!(err < 0.02 * d, "worst error {err} mm of a {d} mm dimple");
+    }
+
+    #[test]
+    fn an_imprint_at_the_frame_edge_is_not_wrapped_around() {
+        let (r, d, px) = (8.0, 0.4, 0.0634);
+        let (cx, cy) = (150.0 * px, 20.0 * px);
+        let cap = |x: f64, y: f64| {
+            let q = (x - cx).powi(2) + (y - cy).powi(2);
+            (d - q / (2.0 * r)).max(0.0)
+        };
+        let err = round_trip(cap, 160, 120, px);
+        assert!(err < 0.05 * d, "worst error {err} mm of a {d} mm dimple");
+    }
+}
