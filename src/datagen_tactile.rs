@@ -431,22 +431,17 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
             .with_context(|| format!("{}: sync failed", manifest_path.display()))?;
     }
     bar.finish_and_clear();
-    if !show_progress {
-        return Ok(DatagenSummary {
-            new: todo.len() as u64,
-            redraws,
-            mean_search_steps: search_steps as f64 / todo.len().max(1) as f64,
-        });
+    if show_progress {
+        eprintln!(
+            "{}: shard {}/{}: {} samples ({} new) in {}",
+            args.out.display(),
+            shard.0,
+            shard.1,
+            total,
+            todo.len(),
+            manifest_path.display()
+        );
     }
-    eprintln!(
-        "{}: shard {}/{}: {} samples ({} new) in {}",
-        args.out.display(),
-        shard.0,
-        shard.1,
-        total,
-        todo.len(),
-        manifest_path.display()
-    );
     Ok(DatagenSummary {
         new: todo.len() as u64,
         redraws,

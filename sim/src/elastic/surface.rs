@@ -268,15 +268,16 @@ impl ObjectSurface {
                 (level > 0.0).then(|| disc(*centre_mm, half))?
             }
             ObjectSurface::Box {
-                size_mm, yaw_rad, ..
+                size_mm,
+                centre_mm,
+                yaw_rad,
             } => {
                 let (sin, cos) = yaw_rad.sin_cos();
                 let half = DVec2::new(
                     size_mm.x * cos.abs() + size_mm.y * sin.abs(),
                     size_mm.x * sin.abs() + size_mm.y * cos.abs(),
                 ) / 2.0;
-                let centre = (self.corners()[0] + self.corners()[2]) / 2.0;
-                (level > 0.0).then(|| disc(centre, half))?
+                (level > 0.0).then(|| disc(*centre_mm, half))?
             }
             ObjectSurface::Mesh(mesh) => {
                 let mut bounds: Option<Rect> = None;
