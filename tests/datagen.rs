@@ -15,6 +15,10 @@ fn tactex(args: &[&str]) -> std::process::Output {
 }
 
 fn datagen(out: &Path, extra: &[&str]) -> std::process::Output {
+    datagen_with(out, "sphere,ellipsoid,box", "11", extra)
+}
+
+fn datagen_with(out: &Path, shapes: &str, seed: &str, extra: &[&str]) -> std::process::Output {
     let mut args = vec![
         "datagen",
         "tactile",
@@ -23,9 +27,9 @@ fn datagen(out: &Path, extra: &[&str]) -> std::process::Output {
         "--fidelity",
         "hertz",
         "--shapes",
-        "sphere,ellipsoid,box",
+        shapes,
         "--seed",
-        "11",
+        seed,
     ];
     args.extend_from_slice(extra);
     tactex(&args)
@@ -192,16 +196,7 @@ fn bad_input_gets_one_clear_line_and_writes_nothing() {
         );
         assert!(!dir.exists(), "{args:?} wrote {}", dir.display());
     }
-    let out = tactex(&[
-        "datagen",
-        "tactile",
-        "--count",
-        "1",
-        "--out",
-        dir.to_str().unwrap(),
-        "--shapes",
-        "cube",
-    ]);
+    let out = datagen_with(&dir, "cube", "11", &["--count", "1"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         !out.status.success() && err.contains("--shapes") && err.contains("cube"),
@@ -220,20 +215,7 @@ fn bad_input_gets_one_clear_line_and_writes_nothing() {
 
     // A second run into one directory with other settings.
     ok(datagen(&dir, &["--count", "1"]));
-    let out = tactex(&[
-        "datagen",
-        "tactile",
-        "--count",
-        "1",
-        "--out",
-        dir.to_str().unwrap(),
-        "--fidelity",
-        "hertz",
-        "--shapes",
-        "sphere,ellipsoid,box",
-        "--seed",
-        "12",
-    ]);
+    let out = datagen_with(&dir, "sphere,ellipsoid,box", "12", &["--count", "1"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         !out.status.success() && err.contains("dataset.json") && err.contains("seed"),

@@ -21,6 +21,7 @@ pub mod pipeline;
 pub mod query;
 pub mod scene;
 pub mod shading_table;
+pub mod spectral;
 pub mod stats;
 pub mod tactile_spec;
 

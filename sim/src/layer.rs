@@ -15,8 +15,8 @@
 //! (T > 1 near kh ~ 0.3 for nu = 0.49): that is why real GelSight markers move outward.
 //! Both are evaluated with tanh and sech^2 so that large kh cannot overflow.
 
-use rustfft::FftPlanner;
 use rustfft::num_complex::Complex;
+use tactex_core::spectral::fft2;
 
 fn tanh_sech2(kh: f64) -> (f64, f64) {
     let e = (-2.0 * kh).exp();
@@ -43,27 +43,6 @@ pub fn normal_compliance_ratio(kh: f64, nu: f64) -> f64 {
     let num = (3.0 - 4.0 * nu) * th - kh * sech2;
     let den = kh * kh * sech2 + 4.0 * (1.0 - nu).powi(2) - (1.0 - 2.0 * nu).powi(2) * th * th;
     num / den
-}
-
-/// 2-D FFT in place (row-major nx x ny); the inverse is unnormalised.
-pub fn fft2(data: &mut [Complex<f64>], nx: usize, ny: usize, inverse: bool) {
-    let mut planner = FftPlanner::new();
-    let (row, col) = if inverse {
-        (planner.plan_fft_inverse(nx), planner.plan_fft_inverse(ny))
-    } else {
-        (planner.plan_fft_forward(nx), planner.plan_fft_forward(ny))
-    };
-    row.process(data);
-    let mut column = vec![Complex::default(); ny];
-    for i in 0..nx {
-        for j in 0..ny {
-            column[j] = data[j * nx + i];
-        }
-        col.process(&mut column);
-        for j in 0..ny {
-            data[j * nx + i] = column[j];
-        }
-    }
 }
 
 /// Lateral surface displacement (x, y) of the layer for the normal indentation field

@@ -4,7 +4,7 @@
 //! boundaries, so an imprint touching the edge is not wrapped onto the opposite side.
 
 use super::slopes::SlopeField;
-use rustfft::FftPlanner;
+use crate::spectral::fft2;
 use rustfft::num_complex::Complex;
 
 /// Indentation (mm, into the gel) per pixel, row-major, zero where the gel is undisturbed
@@ -27,9 +27,8 @@ pub fn integrate_slopes(field: &SlopeField, mm_per_px: f64) -> Vec<f64> {
             }
         }
     }
-    let mut planner = FftPlanner::<f64>::new();
-    fft2(&mut planner, &mut px, w2, h2, false);
-    fft2(&mut planner, &mut py, w2, h2, false);
+    fft2(&mut px, w2, h2, false);
+    fft2(&mut py, w2, h2, false);
     let freq = |k: usize, n: usize| {
         let signed = if k <= n / 2 {
             k as f64
@@ -52,7 +51,7 @@ pub fn integrate_slopes(field: &SlopeField, mm_per_px: f64) -> Vec<f64> {
             }
         }
     }
-    fft2(&mut planner, &mut z, w2, h2, true);
+    fft2(&mut z, w2, h2, true);
     let scale = 1.0 / (w2 * h2) as f64;
     let mut depth: Vec<f64> = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
@@ -66,38 +65,6 @@ pub fn integrate_slopes(field: &SlopeField, mm_per_px: f64) -> Vec<f64> {
     let zero = border[border.len() / 2];
     depth.iter_mut().for_each(|d| *d -= zero);
     depth
-}
-
-fn fft2(
-    planner: &mut FftPlanner<f64>,
-    data: &mut [Complex<f64>],
-    w: usize,
-    h: usize,
-    inverse: bool,
-) {
-    let row = if inverse {
-        planner.plan_fft_inverse(w)
-    } else {
-        planner.plan_fft_forward(w)
-    };
-    for r in data.chunks_mut(w) {
-        row.process(r);
-    }
-    let col = if inverse {
-        planner.plan_fft_inverse(h)
-    } else {
-        planner.plan_fft_forward(h)
-    };
-    let mut column = vec![Complex::new(0.0, 0.0); h];
-    for x in 0..w {
-        for y in 0..h {
-            column[y] = data[y * w + x];
-        }
-        col.process(&mut column);
-        for y in 0..h {
-            data[y * w + x] = column[y];
-        }
-    }
 }
 
 #[cfg(test)]
