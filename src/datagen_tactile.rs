@@ -28,12 +28,11 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::perception::contact::ContactEvidence;
 use tactex_sim::elastic::{ContactSolver, Fidelity};
 use tactex_sim::gel_render::{CpuRenderer, DeviceChoice, GelRenderer, open_renderer};
-use tactex_sim::press_protocol::{PlannedPress, PressError, PressProtocol, PressSetup, plan_press};
+use tactex_sim::press_protocol::{PlannedPress, PressProtocol};
 use tactex_sim::tactile_sample::{SampleDraw, SampleSpace, ShapeFamily};
 
 const FORMAT: &str = "tactex-tactile-dataset/1";
 /// Redraws of a sample whose press found no contact before the run gives up on it.
-const MAX_ATTEMPTS: u32 = 8;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -168,7 +167,8 @@ struct Sample {
     images: Option<Vec<image::RgbImage>>,
 }
 
-/// Draws sample `index` and runs its press, redrawing when the press finds no contact.
+/// Draws sample `index` and plans its press (redrawing where no contact shows), rendering it
+/// here unless a batch renderer will.
 fn press_sample(
     solver: &mut ContactSolver,
     space: &SampleSpace,
@@ -177,42 +177,19 @@ fn press_sample(
     index: u64,
     render_here: bool,
 ) -> Result<Sample> {
-    let protocol = PressProtocol {
-        step_mm: space.step_mm,
-        ..PressProtocol::default()
+    let (draw, press) = space
+        .press(solver, catalog, seed, index)
+        .with_context(|| format!("sample {index}"))?;
+    let images = if render_here {
+        Some(press.render(&mut CpuRenderer, &draw.optics())?)
+    } else {
+        None
     };
-    for attempt in 0..MAX_ATTEMPTS {
-        let draw = space.draw(catalog, seed, index, attempt);
-        let surface = draw.surface(catalog);
-        let optics = draw.optics();
-        let setup = PressSetup {
-            surface: &surface,
-            object: draw.object(),
-            gel: draw.sensor.gel,
-            fidelity: draw.fidelity,
-            optics: &optics,
-            phase_mm: draw.phase_mm,
-            cell_mm: None,
-            seed: draw.noise_seed,
-        };
-        match plan_press(solver, &setup, &protocol) {
-            Ok(press) => {
-                let images = if render_here {
-                    Some(press.render(&mut CpuRenderer, &optics)?)
-                } else {
-                    None
-                };
-                return Ok(Sample {
-                    draw,
-                    press,
-                    images,
-                });
-            }
-            Err(PressError::NoContact { .. }) => continue,
-            Err(e) => return Err(e).with_context(|| format!("sample {index}")),
-        }
-    }
-    bail!("sample {index}: no contact found in {MAX_ATTEMPTS} draws")
+    Ok(Sample {
+        draw,
+        press,
+        images,
+    })
 }
 
 fn write_sample(dir: &Path, format: SampleFormat, s: &Sample) -> Result<Vec<String>> {

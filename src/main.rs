@@ -8,6 +8,8 @@ mod bench_render;
 mod calibrate;
 mod compare;
 mod datagen_tactile;
+mod eval_hardness;
+mod eval_ripeness;
 mod markers;
 mod npz;
 mod output;
@@ -19,7 +21,7 @@ use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::estimate::PhysicsEstimator;
+use tactex_core::estimate::HertzSlopeEstimator;
 use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_sim::SimDevices;
@@ -63,6 +65,11 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Marker centroids on a tactile frame, and displacements against a reference frame.
     Markers(markers::MarkersArgs),
+    /// Evaluations on the twin.
+    Eval {
+        #[command(subcommand)]
+        command: EvalCommand,
+    },
     /// Synthetic data sets.
     Datagen {
         #[command(subcommand)]
@@ -88,6 +95,14 @@ enum BenchCommand {
     Render(bench_render::RenderBenchArgs),
     /// Press sequences per second of `datagen tactile` for each fidelity level.
     Datagen(bench_datagen::DatagenBenchArgs),
+}
+
+#[derive(Subcommand)]
+enum EvalCommand {
+    /// Hardness estimators on held-out synthetic presses of unseen shapes.
+    Hardness(eval_hardness::HardnessEvalArgs),
+    /// The paper's Table III: ripeness stages of five fruits told apart by pressing.
+    Ripeness(eval_ripeness::RipenessEvalArgs),
 }
 
 #[derive(Subcommand)]
@@ -137,7 +152,7 @@ fn ask(
             tactile: &mut sim.tactile,
             arm: &mut sim.arm,
         },
-        &PhysicsEstimator::default(),
+        &HertzSlopeEstimator::default(),
         &config,
     )?;
     if json {
@@ -265,6 +280,12 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Markers(args) => markers::run(&args),
+        Command::Eval {
+            command: EvalCommand::Hardness(args),
+        } => eval_hardness::run(&args),
+        Command::Eval {
+            command: EvalCommand::Ripeness(args),
+        } => eval_ripeness::run(&args),
         Command::Datagen {
             command: DatagenCommand::Tactile(args),
         } => datagen_tactile::run(&args),

@@ -114,3 +114,163 @@ pub fn pareto(
     }
     std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
 }
+
+/// One estimator's (true, predicted) pairs.
+pub struct ScatterSeries {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Predicted against true on equal axes over `range`, with the identity line: the paper's
+/// Fig. 5.
+pub fn predicted_vs_true(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    range: [f64; 2],
+    series: &[ScatterSeries],
+) -> Result<()> {
+    register();
+    let tmp = path.with_extension("partial.png");
+    {
+        let root = BitMapBackend::new(&tmp, (900, 800)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 24))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(range[0]..range[1], range[0]..range[1])
+            .map_err(|e| anyhow!("{e}"))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .label_style(("sans-serif", 16))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        chart
+            .draw_series(LineSeries::new(
+                [(range[0], range[0]), (range[1], range[1])],
+                BLACK.mix(0.5).stroke_width(2),
+            ))
+            .map_err(|e| anyhow!("{e}"))?
+            .label("identity")
+            .legend(|(x, y)| PathElement::new([(x - 10, y), (x + 10, y)], BLACK.mix(0.5)));
+        let clamp = |v: f64| v.clamp(range[0], range[1]);
+        for (k, s) in series.iter().enumerate() {
+            let colour = PALETTE[k % PALETTE.len()];
+            chart
+                .draw_series(
+                    s.points
+                        .iter()
+                        .map(|(t, p)| Circle::new((clamp(*t), clamp(*p)), 5, colour.filled())),
+                )
+                .map_err(|e| anyhow!("{e}"))?
+                .label(s.name.clone())
+                .legend(move |(x, y)| Circle::new((x, y), 5, colour.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 16))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// One labelled group of values (a fruit's ripeness stage).
+pub struct StageGroup {
+    pub label: String,
+    pub values: Vec<f64>,
+    /// The true value, drawn as a black bar.
+    pub truth: Option<f64>,
+}
+
+/// Each group's values as dots beside a box from its 25th to 75th percentile with a line at
+/// the median (and the true value as a black bar): the spread behind a table of medians and
+/// IQRs.
+pub fn stage_groups(path: &Path, title: &str, y_label: &str, groups: &[StageGroup]) -> Result<()> {
+    register();
+    anyhow::ensure!(!groups.is_empty(), "nothing to plot");
+    let all: Vec<f64> = groups
+        .iter()
+        .flat_map(|g| g.values.iter().copied().chain(g.truth))
+        .collect();
+    let lo = all.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = all.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let pad = ((hi - lo) * 0.08).max(1.0);
+    let n = groups.len();
+    let tmp = path.with_extension("partial.png");
+    {
+        let width = (200 + 110 * n as u32).max(900);
+        let root = BitMapBackend::new(&tmp, (width, 650)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(-0.5..n as f64 - 0.5, (lo - pad)..(hi + pad))
+            .map_err(|e| anyhow!("{e}"))?;
+        let labels: Vec<String> = groups.iter().map(|g| g.label.clone()).collect();
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(n)
+            .x_label_formatter(&|x| {
+                let k = x.round();
+                if (x - k).abs() < 1e-6 && k >= 0.0 && (k as usize) < labels.len() {
+                    labels[k as usize].clone()
+                } else {
+                    String::new()
+                }
+            })
+            .x_label_style(("sans-serif", 15))
+            .y_desc(y_label)
+            .label_style(("sans-serif", 16))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        for (k, g) in groups.iter().enumerate() {
+            let x = k as f64;
+            let colour = PALETTE[k % PALETTE.len()];
+            let q = |p: f64| tactex_core::stats::quantile(&g.values, p);
+            let (q25, q50, q75) = (q(0.25)?, q(0.5)?, q(0.75)?);
+            chart
+                .draw_series([Rectangle::new(
+                    [(x - 0.3, q25), (x + 0.3, q75)],
+                    colour.mix(0.25).filled(),
+                )])
+                .map_err(|e| anyhow!("{e}"))?;
+            chart
+                .draw_series([PathElement::new(
+                    [(x - 0.3, q50), (x + 0.3, q50)],
+                    colour.stroke_width(3),
+                )])
+                .map_err(|e| anyhow!("{e}"))?;
+            if let Some(t) = g.truth {
+                chart
+                    .draw_series([PathElement::new(
+                        [(x - 0.4, t), (x + 0.4, t)],
+                        BLACK.stroke_width(2),
+                    )])
+                    .map_err(|e| anyhow!("{e}"))?;
+            }
+            // Dots spread evenly across the box so that equal values stay visible.
+            let m = g.values.len().max(2) as f64;
+            chart
+                .draw_series(g.values.iter().enumerate().map(|(i, v)| {
+                    let dx = -0.25 + 0.5 * i as f64 / (m - 1.0);
+                    Circle::new((x + dx, *v), 3, colour.filled())
+                }))
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+}

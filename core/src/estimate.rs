@@ -1,7 +1,10 @@
 //! Hardness from a press sequence, behind one trait so that learned models (ONNX) and the
-//! physics inversion are interchangeable.
+//! physics inversions are interchangeable.
 //!
-//! The physics estimator reads how much of the robot's travel the gel took. In Hertz contact
+//! Two physics estimators read how much of the robot's travel the gel took. This one fits the
+//! Hertz half-space slope field and so suits a gel that behaves as a half-space (the
+//! Hertz-level twin); `indentation_estimator` fits the gel's integrated indentation with the
+//! bonded layer's stiffening and holds for any shape on the real 4 mm gel. In Hertz contact
 //! each body's surface moves by its compliance share of the approach, so the gel's slope field
 //! is s * du/dr of the Hertz displacement with s = c_gel / (c_gel + c_object). From the frames
 //! it recovers the gel's surface slopes (photometric inversion against the no-contact frame),
@@ -42,8 +45,12 @@ pub struct Evidence {
     /// Gel indentation at the last frame (mm).
     pub last_gel_indentation_mm: f64,
     pub frames_used: usize,
-    /// RMS of the slope residual after the fit.
-    pub slope_residual_rms: f64,
+    /// Centre compliance of the bonded gel layer relative to the half-space at the last
+    /// frame's contact size (1: the half-space split).
+    pub gel_layer_factor: f64,
+    /// RMS residual of the fit, in `fit_residual_unit` (what the estimator fits).
+    pub fit_residual_rms: f64,
+    pub fit_residual_unit: &'static str,
     /// Poisson's ratio assumed for the object.
     pub object_poisson: f64,
 }
@@ -73,16 +80,16 @@ pub trait HardnessEstimator {
     ) -> Result<HardnessEstimate, EstimateError>;
 }
 
-/// Physics inversion of the Hertz compliance split (see the module docs).
+/// Physics inversion of the Hertz compliance split from the slope field (see the module docs).
 #[derive(Clone, Debug)]
-pub struct PhysicsEstimator {
+pub struct HertzSlopeEstimator {
     /// Poisson's ratio assumed for the object (fruit flesh: 0.2-0.5; Mohsenin 1986).
     pub object_poisson: f64,
     /// Every n-th pixel in each direction enters the fit.
     pub stride: usize,
 }
 
-impl Default for PhysicsEstimator {
+impl Default for HertzSlopeEstimator {
     fn default() -> Self {
         Self {
             object_poisson: 0.35,
@@ -97,9 +104,9 @@ struct Sample {
     slope: f64,
 }
 
-impl HardnessEstimator for PhysicsEstimator {
+impl HardnessEstimator for HertzSlopeEstimator {
     fn name(&self) -> &str {
-        "physics"
+        "hertz_slopes"
     }
 
     fn estimate(
@@ -267,7 +274,9 @@ impl HardnessEstimator for PhysicsEstimator {
                 last_contact_radius_mm: last_hertz.contact_radius_mm(),
                 last_gel_indentation_mm: share.min(1.0) * last_approach,
                 frames_used: fields.len(),
-                slope_residual_rms: (rss.max(0.0) / samples.len() as f64).sqrt(),
+                gel_layer_factor: 1.0,
+                fit_residual_rms: (rss.max(0.0) / samples.len() as f64).sqrt(),
+                fit_residual_unit: "slope",
                 object_poisson: self.object_poisson,
             },
         })

@@ -16,6 +16,8 @@ use crate::gel_render::{
     pad_rect,
 };
 use image::RgbImage;
+use tactex_core::estimate::PressSequence;
+use tactex_core::frames::TactileFrame;
 use tactex_core::hertz::Elastic;
 use tactex_core::perception::contact::{ContactEvidence, ContactRule, ContactTest};
 use tactex_core::tactile_spec::GelSpec;
@@ -287,6 +289,20 @@ impl PlannedPress {
             seed: f.seed,
         }));
         renderer.render_batch(optics, &batch)
+    }
+
+    /// The press as the estimators read it: the rendered reference and frames (from
+    /// `render`) with each frame's travel past the first contact frame.
+    pub fn sequence(&self, images: Vec<RgbImage>) -> PressSequence {
+        let mut frames = images.into_iter().map(|image| TactileFrame {
+            image,
+            timestamp_s: 0.0,
+        });
+        PressSequence {
+            reference: frames.next().expect("the reference frame comes first"),
+            frames: frames.collect(),
+            travel_mm: self.frames.iter().map(|f| f.travel_mm).collect(),
+        }
     }
 }
 

@@ -4,9 +4,10 @@
 //! markers and noise are randomised. Each sample is drawn from (seed, index, attempt) alone, so
 //! any shard of a data set can be generated anywhere, in any order.
 
-use crate::elastic::{Fidelity, ObjectSurface};
+use crate::elastic::{ContactSolver, Fidelity, ObjectSurface};
 use crate::gel_render::{SensorOptics, Shading, synthetic_background};
 use crate::mesh::{self, Lobe};
+use crate::press_protocol::{PlannedPress, PressError, PressProtocol, PressSetup, plan_press};
 use glam::{DQuat, DVec2, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -107,6 +108,24 @@ pub struct SensorDraw {
     pub vignette: f64,
 }
 
+impl SensorDraw {
+    /// The nominal GelSight Mini, unrandomised: the sensor of a lab's validation run.
+    pub fn nominal() -> Self {
+        let spec = TactileSpec::gelsight_mini();
+        let optics = SensorOptics::for_spec(&spec);
+        Self {
+            gel: spec.gel,
+            lighting: spec.photometric,
+            background_gain: [1.0; 3],
+            marker_grid: [spec.markers.cols, spec.markers.rows],
+            marker_pitch_mm: spec.markers.pitch_mm,
+            marker_radius_mm: spec.markers.radius_mm,
+            noise_sigma: optics.noise_sigma as f64,
+            vignette: optics.vignette as f64,
+        }
+    }
+}
+
 /// One randomised press.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SampleDraw {
@@ -175,7 +194,36 @@ fn log_uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
     (rng.random_range(lo.ln()..=hi.ln())).exp()
 }
 
+/// Draws a sample gets before its index is given up: a draw whose press never shows
+/// contact (a very soft object touched off-centre) is redrawn.
+pub const MAX_DRAWS: u32 = 8;
+
 impl SampleSpace {
+    /// Draws sample `index` and plans its press at `step_mm`, redrawing (attempt 1, 2, ...)
+    /// when the press finds no contact.
+    pub fn press(
+        &self,
+        solver: &mut ContactSolver,
+        catalog: &FruitCatalog,
+        seed: u64,
+        index: u64,
+    ) -> Result<(SampleDraw, PlannedPress), PressError> {
+        let protocol = PressProtocol {
+            step_mm: self.step_mm,
+            ..PressProtocol::default()
+        };
+        let mut last = None;
+        for attempt in 0..MAX_DRAWS {
+            let draw = self.draw(catalog, seed, index, attempt);
+            match draw.plan_press(solver, catalog, &protocol) {
+                Ok(press) => return Ok((draw, press)),
+                Err(e @ PressError::NoContact { .. }) => last = Some(e),
+                Err(e) => return Err(e),
+            }
+        }
+        Err(last.expect("at least one draw"))
+    }
+
     pub fn draw(&self, catalog: &FruitCatalog, seed: u64, index: u64, attempt: u32) -> SampleDraw {
         let mut rng = sample_rng(seed, index, attempt);
         let family = self.families[rng.random_range(0..self.families.len())];
@@ -327,6 +375,28 @@ fn near_the_pad(mesh: &mesh::TriMesh) -> mesh::TriMesh {
 const MESH_DETAIL: usize = 4;
 
 impl SampleDraw {
+    /// Runs the press protocol on this draw (the frames' fields, not yet rendered).
+    pub fn plan_press(
+        &self,
+        solver: &mut ContactSolver,
+        catalog: &FruitCatalog,
+        protocol: &PressProtocol,
+    ) -> Result<PlannedPress, PressError> {
+        let surface = self.surface(catalog);
+        let optics = self.optics();
+        let setup = PressSetup {
+            surface: &surface,
+            object: self.object(),
+            gel: self.sensor.gel,
+            fidelity: self.fidelity,
+            optics: &optics,
+            phase_mm: self.phase_mm,
+            cell_mm: None,
+            seed: self.noise_seed,
+        };
+        plan_press(solver, &setup, protocol)
+    }
+
     pub fn object(&self) -> Elastic {
         Elastic {
             modulus_mpa: Some(self.modulus_mpa),

@@ -1,12 +1,14 @@
-//! Statistics of the paper's validation tables, each checked against scipy's values in its
-//! tests: rank tests (Mann-Whitney U), t-tests (Welch, one-sample), Levene's test
-//! (median-centred), Shapiro-Wilk (Royston), Holm-Bonferroni, Spearman's rank correlation, and the regression metrics
-//! RMSE and R^2. Distribution functions come from statrs.
+//! Statistics of the paper's validation tables, each checked against scipy's or numpy's
+//! values in its tests: rank tests (Mann-Whitney U), t-tests (Welch, one-sample), Levene's
+//! test (median-centred), Shapiro-Wilk (Royston), Holm-Bonferroni, Spearman's rank
+//! correlation, sample quantiles, and the regression metrics RMSE and R^2. Distribution
+//! functions come from statrs.
 
 mod correlation;
 mod levene;
 mod mann_whitney;
 mod multiple;
+mod quantile;
 mod ranks;
 mod shapiro_wilk;
 mod t_tests;
@@ -15,6 +17,7 @@ pub use correlation::{r_squared, rmse, spearman};
 pub use levene::levene_median;
 pub use mann_whitney::{MannWhitneyMethod, mann_whitney_u};
 pub use multiple::holm_bonferroni;
+pub use quantile::quantile;
 pub use ranks::average_ranks;
 pub use shapiro_wilk::shapiro_wilk;
 pub use t_tests::{one_sample_t, welch_t};

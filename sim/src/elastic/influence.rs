@@ -14,8 +14,8 @@
 //! at k = 0 and decay exponentially, so plain quadrature converges; the corrections are
 //! tabulated in r and averaged over a cell with 2 x 2 Gauss points.
 
-use crate::layer::{lateral_ratio, normal_compliance_ratio};
 use std::f64::consts::PI;
+use tactex_core::layer_compliance::{lateral_ratio, normal_compliance_ratio};
 
 /// The half-space radial-to-normal displacement ratio T_inf (negative: inward).
 pub fn half_space_lateral_ratio(nu: f64) -> f64 {

@@ -1,0 +1,158 @@
+//! Hardness from how much of the robot's travel the gel took, for objects of any shape.
+//!
+//! Two elastic bodies pressed together share the approach by compliance, whatever their
+//! shapes (exact for half-spaces). The estimator recovers the gel's indentation map of every
+//! frame (photometric slopes against the no-contact frame, integrated), takes its peak and
+//! its contact size, and fits the split (core's `gel_share_fit`) with the bonded gel layer's
+//! stiffening at each frame's contact size, so a wide flat contact on a thin gel is not read
+//! as a softer object. The object's modulus follows from the compliance ratio and the gel's
+//! modulus.
+
+use crate::estimate::{
+    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, PressSequence,
+};
+use crate::gel_share_fit::{ShareFit, fit_gel_share};
+use crate::hardness::Hardness;
+use crate::hertz::Elastic;
+use crate::layer_compliance::hertz_centre_compliance_ratio;
+use crate::perception::depth::integrate_slopes;
+use crate::perception::slopes::recover_slopes;
+use crate::tactile_spec::TactileSpec;
+use std::f64::consts::PI;
+
+#[derive(Clone, Debug)]
+pub struct IndentationEstimator {
+    /// Poisson's ratio assumed for the object (fruit flesh: 0.2-0.5; Mohsenin 1986).
+    pub object_poisson: f64,
+}
+
+impl Default for IndentationEstimator {
+    fn default() -> Self {
+        Self {
+            object_poisson: 0.35,
+        }
+    }
+}
+
+/// The peak of an indentation map: the mean of its 20 deepest pixels, which averages out the
+/// integration's pixel noise while staying within the contact's centre.
+fn peak(depth: &[f64]) -> f64 {
+    let mut sorted: Vec<f64> = depth.to_vec();
+    let n = sorted.len().min(20);
+    let k = sorted.len() - n;
+    sorted.select_nth_unstable_by(k, f64::total_cmp);
+    sorted[k..].iter().sum::<f64>() / n as f64
+}
+
+/// Whether the region `inside` holds reaches the outermost two pixels of the frame.
+fn touches_border(depth: &[f64], w: usize, h: usize, inside: impl Fn(f64) -> bool) -> bool {
+    (0..h).any(|y| {
+        (0..w).any(|x| {
+            let edge = x < 2 || y < 2 || x + 2 >= w || y + 2 >= h;
+            edge && inside(depth[y * w + x])
+        })
+    })
+}
+
+impl HardnessEstimator for IndentationEstimator {
+    fn name(&self) -> &str {
+        "indentation"
+    }
+
+    fn estimate(
+        &self,
+        press: &PressSequence,
+        spec: &TactileSpec,
+    ) -> Result<HardnessEstimate, EstimateError> {
+        let n = press.frames.len();
+        if n < 2 || n != press.travel_mm.len() {
+            return Err(EstimateError::BadSequence(format!(
+                "need at least 2 frames with one travel each, got {n} frames and {} travels",
+                press.travel_mm.len()
+            )));
+        }
+        if press.travel_mm.iter().any(|t| !t.is_finite()) {
+            return Err(EstimateError::BadSequence("travel must be finite".into()));
+        }
+        let mut peaks = Vec::with_capacity(n);
+        let mut contact_radii = Vec::with_capacity(n);
+        let mut within_frame = Vec::with_capacity(n);
+        let pixel_area = spec.mm_per_px * spec.mm_per_px;
+        for frame in &press.frames {
+            let slopes = recover_slopes(&frame.image, &press.reference.image, &spec.photometric)
+                .ok_or_else(|| {
+                    EstimateError::BadSequence("frame and reference sizes differ".into())
+                })?;
+            let depth = integrate_slopes(&slopes, spec.mm_per_px);
+            let p = peak(&depth);
+            // The half-depth area as a circle; the half-depth circle of a Hertz dimple is
+            // about 0.866 of the contact radius.
+            let deep = |d: f64| d > 0.5 * p;
+            let half_depth_px = depth.iter().filter(|d| deep(**d)).count();
+            contact_radii.push((half_depth_px as f64 * pixel_area / PI).sqrt() / 0.866);
+            within_frame.push(!touches_border(&depth, slopes.width, slopes.height, deep));
+            peaks.push(p);
+        }
+        if !peaks.last().is_some_and(|p| *p > 0.0) {
+            return Err(EstimateError::NoImprint);
+        }
+        // An imprint that reaches the frame's edge has no undisturbed gel left to zero the
+        // integration on, so its peak reads short: fit the frames whose imprint lies within
+        // the frame, or the first three (the least cut) when fewer do.
+        let mut used: Vec<usize> = (0..n).filter(|k| within_frame[*k]).collect();
+        if used.len() < 3 {
+            used = (0..n.min(3)).collect();
+        }
+        let pick = |v: &[f64]| used.iter().map(|k| v[*k]).collect::<Vec<f64>>();
+        let layer: Vec<f64> = contact_radii
+            .iter()
+            .map(|a| hertz_centre_compliance_ratio(a / spec.gel.thickness_mm, spec.gel.poisson))
+            .collect();
+        let fit = fit_gel_share(&pick(&peaks), &pick(&press.travel_mm), &pick(&layer))
+            .ok_or(EstimateError::NoImprint)?;
+        let gel = Elastic {
+            modulus_mpa: Some(spec.gel.modulus_mpa),
+            poisson: spec.gel.poisson,
+        };
+        let object_one_minus_nu2 = 1.0 - self.object_poisson * self.object_poisson;
+        // rho -> 0 is a rigid object; the modulus follows from c_object = rho c_gel.
+        let to_modulus =
+            |rho: f64| (rho > 1e-6).then(|| object_one_minus_nu2 / (rho * gel.compliance()));
+        let hardness = match to_modulus(fit.compliance_ratio) {
+            Some(e) => Hardness::ModulusMpa(e),
+            None => Hardness::Rigid,
+        };
+        let [rho_lo, rho_hi] = fit.compliance_ratio_interval;
+        let last = *used.last().expect("at least two frames used");
+        let last_share = *fit.shares.last().expect("one share per frame used");
+        let last_approach = fit.first_contact_approach_mm + press.travel_mm[last];
+        let contact_radius = contact_radii[last];
+        Ok(HardnessEstimate {
+            hardness,
+            // A softer object has the larger compliance ratio.
+            modulus_interval_mpa: [to_modulus(rho_hi), to_modulus(rho_lo)],
+            evidence: Evidence {
+                gel_share: last_share,
+                gel_share_se: share_se(&fit),
+                local_radius_mm: contact_radius * contact_radius / last_approach.max(1e-9),
+                first_contact_approach_mm: fit.first_contact_approach_mm,
+                last_contact_radius_mm: contact_radius,
+                last_gel_indentation_mm: peaks[last],
+                frames_used: used.len(),
+                gel_layer_factor: layer[last],
+                fit_residual_rms: fit.residual_rms_mm,
+                fit_residual_unit: "mm",
+                object_poisson: self.object_poisson,
+            },
+        })
+    }
+}
+
+/// Standard error of the last frame's share, carried over from the ratio's interval.
+fn share_se(fit: &ShareFit) -> f64 {
+    let last = *fit.shares.last().expect("one share per frame used");
+    let layer = last * fit.compliance_ratio / (1.0 - last).max(1e-12);
+    let share = |rho: f64| layer / (layer + rho);
+    let [lo, hi] = fit.compliance_ratio_interval;
+    0.5 * (share(lo) - share(hi)).abs()
+}

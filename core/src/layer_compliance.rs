@@ -1,0 +1,145 @@
+//! Surface response of an elastic layer of thickness h bonded to a rigid base, with a
+//! frictionless top, to normal surface loading, per Fourier mode of wavenumber k.
+//!
+//! Derived from the plane-strain Airy stress function f(z) = (A + Bz) cosh kz + (C + Dz) sinh kz
+//! with u = w = 0 at the base and sigma_zz = -p cos kx, sigma_xz = 0 on top (derivation
+//! checked symbolically). With s = sinh kh, c = cosh kh:
+//!
+//! * lateral / normal surface displacement (positive = away from the indentation):
+//!   T(kh) = [(kh)^2 - (1 - 2nu)(3 - 4nu) s^2] / [2 (1 - nu) ((3 - 4nu) s c - kh)]
+//! * normal compliance relative to the half-space 2 (1 - nu^2) / (E k):
+//!   K(kh) = ((3 - 4nu) s c - kh) / ((kh)^2 + 4 (1 - nu)^2 c^2 - (1 - 2nu)^2 s^2)
+//!
+//! For kh -> infinity both reach the half-space: T -> -(1 - 2nu) / (2 (1 - nu)) (Johnson's
+//! inward surface motion) and K -> 1. A thin near-incompressible gel squeezes outwards
+//! (T > 1 near kh ~ 0.3 for nu = 0.49): that is why real GelSight markers move outward.
+//! Both are evaluated with tanh and sech^2 so that large kh cannot overflow.
+
+fn tanh_sech2(kh: f64) -> (f64, f64) {
+    let e = (-2.0 * kh).exp();
+    ((1.0 - e) / (1.0 + e), 4.0 * e / ((1.0 + e) * (1.0 + e)))
+}
+
+/// Lateral-to-normal surface displacement ratio of the bonded layer.
+pub fn lateral_ratio(kh: f64, nu: f64) -> f64 {
+    if kh <= 0.0 {
+        return 0.0;
+    }
+    let (th, sech2) = tanh_sech2(kh);
+    let num = kh * kh * sech2 - (1.0 - 2.0 * nu) * (3.0 - 4.0 * nu) * th * th;
+    let den = 2.0 * (1.0 - nu) * ((3.0 - 4.0 * nu) * th - kh * sech2);
+    if den.abs() < 1e-300 { 0.0 } else { num / den }
+}
+
+/// Normal compliance of the bonded layer relative to the half-space.
+pub fn normal_compliance_ratio(kh: f64, nu: f64) -> f64 {
+    if kh <= 0.0 {
+        return 0.0;
+    }
+    let (th, sech2) = tanh_sech2(kh);
+    let num = (3.0 - 4.0 * nu) * th - kh * sech2;
+    let den = kh * kh * sech2 + 4.0 * (1.0 - nu).powi(2) - (1.0 - 2.0 * nu).powi(2) * th * th;
+    num / den
+}
+
+/// Centre displacement of the bonded layer under a Hertz pressure of contact radius a,
+/// relative to the half-space's, for a / h = `contact_over_thickness`. This is how much
+/// stiffer a thin gel is than the half-space formula thinks, at the contact size in play.
+///
+/// The Hankel transform of p0 sqrt(1 - r^2/a^2) is p0 a^2 j1(ka) / (ka), whose integral over
+/// k is p0 a pi / 4, so the ratio is 1 - (4 / pi) int_0^inf j1(x)/x (1 - K(x h/a)) dx; 1 - K
+/// decays like e^(-2kh), so the integral stops at kh = 40.
+pub fn hertz_centre_compliance_ratio(contact_over_thickness: f64, nu: f64) -> f64 {
+    let aoh = contact_over_thickness;
+    if aoh.is_nan() || aoh <= 0.0 {
+        return 1.0;
+    }
+    let j1_over_x = |x: f64| {
+        if x < 1e-3 {
+            1.0 / 3.0 - x * x / 30.0
+        } else {
+            (x.sin() / (x * x) - x.cos() / x) / x
+        }
+    };
+    let f = |x: f64| j1_over_x(x) * (1.0 - normal_compliance_ratio(x / aoh, nu));
+    let end = 40.0 * aoh;
+    // Simpson's rule at about 40 nodes per period of j1 and per unit of kh.
+    let n = ((end / 0.15).ceil() as usize).clamp(400, 200_000) & !1;
+    let dx = end / n as f64;
+    let mut sum = f(0.0) + f(end);
+    for i in 1..n {
+        sum += if i % 2 == 1 { 4.0 } else { 2.0 } * f(i as f64 * dx);
+    }
+    1.0 - 4.0 / std::f64::consts::PI * sum * dx / 3.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thick_layer_tends_to_the_half_space() {
+        for nu in [0.0, 0.3, 0.49] {
+            let half_space = -(1.0 - 2.0 * nu) / (2.0 * (1.0 - nu));
+            assert!(
+                (lateral_ratio(60.0, nu) - half_space).abs() < 1e-9,
+                "nu {nu}"
+            );
+            assert!((normal_compliance_ratio(60.0, nu) - 1.0).abs() < 1e-9);
+            assert!(
+                lateral_ratio(1e6, nu).is_finite() && normal_compliance_ratio(1e6, nu).is_finite()
+            );
+        }
+    }
+
+    #[test]
+    fn matches_the_symbolic_solution_at_sample_points() {
+        // Values from the sympy solution of the layer problem (see module docs).
+        let cases = [
+            (0.3, 0.5, 0.06979279783946649, 0.20664248636698512),
+            (0.49, 1.0, 1.0747896366951155, 0.25482692515035976),
+            (0.49, 2.0, 0.2996801461380801, 0.6511919568440806),
+        ];
+        for (nu, kh, t, k) in cases {
+            assert!((lateral_ratio(kh, nu) - t).abs() < 1e-9, "T({kh}, {nu})");
+            assert!(
+                (normal_compliance_ratio(kh, nu) - k).abs() < 1e-9,
+                "K({kh}, {nu})"
+            );
+        }
+    }
+
+    #[test]
+    fn hertz_centre_compliance_matches_scipy_quadrature() {
+        // scipy.integrate.quad of 1 - (4/pi) int j1(x)/x (1 - K(x h/a)) dx (see the docs).
+        let cases = [
+            (0.49, 0.25, 0.8180783614733576),
+            (0.49, 1.0, 0.3878658882784619),
+            (0.49, 3.0, 0.06734959252061612),
+            (0.3, 1.0, 0.5015370284261629),
+            (0.45, 0.5, 0.6717513466004917),
+        ];
+        for (nu, aoh, want) in cases {
+            let got = hertz_centre_compliance_ratio(aoh, nu);
+            assert!(
+                (got - want).abs() < 1e-6,
+                "a/h {aoh}, nu {nu}: {got} vs {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_small_contact_on_a_thick_layer_sees_the_half_space() {
+        assert!((hertz_centre_compliance_ratio(1e-3, 0.49) - 1.0).abs() < 2e-3);
+        assert_eq!(hertz_centre_compliance_ratio(0.0, 0.49), 1.0);
+        let mut last = 1.0;
+        for aoh in [0.1, 0.3, 1.0, 3.0, 10.0] {
+            let r = hertz_centre_compliance_ratio(aoh, 0.49);
+            assert!(
+                r > 0.0 && r < last,
+                "stiffer as the contact outgrows the layer"
+            );
+            last = r;
+        }
+    }
+}
