@@ -27,8 +27,10 @@ use tactex_core::stats::{
 };
 use tactex_sim::elastic::{ContactSolver, Fidelity};
 use tactex_sim::gel_render::CpuRenderer;
-use tactex_sim::press_protocol::{PressError, PressProtocol};
-use tactex_sim::tactile_sample::{MAX_DRAWS, SampleDraw, SensorDraw, ShapeDraw, ShapeFamily};
+use tactex_sim::press_protocol::PressProtocol;
+use tactex_sim::tactile_sample::{
+    SampleDraw, SensorDraw, ShapeDraw, ShapeFamily, press_with_redraws,
+};
 
 /// The paper's Table III fruits.
 const TABLE_III: [&str; 5] = ["mango", "lime", "tomato", "banana", "avocado"];
@@ -181,12 +183,11 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         .map_init(ContactSolver::new, |solver, job| -> Result<Option<f64>> {
             let spec = &fruits[job.fruit];
             let stage = &spec.stages[job.stage];
-            let mut last_error = None;
-            for attempt in 0..MAX_DRAWS {
+            let (draw, press) = press_with_redraws(solver, &catalog, &protocol, |attempt| {
                 let mut rng = press_rng(args.seed, job.fruit, job.stage, job.press, attempt);
                 let spot: f64 = StandardNormal.sample(&mut rng);
                 let modulus_mpa = stage.modulus_mpa * (args.spot_spread * spot).exp();
-                let draw = SampleDraw {
+                SampleDraw {
                     index: job.press as u64,
                     attempt,
                     family: ShapeFamily::Fruit,
@@ -204,27 +205,15 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
                     sensor: SensorDraw::nominal(),
                     phase_mm: rng.random_range(0.0..protocol.step_mm),
                     noise_seed: rng.random(),
-                };
-                match draw.plan_press(solver, &catalog, &protocol) {
-                    Ok(press) => {
-                        let sequence =
-                            press.sequence(press.render(&mut CpuRenderer, &draw.optics())?);
-                        bar.inc(1);
-                        return Ok(estimator
-                            .estimate(&sequence, &draw.spec())
-                            .ok()
-                            .map(|h| h.hardness.shore_a()));
-                    }
-                    Err(e @ PressError::NoContact { .. }) => last_error = Some(e),
-                    Err(e) => {
-                        return Err(e).with_context(|| {
-                            format!("{} {} press {}", spec.name, stage.name, job.press)
-                        });
-                    }
                 }
-            }
-            Err(last_error.expect("at least one draw"))
-                .with_context(|| format!("{} {} press {}", spec.name, stage.name, job.press))
+            })
+            .with_context(|| format!("{} {} press {}", spec.name, stage.name, job.press))?;
+            let sequence = press.sequence(press.render(&mut CpuRenderer, &draw.optics())?);
+            bar.inc(1);
+            Ok(estimator
+                .estimate(&sequence, &draw.spec())
+                .ok()
+                .map(|h| h.hardness.shore_a()))
         })
         .collect::<Result<_>>()?;
     bar.finish_and_clear();

@@ -2,6 +2,7 @@
 //! on any machine).
 
 use anyhow::{Context, Result, anyhow};
+use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 use std::path::Path;
@@ -17,6 +18,43 @@ fn register() {
             eprintln!("warning: embedded font rejected; plot text may be missing");
         }
     });
+}
+
+/// Draws a chart of `size` pixels on white and writes it to `path` whole: into a partial
+/// file beside it, renamed over it once drawn, and removed if drawing fails.
+fn write_png(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<()>,
+) -> Result<()> {
+    register();
+    let tmp = path.with_extension("partial.png");
+    let drawn = (|| {
+        let root = BitMapBackend::new(&tmp, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        draw(&root)?;
+        root.present().map_err(|e| anyhow!("{e}"))
+    })();
+    if let Err(e) = drawn {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e.context(format!("{}: cannot draw", path.display())));
+    }
+    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// The series legend, boxed on white, where the chart has room for it.
+fn legend<'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, CT>,
+    position: SeriesLabelPosition,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 16))
+        .draw()
+        .map_err(|e| anyhow!("{e}"))
 }
 
 /// One point of a Pareto plot.
@@ -44,7 +82,6 @@ pub fn pareto(
     y_label: &str,
     points: &[ParetoPoint],
 ) -> Result<()> {
-    register();
     let positive = |v: f64| v.is_finite() && v > 0.0;
     let xs: Vec<f64> = points
         .iter()
@@ -65,11 +102,8 @@ pub fn pareto(
     // Errors of exactly zero (the reference itself) sit on the floor of the axis.
     let y_range = range(&ys);
     let floor = y_range.start;
-    let tmp = path.with_extension("partial.png");
-    {
-        let root = BitMapBackend::new(&tmp, (1000, 700)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
-        let mut chart = ChartBuilder::on(&root)
+    write_png(path, (1000, 700), |root| {
+        let mut chart = ChartBuilder::on(root)
             .caption(title, ("sans-serif", 26))
             .margin(20)
             .x_label_area_size(50)
@@ -103,16 +137,9 @@ pub fn pareto(
                 .label(*name)
                 .legend(move |(x, y)| Circle::new((x, y), 6, colour.filled()));
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 16))
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
-        root.present().map_err(|e| anyhow!("{e}"))?;
-    }
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+        legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
+        Ok(())
+    })
 }
 
 /// One estimator's (true, predicted) pairs.
@@ -131,12 +158,8 @@ pub fn predicted_vs_true(
     range: [f64; 2],
     series: &[ScatterSeries],
 ) -> Result<()> {
-    register();
-    let tmp = path.with_extension("partial.png");
-    {
-        let root = BitMapBackend::new(&tmp, (900, 800)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
-        let mut chart = ChartBuilder::on(&root)
+    write_png(path, (900, 800), |root| {
+        let mut chart = ChartBuilder::on(root)
             .caption(title, ("sans-serif", 24))
             .margin(20)
             .x_label_area_size(50)
@@ -171,17 +194,9 @@ pub fn predicted_vs_true(
                 .label(s.name.clone())
                 .legend(move |(x, y)| Circle::new((x, y), 5, colour.filled()));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 16))
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
-        root.present().map_err(|e| anyhow!("{e}"))?;
-    }
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+        Ok(())
+    })
 }
 
 /// One labelled group of values (a fruit's ripeness stage).
@@ -196,7 +211,6 @@ pub struct StageGroup {
 /// the median (and the true value as a black bar): the spread behind a table of medians and
 /// IQRs.
 pub fn stage_groups(path: &Path, title: &str, y_label: &str, groups: &[StageGroup]) -> Result<()> {
-    register();
     anyhow::ensure!(!groups.is_empty(), "nothing to plot");
     let all: Vec<f64> = groups
         .iter()
@@ -206,12 +220,9 @@ pub fn stage_groups(path: &Path, title: &str, y_label: &str, groups: &[StageGrou
     let hi = all.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let pad = ((hi - lo) * 0.08).max(1.0);
     let n = groups.len();
-    let tmp = path.with_extension("partial.png");
-    {
-        let width = (200 + 110 * n as u32).max(900);
-        let root = BitMapBackend::new(&tmp, (width, 650)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
-        let mut chart = ChartBuilder::on(&root)
+    let width = (200 + 110 * n as u32).max(900);
+    write_png(path, (width, 650), |root| {
+        let mut chart = ChartBuilder::on(root)
             .caption(title, ("sans-serif", 22))
             .margin(20)
             .x_label_area_size(50)
@@ -270,7 +281,6 @@ pub fn stage_groups(path: &Path, title: &str, y_label: &str, groups: &[StageGrou
                 }))
                 .map_err(|e| anyhow!("{e}"))?;
         }
-        root.present().map_err(|e| anyhow!("{e}"))?;
-    }
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+        Ok(())
+    })
 }

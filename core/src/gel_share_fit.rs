@@ -17,16 +17,19 @@ pub struct ShareFit {
     pub compliance_ratio_interval: [f64; 2],
     /// Total approach at the first contact frame (mm).
     pub first_contact_approach_mm: f64,
-    /// The gel's share of the approach at each frame.
-    pub shares: Vec<f64>,
     /// RMS of the indentation residual (mm).
     pub residual_rms_mm: f64,
+}
+
+/// The gel's share of the approach at layer factor `layer` and compliance ratio `rho`.
+pub fn gel_share(layer: f64, rho: f64) -> f64 {
+    layer / (layer + rho)
 }
 
 /// Residual sum of squares of indentation = s_k (a0 + travel_k) at ratio `rho`, with the
 /// first-contact approach a0 >= 0 solved in closed form.
 fn residual(rho: f64, indentation: &[f64], travel: &[f64], layer: &[f64]) -> (f64, f64) {
-    let share = |k: usize| layer[k] / (layer[k] + rho);
+    let share = |k: usize| gel_share(layer[k], rho);
     let (mut num, mut den) = (0.0, 0.0);
     for k in 0..indentation.len() {
         let s = share(k);
@@ -94,7 +97,6 @@ pub fn fit_gel_share(indentation_mm: &[f64], travel_mm: &[f64], layer: &[f64]) -
         compliance_ratio: rho,
         compliance_ratio_interval: [(ln_rho - se).exp(), (ln_rho + se).exp()],
         first_contact_approach_mm: a0,
-        shares: layer.iter().map(|p| p / (p + rho)).collect(),
         residual_rms_mm: (best_rss / n as f64).sqrt(),
     })
 }

@@ -11,7 +11,7 @@
 use crate::estimate::{
     EstimateError, Evidence, HardnessEstimate, HardnessEstimator, PressSequence,
 };
-use crate::gel_share_fit::{ShareFit, fit_gel_share};
+use crate::gel_share_fit::{fit_gel_share, gel_share};
 use crate::hardness::Hardness;
 use crate::hertz::Elastic;
 use crate::layer_compliance::hertz_centre_compliance_ratio;
@@ -124,7 +124,7 @@ impl HardnessEstimator for IndentationEstimator {
         };
         let [rho_lo, rho_hi] = fit.compliance_ratio_interval;
         let last = *used.last().expect("at least two frames used");
-        let last_share = *fit.shares.last().expect("one share per frame used");
+        let share_at = |rho: f64| gel_share(layer[last], rho);
         let last_approach = fit.first_contact_approach_mm + press.travel_mm[last];
         let contact_radius = contact_radii[last];
         Ok(HardnessEstimate {
@@ -132,8 +132,9 @@ impl HardnessEstimator for IndentationEstimator {
             // A softer object has the larger compliance ratio.
             modulus_interval_mpa: [to_modulus(rho_hi), to_modulus(rho_lo)],
             evidence: Evidence {
-                gel_share: last_share,
-                gel_share_se: share_se(&fit),
+                gel_share: share_at(fit.compliance_ratio),
+                // Carried over from the ratio's interval.
+                gel_share_se: 0.5 * (share_at(rho_lo) - share_at(rho_hi)),
                 local_radius_mm: contact_radius * contact_radius / last_approach.max(1e-9),
                 first_contact_approach_mm: fit.first_contact_approach_mm,
                 last_contact_radius_mm: contact_radius,
@@ -146,13 +147,4 @@ impl HardnessEstimator for IndentationEstimator {
             },
         })
     }
-}
-
-/// Standard error of the last frame's share, carried over from the ratio's interval.
-fn share_se(fit: &ShareFit) -> f64 {
-    let last = *fit.shares.last().expect("one share per frame used");
-    let layer = last * fit.compliance_ratio / (1.0 - last).max(1e-12);
-    let share = |rho: f64| layer / (layer + rho);
-    let [lo, hi] = fit.compliance_ratio_interval;
-    0.5 * (share(lo) - share(hi)).abs()
 }

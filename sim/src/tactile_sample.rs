@@ -198,6 +198,26 @@ fn log_uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
 /// contact (a very soft object touched off-centre) is redrawn.
 pub const MAX_DRAWS: u32 = 8;
 
+/// Plans the press of `draw(0)`, and of `draw(1)`, `draw(2)`, ... while a press finds no
+/// contact, up to `MAX_DRAWS` draws.
+pub fn press_with_redraws(
+    solver: &mut ContactSolver,
+    catalog: &FruitCatalog,
+    protocol: &PressProtocol,
+    draw: impl Fn(u32) -> SampleDraw,
+) -> Result<(SampleDraw, PlannedPress), PressError> {
+    let mut last = None;
+    for attempt in 0..MAX_DRAWS {
+        let sample = draw(attempt);
+        match sample.plan_press(solver, catalog, protocol) {
+            Ok(press) => return Ok((sample, press)),
+            Err(e @ PressError::NoContact { .. }) => last = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last.expect("at least one draw"))
+}
+
 impl SampleSpace {
     /// Draws sample `index` and plans its press at `step_mm`, redrawing (attempt 1, 2, ...)
     /// when the press finds no contact.
@@ -212,16 +232,9 @@ impl SampleSpace {
             step_mm: self.step_mm,
             ..PressProtocol::default()
         };
-        let mut last = None;
-        for attempt in 0..MAX_DRAWS {
-            let draw = self.draw(catalog, seed, index, attempt);
-            match draw.plan_press(solver, catalog, &protocol) {
-                Ok(press) => return Ok((draw, press)),
-                Err(e @ PressError::NoContact { .. }) => last = Some(e),
-                Err(e) => return Err(e),
-            }
-        }
-        Err(last.expect("at least one draw"))
+        press_with_redraws(solver, catalog, &protocol, |attempt| {
+            self.draw(catalog, seed, index, attempt)
+        })
     }
 
     pub fn draw(&self, catalog: &FruitCatalog, seed: u64, index: u64, attempt: u32) -> SampleDraw {

@@ -1,0 +1,160 @@
+//! `tactex eval hardness` and `eval ripeness` end to end on small runs: their JSON
+//! contracts, plots and raw records, tests that recompute from the raw predictions, and bad
+//! input named.
+
+use std::process::Command;
+
+fn tactex(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args(args)
+        .output()
+        .expect("tactex runs")
+}
+
+/// Each bad argument of `eval <command>` fails with a one-line error naming it.
+fn bad_arguments_are_named(command: &str, cases: &[(&[&str], &str)]) {
+    for (args, needle) in cases {
+        let mut all = vec!["eval", command];
+        all.extend(args.iter());
+        let o = tactex(&all);
+        assert!(!o.status.success(), "{all:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(needle), "{err}");
+        assert_eq!(err.trim().lines().count(), 1, "one line: {err}");
+    }
+}
+
+#[test]
+fn scores_each_estimator_and_draws_predicted_against_true() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("eval");
+    let o = tactex(&[
+        "eval",
+        "hardness",
+        "--count",
+        "4",
+        "--shapes",
+        "sphere",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
+    let estimators = report["estimators"].as_array().unwrap();
+    let names: Vec<&str> = estimators
+        .iter()
+        .map(|e| e["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["hertz_slopes", "indentation"]);
+    for e in estimators {
+        assert_eq!(
+            e["n"].as_u64().unwrap() + e["failures"].as_u64().unwrap(),
+            4
+        );
+        for field in ["rmse", "r2", "spearman"] {
+            assert!(e[field].as_f64().unwrap().is_finite(), "{field}");
+        }
+    }
+    let png = image::open(out.join("hardness.png")).expect("a PNG plot");
+    assert!(png.width() > 400 && png.height() > 400);
+    let lines = std::fs::read_to_string(out.join("predictions.jsonl")).unwrap();
+    assert_eq!(lines.lines().count(), 4);
+    let first: serde_json::Value = serde_json::from_str(lines.lines().next().unwrap()).unwrap();
+    assert!(first["true_shore_a"].as_f64().unwrap() >= 5.0);
+    assert!(
+        first["predictions"][1]["evidence"]["gel_layer_factor"]
+            .as_f64()
+            .unwrap()
+            < 1.0
+    );
+}
+
+#[test]
+fn stages_are_told_apart_and_each_test_recomputes_from_the_predictions() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = tactex(&[
+        "eval",
+        "ripeness",
+        "--fruits",
+        "lime",
+        "--presses",
+        "4",
+        "--json",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
+    assert_eq!(r["estimator"], "indentation");
+    let lime = &r["fruits"][0];
+    assert_eq!(lime["fruit"], "lime");
+    let stages = lime["stages"].as_array().unwrap();
+    assert_eq!(stages.len(), 2);
+    let values = |k: usize| -> Vec<f64> {
+        stages[k]["predictions"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (unripe, ripe) = (values(0), values(1));
+    assert_eq!(unripe.len() + ripe.len(), 8);
+    for s in stages {
+        let (q25, med, q75) = (
+            s["q25"].as_f64().unwrap(),
+            s["median"].as_f64().unwrap(),
+            s["q75"].as_f64().unwrap(),
+        );
+        assert!(q25 <= med && med <= q75);
+    }
+    // U of the harder stage: pairs where it reads harder, ties counting a half.
+    let u: f64 = unripe
+        .iter()
+        .flat_map(|a| ripe.iter().map(move |b| (a, b)))
+        .map(|(a, b)| match a.total_cmp(b) {
+            std::cmp::Ordering::Greater => 1.0,
+            std::cmp::Ordering::Equal => 0.5,
+            std::cmp::Ordering::Less => 0.0,
+        })
+        .sum();
+    let test = &lime["tests"][0];
+    assert_eq!(test["harder"], "unripe");
+    assert_eq!(test["softer"], "ripe");
+    assert_eq!(test["u"].as_f64().unwrap(), u);
+    // Unripe lime (4 MPa) reads harder than ripe (1.5 MPa) in every press: the exact
+    // one-sided p of complete separation of 4 and 4 is 1 / C(8, 4).
+    assert_eq!(u, 16.0);
+    assert!((test["p"].as_f64().unwrap() - 1.0 / 70.0).abs() < 1e-12);
+    assert!(dir.path().join("ripeness.png").is_file());
+    assert!(dir.path().join("ripeness.json").is_file());
+}
+
+#[test]
+fn bad_hardness_arguments_are_named() {
+    bad_arguments_are_named(
+        "hardness",
+        &[
+            (&["--count", "2"], "--count"),
+            (&["--shapes", "cube"], "--shapes"),
+            (&["--fidelity", "exact"], "--fidelity"),
+        ],
+    );
+}
+
+#[test]
+fn bad_ripeness_arguments_are_named() {
+    bad_arguments_are_named(
+        "ripeness",
+        &[
+            (&["--fruits", "durian"], "--fruits"),
+            (&["--presses", "1"], "--presses"),
+            (&["--spot-spread", "-1"], "--spot-spread"),
+        ],
+    );
+    // clap's own refusal of an unknown value names the option too, over several lines.
+    let o = tactex(&["eval", "ripeness", "--estimator", "guess"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--estimator"));
+}
