@@ -63,3 +63,39 @@ fn indentation_split_on_the_bonded_gel_recovers_sphere_moduli() {
 fn hertz_slope_fit_recovers_the_half_space_twin() {
     reads_back_sphere_moduli(&HertzSlopeEstimator::default(), Fidelity::Hertz, 0.1);
 }
+
+#[test]
+fn a_press_does_not_depend_on_what_the_solver_pressed_before() {
+    // Parallel data generation reuses one solver per thread in whatever order the scheduler
+    // picks, so its caches must not change a press's numbers.
+    let spec = TactileSpec::gelsight_mini();
+    let optics = SensorOptics::for_spec(&spec);
+    let press = |solver: &mut ContactSolver, radius_mm: f64| {
+        let surface = ObjectSurface::Sphere {
+            radius_mm,
+            centre_mm: DVec2::new(0.3, 0.2),
+        };
+        let setup = PressSetup {
+            surface: &surface,
+            object: Elastic {
+                modulus_mpa: Some(0.5),
+                poisson: 0.4,
+            },
+            gel: spec.gel,
+            fidelity: Fidelity::Layer,
+            optics: &optics,
+            phase_mm: 0.1,
+            cell_mm: None,
+            seed: 3,
+        };
+        plan_press(solver, &setup, &PressProtocol::default()).expect("contact")
+    };
+    let fresh = press(&mut ContactSolver::new(), 8.0);
+    let mut used = ContactSolver::new();
+    press(&mut used, 200.0); // a wide contact first: larger grids and layer tables
+    let after = press(&mut used, 8.0);
+    for (a, b) in fresh.frames.iter().zip(&after.frames) {
+        assert_eq!(a.fields.normal_mm, b.fields.normal_mm);
+        assert_eq!(a.force_n, b.force_n);
+    }
+}

@@ -134,10 +134,6 @@ impl LayerCorrection {
         }
     }
 
-    pub fn r_max_mm(&self) -> f64 {
-        self.dr * (self.normal.len() - 1) as f64
-    }
-
     fn lookup(table: &[f64], dr: f64, r: f64) -> f64 {
         let x = r / dr;
         let i = (x.floor() as usize).min(table.len() - 2);

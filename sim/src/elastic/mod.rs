@@ -172,7 +172,8 @@ pub struct ContactSolution {
 pub struct ContactSolver {
     pub settings: polonsky_keer::Settings,
     kernels: HashMap<KernelKey, GridKernels>,
-    layers: Vec<LayerCorrection>,
+    /// Layer tables keyed by (thickness, Poisson's ratio, extent).
+    layers: Vec<((f64, f64, f64), LayerCorrection)>,
 }
 
 fn finite_in(field: &str, v: f64, lo: f64, hi: f64) -> Result<(), ContactError> {
@@ -281,17 +282,23 @@ impl ContactSolver {
         Self::default()
     }
 
+    /// The layer table reaching `r_max_mm`. Its extent is rounded up to a power of two
+    /// (at least 4 mm) and tables are looked up by that extent exactly, because the table's
+    /// sampling depends on its extent: a table grown for an earlier, larger press must not
+    /// serve a later one, or a press would depend on what the solver solved before it (and
+    /// parallel data generation on thread scheduling).
     fn layer_table(&mut self, thickness_mm: f64, poisson: f64, r_max_mm: f64) -> usize {
-        if let Some(k) = self.layers.iter().position(|l| {
-            l.thickness_mm == thickness_mm && l.poisson == poisson && l.r_max_mm() >= r_max_mm
-        }) {
+        let extent_mm = r_max_mm.max(4.0).log2().ceil().exp2();
+        let key = (thickness_mm, poisson, extent_mm);
+        if let Some(k) = self.layers.iter().position(|(k, _)| *k == key) {
             return k;
         }
+        // Tables are small (a few hundred samples); bound the cache for long randomised runs.
+        if self.layers.len() >= 64 {
+            self.layers.clear();
+        }
         self.layers
-            .retain(|l| l.thickness_mm != thickness_mm || l.poisson != poisson);
-        // Grow with headroom so that slightly larger grids reuse the table.
-        self.layers
-            .push(LayerCorrection::new(thickness_mm, poisson, r_max_mm * 1.5));
+            .push((key, LayerCorrection::new(thickness_mm, poisson, extent_mm)));
         self.layers.len() - 1
     }
 
@@ -303,7 +310,7 @@ impl ContactSolver {
                 let diagonal = grid.cell_mm * (grid.nx as f64).hypot(grid.ny as f64) + grid.cell_mm;
                 self.layer_table(gel.thickness_mm, gel.poisson, diagonal)
             });
-            let built = GridKernels::new(grid, gel.poisson, table.map(|k| &self.layers[k]));
+            let built = GridKernels::new(grid, gel.poisson, table.map(|k| &self.layers[k].1));
             // Keep the cache bounded: a press sequence needs one or two grids.
             if self.kernels.len() >= 8 {
                 self.kernels.clear();
