@@ -39,6 +39,12 @@ pub struct HardnessEvalArgs {
     /// Write hardness.png (predicted against true), predictions.jsonl and scores.json here.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Also score this trained model (NAME.onnx with its card NAME.json beside it); repeatable.
+    #[arg(long)]
+    model: Vec<PathBuf>,
+    /// Leave out the built-in trained model (models/hardness-small.onnx).
+    #[arg(long)]
+    no_builtin_model: bool,
 }
 
 /// Held-out hardness range: Shore A 5 to 90, where the Shore A scale resolves the objects
@@ -95,10 +101,16 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
     let mut space = crate::datagen_tactile::sample_space(&args.fidelity, &args.shapes)?;
     space.modulus_mpa = SHORE_A_RANGE.map(|s| shore_a_to_modulus_mpa(s).expect("below 100"));
     let catalog = FruitCatalog::builtin();
-    let estimators: Vec<Box<dyn HardnessEstimator + Sync>> = vec![
+    let mut estimators: Vec<Box<dyn HardnessEstimator + Sync>> = vec![
         Box::new(HertzSlopeEstimator::default()),
         Box::new(IndentationEstimator::default()),
     ];
+    if !args.no_builtin_model {
+        estimators.push(Box::new(crate::learned_model::builtin_small()?));
+    }
+    for path in &args.model {
+        estimators.push(Box::new(crate::learned_model::from_file("--model", path)?));
+    }
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--out {}: cannot create", dir.display()))?;
@@ -160,8 +172,12 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
         let (truth, pred): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
         let name = e.name().to_string();
         if pairs.len() < 3 {
+            let first_error = records
+                .iter()
+                .find_map(|r| r.predictions[k].error.as_deref())
+                .unwrap_or("none");
             bail!(
-                "estimator {name}: only {} of {} presses estimated",
+                "estimator {name}: only {} of {} presses estimated (first error: {first_error})",
                 pairs.len(),
                 records.len()
             );

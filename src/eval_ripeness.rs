@@ -41,6 +41,8 @@ pub enum EstimatorChoice {
     Indentation,
     /// Hertz half-space fit of the slope field.
     HertzSlopes,
+    /// The built-in trained CNN (models/hardness-small.onnx).
+    Learned,
 }
 
 #[derive(Args, Debug)]
@@ -158,6 +160,7 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
     let estimator: Box<dyn HardnessEstimator + Sync> = match args.estimator {
         EstimatorChoice::Indentation => Box::new(IndentationEstimator::default()),
         EstimatorChoice::HertzSlopes => Box::new(HertzSlopeEstimator::default()),
+        EstimatorChoice::Learned => Box::new(crate::learned_model::builtin_small()?),
     };
     let protocol = PressProtocol::default();
     let jobs: Vec<Job> = fruits

@@ -10,6 +10,7 @@ mod compare;
 mod datagen_tactile;
 mod eval_hardness;
 mod eval_ripeness;
+mod learned_model;
 mod markers;
 mod npz;
 mod output;

@@ -46,7 +46,7 @@ fn scores_each_estimator_and_draws_predicted_against_true() {
         .iter()
         .map(|e| e["name"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["hertz_slopes", "indentation"]);
+    assert_eq!(names, ["hertz_slopes", "indentation", "onnx_small"]);
     for e in estimators {
         assert_eq!(
             e["n"].as_u64().unwrap() + e["failures"].as_u64().unwrap(),
@@ -68,6 +68,71 @@ fn scores_each_estimator_and_draws_predicted_against_true() {
             .unwrap()
             < 1.0
     );
+    let learned = &first["predictions"][2]["evidence"];
+    assert_eq!(learned["kind"], "learned");
+    assert_eq!(learned["backend"], "tract");
+}
+
+/// The library of PyPI's onnxruntime wheel, which CI installs; elsewhere the test is skipped.
+fn onnxruntime_library() -> Option<String> {
+    match std::env::var("TACTEX_TEST_ORT_DYLIB") {
+        Ok(p) if !p.is_empty() => Some(p),
+        _ if std::env::var("CI").is_ok_and(|v| v == "true") => {
+            panic!("CI must set TACTEX_TEST_ORT_DYLIB to libonnxruntime.so (see .ci/run)")
+        }
+        _ => None,
+    }
+}
+
+#[test]
+fn the_trained_model_answers_alike_on_tract_and_onnx_runtime() {
+    let Some(library) = onnxruntime_library() else {
+        eprintln!("skipped: TACTEX_TEST_ORT_DYLIB is not set");
+        return;
+    };
+    let args = [
+        "eval", "hardness", "--count", "3", "--shapes", "sphere", "--json",
+    ];
+    let runs: Vec<Vec<serde_json::Value>> = [None, Some(library.as_str())]
+        .iter()
+        .map(|lib| {
+            let mut cmd = Command::new(env!("CARGO_BIN_EXE_tactex"));
+            cmd.args(args).env_remove("ORT_DYLIB_PATH");
+            let dir = tempfile::tempdir().unwrap();
+            cmd.args(["--out", dir.path().to_str().unwrap()]);
+            if let Some(lib) = lib {
+                cmd.env("ORT_DYLIB_PATH", lib);
+            }
+            let o = cmd.output().unwrap();
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            let lines = std::fs::read_to_string(dir.path().join("predictions.jsonl")).unwrap();
+            lines
+                .lines()
+                .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+                .collect()
+        })
+        .collect();
+    let (tract, ort) = (&runs[0], &runs[1]);
+    assert_eq!(tract.len(), 3);
+    for (a, b) in tract.iter().zip(ort) {
+        let (pa, pb) = (&a["predictions"][2], &b["predictions"][2]);
+        assert_eq!(pa["evidence"]["backend"], "tract");
+        assert!(
+            pb["evidence"]["backend"]
+                .as_str()
+                .unwrap()
+                .starts_with("onnxruntime 1."),
+            "{pb}"
+        );
+        let (sa, sb) = (
+            pa["shore_a"].as_f64().unwrap(),
+            pb["shore_a"].as_f64().unwrap(),
+        );
+        assert!(
+            (sa - sb).abs() < 0.05,
+            "Shore A {sa} (tract) vs {sb} (onnxruntime)"
+        );
+    }
 }
 
 #[test]

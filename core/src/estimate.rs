@@ -32,7 +32,29 @@ pub struct PressSequence {
 
 /// The evidence an estimate rests on, so that explanations can cite it.
 #[derive(Clone, Debug, Serialize, PartialEq)]
-pub struct Evidence {
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Evidence {
+    /// A physics inversion: how the travel split between gel and object.
+    Physics(PhysicsEvidence),
+    /// A learned model: which model read which frames, and how far its answers spread.
+    Learned(LearnedEvidence),
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct LearnedEvidence {
+    /// The model file and the runtime that ran it (tract or ONNX Runtime).
+    pub model: String,
+    pub backend: String,
+    /// Press frames read (0-based from the first contact frame).
+    pub frames_used: Vec<usize>,
+    /// Standard deviation of ln(E) over the flipped copies of the input.
+    pub flip_spread_ln: f64,
+    /// The model's RMSE in ln(E) on held-out shapes, from its model card.
+    pub heldout_rmse_ln: f64,
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PhysicsEvidence {
     /// Share of the approach taken by the gel, and its standard error.
     pub gel_share: f64,
     pub gel_share_se: f64,
@@ -69,6 +91,8 @@ pub enum EstimateError {
     BadSequence(String),
     #[error("press sequence: no contact imprint in the frames")]
     NoImprint,
+    #[error("hardness model {0}")]
+    Model(String),
 }
 
 pub trait HardnessEstimator {
@@ -266,7 +290,7 @@ impl HardnessEstimator for HertzSlopeEstimator {
         Ok(HardnessEstimate {
             hardness,
             modulus_interval_mpa: [to_modulus(share - share_se), to_modulus(share + share_se)],
-            evidence: Evidence {
+            evidence: Evidence::Physics(PhysicsEvidence {
                 gel_share: share,
                 gel_share_se: share_se,
                 local_radius_mm: radius,
@@ -278,7 +302,7 @@ impl HardnessEstimator for HertzSlopeEstimator {
                 fit_residual_rms: (rss.max(0.0) / samples.len() as f64).sqrt(),
                 fit_residual_unit: "slope",
                 object_poisson: self.object_poisson,
-            },
+            }),
         })
     }
 }

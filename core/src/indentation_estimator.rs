@@ -9,7 +9,7 @@
 //! modulus.
 
 use crate::estimate::{
-    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, PressSequence,
+    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, PhysicsEvidence, PressSequence,
 };
 use crate::gel_share_fit::{fit_gel_share, gel_share};
 use crate::hardness::Hardness;
@@ -131,7 +131,7 @@ impl HardnessEstimator for IndentationEstimator {
             hardness,
             // A softer object has the larger compliance ratio.
             modulus_interval_mpa: [to_modulus(rho_hi), to_modulus(rho_lo)],
-            evidence: Evidence {
+            evidence: Evidence::Physics(PhysicsEvidence {
                 gel_share: share_at(fit.compliance_ratio),
                 // Carried over from the ratio's interval.
                 gel_share_se: 0.5 * (share_at(rho_lo) - share_at(rho_hi)),
@@ -144,7 +144,7 @@ impl HardnessEstimator for IndentationEstimator {
                 fit_residual_rms: fit.residual_rms_mm,
                 fit_residual_unit: "mm",
                 object_poisson: self.object_poisson,
-            },
+            }),
         })
     }
 }

@@ -18,6 +18,8 @@ pub mod hardness;
 pub mod hertz;
 pub mod indentation_estimator;
 pub mod layer_compliance;
+pub mod onnx_estimator;
+pub mod onnx_runtime;
 pub mod perception;
 pub mod photometric;
 pub mod pipeline;

@@ -1,0 +1,259 @@
+"""Train, fine-tune and export a tactile hardness model (see models/README.md).
+
+    python train.py --model small --train DATA/train --heldout DATA/heldout --out runs/small
+    python train.py --model resnet50_lstm3 --init runs/r50-pretrain/model.pt --train REAL ...
+
+Writes to --out: model.pt (weights and recipe), model.onnx with model.json (what the Rust
+`OnnxEstimator` reads), metrics.json (held-out scores) and predictions.jsonl.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from scipy import stats
+from tqdm import tqdm
+
+import architectures as arch
+from shore import modulus_to_shore_a
+from tactile_data import FRAME_PICKS, PressDataset, augment
+
+FORMAT = "tactex-hardness-model/1"
+
+
+def parse_args():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--model", required=True, choices=arch.MODELS)
+    p.add_argument("--train", nargs="+", required=True, help="datagen directories to train on")
+    p.add_argument("--families", default=None, help="comma-separated shape families to train on")
+    p.add_argument("--heldout", nargs="*", default=[], help="datagen directories of unseen shapes to score")
+    p.add_argument("--out", required=True)
+    p.add_argument("--frames", type=int, default=2, choices=[2, 4], help="difference frames read")
+    p.add_argument("--epochs", type=int, default=30)
+    p.add_argument("--batch", type=int, default=8)
+    p.add_argument("--lr-early", type=float, default=5e-5, help="learning rate of the image encoder")
+    p.add_argument("--lr-late", type=float, default=1e-3, help="learning rate of the sequence model and head")
+    p.add_argument("--weight-decay", type=float, default=1e-4)
+    p.add_argument("--dropout", type=float, default=0.1)
+    p.add_argument(
+        "--collapse-weight",
+        type=float,
+        default=4.0 / 25.0**2,
+        help="weight of min(1/(Var(p)+1e-6), 1000); the paper's 4 on Shore values (sd ~25) is 4/25^2 on the standardised targets used here",
+    )
+    p.add_argument("--val-fraction", type=float, default=0.1)
+    p.add_argument("--limit", type=int, default=None, help="at most this many training samples")
+    p.add_argument("--init", default=None, help="model.pt to fine-tune from (pretrain, then fine-tune)")
+    p.add_argument("--imagenet", action="store_true", help="start the backbone from torchvision's ImageNet weights")
+    p.add_argument("--threads", type=int, default=os.cpu_count())
+    p.add_argument("--seed", type=int, default=0)
+    return p.parse_args()
+
+
+def collapse_penalty(pred, weight):
+    """The paper's anti-collapse term: large when the batch's predictions stop varying."""
+    if pred.numel() < 2:
+        return pred.new_zeros(())
+    return weight * torch.clamp(1.0 / (pred.var() + 1e-6), max=1000.0)
+
+
+def predict(model, dataset, batch=16):
+    model.eval()
+    out = []
+    with torch.no_grad():
+        for i in range(0, len(dataset), batch):
+            frames = torch.stack([dataset[j][0] for j in range(i, min(i + batch, len(dataset)))])
+            out.append(model(frames).reshape(-1))
+    return torch.cat(out).numpy().astype(np.float64)
+
+
+def scores(dataset, ln_pred):
+    ln_true = dataset.targets.numpy().astype(np.float64)
+    shore_true = np.array([r["shore_a"] for r in dataset.records])
+    shore_pred = np.array([modulus_to_shore_a(math.exp(v)) for v in ln_pred])
+    resid = shore_pred - shore_true
+    return {
+        "n": len(dataset),
+        "families": sorted({r["family"] for r in dataset.records}),
+        "ln_modulus_rmse": float(np.sqrt(np.mean((ln_pred - ln_true) ** 2))),
+        "ln_modulus_spearman": float(stats.spearmanr(ln_true, ln_pred).statistic),
+        "shore_a_rmse": float(np.sqrt(np.mean(resid**2))),
+        "shore_a_r2": float(1.0 - np.sum(resid**2) / np.sum((shore_true - shore_true.mean()) ** 2)),
+        "shore_a_spearman": float(stats.spearmanr(shore_true, shore_pred).statistic),
+    }
+
+
+def export_onnx(model, path, frames, height, width):
+    model.eval()
+    dummy = torch.full((1, frames + 1, height, width, 3), 128.0)
+    torch.onnx.export(
+        model,
+        (dummy,),
+        str(path),
+        input_names=["frames"],
+        output_names=["ln_modulus_mpa"],
+        dynamic_axes={"frames": {0: "batch"}, "ln_modulus_mpa": {0: "batch"}},
+        opset_version=17,
+        dynamo=False,
+    )
+    # The exported graph must compute what the PyTorch model does.
+    import onnxruntime
+
+    probe = torch.rand(3, frames + 1, height, width, 3) * 255.0
+    with torch.no_grad():
+        expected = model(probe).numpy()
+    got = onnxruntime.InferenceSession(str(path)).run(None, {"frames": probe.numpy()})[0]
+    err = float(np.max(np.abs(got - expected)))
+    if err > 1e-3:
+        raise SystemExit(f"{path}: ONNX output differs from PyTorch by {err}")
+    return err
+
+
+def write_atomic(path, text):
+    tmp = Path(str(path) + ".tmp")
+    tmp.write_text(text)
+    tmp.replace(path)
+
+
+def main():
+    args = parse_args()
+    torch.manual_seed(args.seed)
+    torch.set_num_threads(args.threads)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    families = set(args.families.split(",")) if args.families else None
+
+    with tqdm(desc="loading", unit=" presses") as bar:
+        data = PressDataset(args.train, args.frames, families, args.limit, bar)
+        heldout = [PressDataset([d], args.frames, None, None, bar) for d in args.heldout]
+    height, width = data.frames[0].shape[1:3]
+
+    gen = torch.Generator().manual_seed(args.seed)
+    order = torch.randperm(len(data), generator=gen).tolist()
+    n_val = max(1, int(round(args.val_fraction * len(data))))
+    val_idx, train_idx = order[:n_val], order[n_val:]
+    train_set = torch.utils.data.Subset(data, train_idx)
+    val_set = torch.utils.data.Subset(data, val_idx)
+    val_set.targets = data.targets[val_idx]
+    val_set.records = [data.records[i] for i in val_idx]
+
+    if args.init:
+        ckpt = torch.load(args.init, map_location="cpu", weights_only=False)
+        if ckpt["recipe"]["model"] != args.model or ckpt["recipe"]["frames"] != args.frames:
+            raise SystemExit(f"--init {args.init}: a {ckpt['recipe']['model']} on {ckpt['recipe']['frames']} frames, not {args.model} on {args.frames}")
+        mean, sd = ckpt["target_mean"], ckpt["target_sd"]
+    else:
+        t = data.targets[train_idx]
+        mean, sd = float(t.mean()), float(t.std())
+    model = arch.HardnessModel(arch.build(args.model, args.frames, args.dropout), mean, sd, height, width)
+    if args.init:
+        model.load_state_dict(ckpt["state"])
+    elif args.imagenet and args.model != "small":
+        arch.load_imagenet(model.regressor, args.model)
+
+    early = model.regressor.early_parameters()
+    early_ids = {id(p) for p in early}
+    late = [p for p in model.parameters() if id(p) not in early_ids]
+    opt = torch.optim.AdamW(
+        [{"params": early, "lr": args.lr_early}, {"params": late, "lr": args.lr_late}],
+        weight_decay=args.weight_decay,
+    )
+    loader = torch.utils.data.DataLoader(
+        train_set, batch_size=args.batch, shuffle=True, drop_last=True, generator=gen
+    )
+    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=max(1, args.epochs * len(loader)))
+    print(f"{args.model}: {arch.parameter_count(model):,} parameters, {len(train_idx)} train / {n_val} validation presses")
+
+    best, history = None, []
+    started = time.time()
+    for epoch in range(args.epochs):
+        model.train()
+        total, count = 0.0, 0
+        for frames, target in tqdm(loader, desc=f"epoch {epoch + 1}/{args.epochs}", leave=False):
+            frames = augment(frames, gen)
+            z = (target - mean) / sd
+            pred = model.standardised(frames).reshape(-1)
+            loss = F.mse_loss(pred, z) + collapse_penalty(pred, args.collapse_weight)
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+            sched.step()
+            total += loss.item() * len(target)
+            count += len(target)
+        val_pred = predict(model, val_set)
+        val_rmse = float(np.sqrt(np.mean((val_pred - val_set.targets.numpy()) ** 2)))
+        history.append({"epoch": epoch + 1, "train_loss": total / count, "val_ln_rmse": val_rmse})
+        print(f"epoch {epoch + 1}: train loss {total / count:.4f}, validation ln-modulus RMSE {val_rmse:.3f}", flush=True)
+        if best is None or val_rmse < best[0]:
+            best = (val_rmse, {k: v.clone() for k, v in model.state_dict().items()}, epoch + 1)
+    model.load_state_dict(best[1])
+    minutes = (time.time() - started) / 60.0
+
+    recipe = {
+        "height": int(height),
+        "width": int(width),
+        "model": args.model,
+        "frames": args.frames,
+        "frame_picks": FRAME_PICKS[args.frames],
+        "train": [str(d) for d in args.train],
+        "families": sorted({r["family"] for r in data.records}),
+        "train_presses": len(train_idx),
+        "validation_presses": n_val,
+        "epochs": args.epochs,
+        "best_epoch": best[2],
+        "batch": args.batch,
+        "lr_early": args.lr_early,
+        "lr_late": args.lr_late,
+        "weight_decay": args.weight_decay,
+        "dropout": args.dropout,
+        "collapse_weight": args.collapse_weight,
+        "schedule": "cosine",
+        "augment": "flips, per-channel gain +-10%, offset +-8/255",
+        "init": args.init,
+        "imagenet": args.imagenet,
+        "seed": args.seed,
+        "threads": args.threads,
+        "train_minutes": round(minutes, 1),
+        "parameters": arch.parameter_count(model),
+    }
+    torch.save({"state": model.state_dict(), "recipe": recipe, "target_mean": mean, "target_sd": sd, "history": history}, out / "model.pt")
+
+    metrics = {"validation": scores(val_set, predict(model, val_set)), "heldout": []}
+    lines = []
+    for d, ds in zip(args.heldout, heldout):
+        pred = predict(model, ds)
+        metrics["heldout"].append({"data": str(d), **scores(ds, pred)})
+        for r, p in zip(ds.records, pred):
+            lines.append(json.dumps({"data": str(d), "index": r["index"], "family": r["family"], "true_ln_modulus": math.log(r["modulus_mpa"]), "pred_ln_modulus": float(p), "true_shore_a": r["shore_a"], "pred_shore_a": modulus_to_shore_a(math.exp(p))}))
+    write_atomic(out / "predictions.jsonl", "".join(line + "\n" for line in lines))
+
+    export_err = export_onnx(model, out / "model.onnx", args.frames, height, width)
+    spec = {
+        "format": FORMAT,
+        "model": args.model,
+        "input": "frames",
+        "input_layout": "[batch, first contact frame then the picked frames, height, width, RGB], float 0..255",
+        "output": "ln_modulus_mpa",
+        "frame_picks": FRAME_PICKS[args.frames],
+        "height": int(height),
+        "width": int(width),
+        # Uncertainty floor for the Rust estimator: the held-out spread, else the validation one.
+        "ln_modulus_rmse": (metrics["heldout"][0] if metrics["heldout"] else metrics["validation"])["ln_modulus_rmse"],
+        "onnx_vs_torch_max_abs": export_err,
+        "recipe": recipe,
+        "metrics": metrics,
+    }
+    write_atomic(out / "model.json", json.dumps(spec, indent=2) + "\n")
+    write_atomic(out / "metrics.json", json.dumps(metrics, indent=2) + "\n")
+    print(json.dumps(metrics, indent=2))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
