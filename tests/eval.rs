@@ -204,6 +204,7 @@ fn bad_hardness_arguments_are_named() {
             (&["--count", "2"], "--count"),
             (&["--shapes", "cube"], "--shapes"),
             (&["--fidelity", "exact"], "--fidelity"),
+            (&["--model", "no-such-model.onnx"], "no-such-model.json"),
         ],
     );
 }

@@ -50,7 +50,7 @@ impl ModelCard {
             || self.frame_picks.windows(2).any(|w| w[0] >= w[1])
         {
             return Err(format!(
-                "frame_picks: {:?} must start at 0 (the first contact frame) and rise",
+                "frame_picks: {:?} must list at least two frames, start at 0 (the first contact frame) and rise",
                 self.frame_picks
             ));
         }
