@@ -14,6 +14,7 @@ mod learned_model;
 mod markers;
 mod npz;
 mod output;
+mod parse_prompt;
 mod plot;
 mod press;
 
@@ -57,6 +58,8 @@ enum Command {
         /// The question.
         prompt: String,
     },
+    /// What the prompt parser reads from a question (intent, property, targets, filters).
+    Parse(parse_prompt::ParseArgs),
     /// Press the gel into one object and report force, contact and indentation.
     Press(press::PressArgs),
     /// Fit a GelSight shading table from annotated presses of a ball of known radius.
@@ -277,6 +280,7 @@ fn main() -> ExitCode {
             reproducible,
             prompt,
         } => ask(scene, seed, json, reproducible, &prompt),
+        Command::Parse(args) => parse_prompt::run(&args),
         Command::Press(args) => press::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Compare(args) => compare::run(&args),

@@ -273,5 +273,52 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
     let e = fails(&["ask", "  "]);
     assert!(e.contains("prompt: empty"), "{e}");
     let e = fails(&["ask", "How hard is the pineapple?"]);
+    assert!(
+        e.contains("prompt: 'pineapple' is not in the fruit catalog"),
+        "{e}"
+    );
+    let e = fails(&["ask", "What is the weather like?"]);
     assert!(e.contains("prompt: names no known fruit"), "{e}");
+}
+
+#[test]
+fn parse_prints_the_query_contract_as_json() {
+    let out = tactex(&["parse", "--json", "Which lemon is ripest?"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let q: Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(q["intent"], "extreme");
+    assert_eq!(q["property"], "ripeness");
+    assert_eq!(q["extreme"], "most");
+    assert_eq!(q["targets"], serde_json::json!(["lemon"]));
+    assert_eq!(q["all"], false);
+    assert_eq!(q["exclude"], serde_json::json!([]));
+    assert!(q["filters"].is_object());
+    let e = fails(&["parse", "How hard is the pineapple?"]);
+    assert!(e.contains("'pineapple' is not in the fruit catalog"), "{e}");
+}
+
+#[test]
+fn colour_and_position_filters_choose_the_fruit() {
+    let scene = "scenes/demo.toml";
+    let a = ask_json(scene, "How hard is the yellow one?");
+    assert_eq!(selected_labels(&a), ["banana"]);
+    let a = ask_json(scene, "Which fruit on the right is the softest?");
+    assert_eq!(selected_labels(&a), ["tomato"]);
+    let labels: Vec<&str> = a["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| o["label"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        labels,
+        ["tomato", "avocado"],
+        "only the right-hand fruit are pressed"
+    );
+    let a = ask_json(scene, "How firm is the fruit at the front left?");
+    assert_eq!(selected_labels(&a), ["banana"]);
 }

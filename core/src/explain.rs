@@ -78,23 +78,28 @@ fn capitalise(s: &str) -> String {
 
 /// Indices of `objects` that answer the query, in answer order.
 pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Vec<usize> {
-    let measured: Vec<usize> = (0..objects.len())
+    let mut measured: Vec<usize> = (0..objects.len())
         .filter(|&i| objects[i].hardness.is_some())
         .collect();
+    // How much of the asked property an object has.
+    let key = |i: &usize| -> f64 {
+        let m = &objects[*i];
+        let e = stiffness(m);
+        match query.property {
+            Property::Hardness => e,
+            Property::Softness => -e,
+            // Ripeness: stiffness relative to the fruit's unripe stage, lower is riper.
+            Property::Ripeness => -catalog
+                .get(&m.label)
+                .map_or(e, |f| e / f.stages[0].modulus_mpa),
+        }
+    };
     match query.intent {
+        Intent::Summarize if query.ranked => {
+            measured.sort_by(|a, b| key(b).total_cmp(&key(a)));
+            measured
+        }
         Intent::Extreme => {
-            let key = |i: &usize| -> f64 {
-                let m = &objects[*i];
-                let e = stiffness(m);
-                match query.property {
-                    Property::Hardness => e,
-                    Property::Softness => -e,
-                    // Ripeness: stiffness relative to the fruit's unripe stage, lower is riper.
-                    Property::Ripeness => -catalog
-                        .get(&m.label)
-                        .map_or(e, |f| e / f.stages[0].modulus_mpa),
-                }
-            };
             let pick = match query.extreme {
                 Some(Extreme::Least) => measured.iter().min_by(|a, b| key(a).total_cmp(&key(b))),
                 _ => measured.iter().max_by(|a, b| key(a).total_cmp(&key(b))),
@@ -166,14 +171,37 @@ pub fn explain(
                 describe(b)
             )));
         }
+        Intent::Summarize if query.ranked && !selected.is_empty() => {
+            let (most, least) = match query.property {
+                Property::Hardness => ("hardest", "softest"),
+                Property::Softness => ("softest", "hardest"),
+                Property::Ripeness => ("ripest", "least ripe"),
+            };
+            let list: Vec<String> = selected.iter().map(|&i| describe(&objects[i])).collect();
+            parts.push(format!("From {most} to {least}: {}.", list.join("; ")));
+        }
         _ => {
             for &i in selected {
                 parts.push(capitalise(&format!("{}.", describe(&objects[i]))));
             }
         }
     }
+    if let Some(n) = query.filters.count
+        && !objects.is_empty()
+        && objects.len() != n
+    {
+        parts.push(format!(
+            "You mentioned {n}; I found {} on the table.",
+            objects.len()
+        ));
+    }
     for kind in missing {
         parts.push(format!("I could not find a {kind} on the table."));
+    }
+    for name in &query.unknown {
+        parts.push(format!(
+            "I do not know the {name}: it is not in my fruit catalog, so I did not look for it."
+        ));
     }
     parts.join(" ")
 }
@@ -220,6 +248,39 @@ mod tests {
         assert!(text.contains("From softest to hardest: banana"), "{text}");
         let q = crate::query::parse("Which fruit is the hardest?", &c).unwrap();
         assert_eq!(select(&q, &objs, &c), vec![0]);
+    }
+
+    #[test]
+    fn rankings_list_every_object_in_order() {
+        let c = FruitCatalog::builtin();
+        let objs = [
+            m("apple", 3.25, 0.1, 0.1),
+            m("banana", 0.8, -0.15, -0.1),
+            m("lime", 1.5, 0.0, 0.0),
+        ];
+        let q = crate::query::parse("Rank the fruits from softest to hardest", &c).unwrap();
+        let sel = select(&q, &objs, &c);
+        assert_eq!(sel, vec![1, 2, 0]);
+        let text = explain(&q, &objs, &sel, &[]);
+        assert!(
+            text.starts_with("From softest to hardest: the banana"),
+            "{text}"
+        );
+        let q = crate::query::parse("Order the fruit by firmness", &c).unwrap();
+        assert_eq!(select(&q, &objs, &c), vec![0, 2, 1]);
+    }
+
+    #[test]
+    fn counts_and_unknown_fruits_are_answered() {
+        let c = FruitCatalog::builtin();
+        let q = crate::query::parse("How hard are the two bananas and the grapes?", &c).unwrap();
+        let objs = [m("banana", 0.8, -0.15, -0.1)];
+        let text = explain(&q, &objs, &[0], &[]);
+        assert!(
+            text.contains("You mentioned 2; I found 1 on the table."),
+            "{text}"
+        );
+        assert!(text.contains("I do not know the grape"), "{text}");
     }
 
     #[test]

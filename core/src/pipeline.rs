@@ -8,6 +8,7 @@ use crate::explain::{self, Measured, location_words};
 use crate::geometry::Pose;
 use crate::hardness::HardnessReport;
 use crate::perception::centroid::{back_project_mask, median_depth, median_point};
+use crate::perception::colour_name::{colour_name, mean_colour};
 use crate::perception::detect::ClassicalDetector;
 use crate::perception::markers::{detect_markers, mean_moved_displacement, track};
 use crate::perception::mask::refine_mask;
@@ -258,16 +259,19 @@ fn ground<C: RgbdCamera>(
     })?;
     let (k, pose) = (camera.intrinsics(), camera.pose());
     let detector = ClassicalDetector::new(catalog);
-    let mut targets: Vec<Target> = detector
+    let candidates: Vec<(Target, String)> = detector
         .detect(&frames[0].color, &depth, &k, &pose)
         .into_iter()
         .filter(|d| query.wants(&d.label))
         .filter_map(|d| {
             let inner = refine_mask(&d.mask);
             let mut points = back_project_mask(&inner, &depth, &k, &pose);
+            let mut region = &inner;
             if points.len() < 20 {
                 points = back_project_mask(&d.mask, &depth, &k, &pose);
+                region = &d.mask;
             }
+            let colour = mean_colour(&frames[0].color, region).map(colour_name);
             let surface = median_point(&points)?;
             let mut heights: Vec<f64> = points.iter().map(|p| p.z).collect();
             heights.sort_by(f64::total_cmp);
@@ -280,15 +284,20 @@ fn ground<C: RgbdCamera>(
                 .filter(|p| near(p) <= 0.015)
                 .max_by(|a, b| a.z.total_cmp(&b.z))
                 .or_else(|| points.iter().min_by(|a, b| near(a).total_cmp(&near(b))))?;
-            Some(Target {
-                label: d.label,
-                score: d.score,
-                centre: DVec3::new(surface.x, surface.y, top / 2.0),
-                surface,
-                touch,
-            })
+            Some((
+                Target {
+                    label: d.label,
+                    score: d.score,
+                    centre: DVec3::new(surface.x, surface.y, top / 2.0),
+                    surface,
+                    touch,
+                },
+                colour.unwrap_or("grey").to_string(),
+            ))
         })
+        .filter(|(_, colour)| query.filters.color.as_deref().is_none_or(|c| c == colour))
         .collect();
+    let mut targets = apply_position(query, candidates);
     // A stable order: left to right, then front to back.
     targets.sort_by(|a, b| {
         (a.centre.x, a.centre.y)
@@ -296,6 +305,43 @@ fn ground<C: RgbdCamera>(
             .unwrap_or(std::cmp::Ordering::Equal)
     });
     Ok(targets)
+}
+
+/// Targets whose location matches the query's position filter. When none does ("the fruit
+/// on the left" with every fruit right of centre), the one furthest that way answers.
+fn apply_position(query: &Query, candidates: Vec<(Target, String)>) -> Vec<Target> {
+    let targets: Vec<Target> = candidates.into_iter().map(|(t, _)| t).collect();
+    let Some(filter) = query.filters.position.as_deref() else {
+        return targets;
+    };
+    let located = |t: &Target| location_words(t.centre.x, t.centre.y);
+    if targets
+        .iter()
+        .any(|t| query::position_matches(filter, &located(t)))
+    {
+        return targets
+            .into_iter()
+            .filter(|t| query::position_matches(filter, &located(t)))
+            .collect();
+    }
+    // How far a target lies in the filter's direction (x right, y back).
+    let toward = |t: &Target| -> f64 {
+        filter
+            .split(' ')
+            .map(|w| match w {
+                "left" => -t.centre.x,
+                "right" => t.centre.x,
+                "front" => -t.centre.y,
+                "back" => t.centre.y,
+                _ => -t.centre.truncate().length(),
+            })
+            .sum()
+    };
+    targets
+        .into_iter()
+        .max_by(|a, b| toward(a).total_cmp(&toward(b)))
+        .into_iter()
+        .collect()
 }
 
 /// Above the target, descend until the contact test fires, record the press frames, retract.

@@ -1,0 +1,676 @@
+//! Prompt -> `Query`: rule-based, offline. Says clearly when a prompt cannot be grounded.
+
+pub mod lexicon;
+
+use crate::catalog::FruitCatalog;
+use lexicon::Degree;
+use serde::Serialize;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Intent {
+    /// The property of named objects ("Identify the hardness of the lemon").
+    Identify,
+    /// The most/least of a property ("Which fruit is the softest?").
+    Extreme,
+    /// The property of every object, or of several named ones.
+    Summarize,
+    /// Two named objects against each other ("Is the mango harder than the avocado?").
+    Compare,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Property {
+    Hardness,
+    Softness,
+    Ripeness,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Extreme {
+    Most,
+    Least,
+}
+
+/// Qualifiers that narrow which objects a query is about.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Filters {
+    /// A colour the object must show ("the yellow one"), one of `lexicon::COLOURS`.
+    pub color: Option<String>,
+    /// Position words the object's location must contain, in `explain::location_words`
+    /// order: "left", "front", "left front", "centre".
+    pub position: Option<String>,
+    /// How many objects the prompt expects ("both bananas", "the two limes").
+    pub count: Option<usize>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Query {
+    pub intent: Intent,
+    pub property: Property,
+    pub extreme: Option<Extreme>,
+    /// Catalog names (singular) the prompt names, in the order named.
+    pub targets: Vec<String>,
+    /// The prompt is about every fruit on the table ("which fruit", "all fruits"), or every
+    /// one the filters keep.
+    pub all: bool,
+    pub exclude: Vec<String>,
+    pub filters: Filters,
+    /// The answer should order the objects ("rank the fruits from softest to hardest").
+    pub ranked: bool,
+    /// Fruits the prompt names that the catalog does not know ("pineapple").
+    pub unknown: Vec<String>,
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum QueryError {
+    #[error("prompt: empty; ask e.g. \"Which fruit is the softest?\"")]
+    Empty,
+    #[error("prompt: names no known fruit in \"{prompt}\" (known: {known})")]
+    NoTarget { prompt: String, known: String },
+    #[error("prompt: '{name}' is not in the fruit catalog (known: {known})")]
+    UnknownFruit { name: String, known: String },
+    #[error("prompt: over {max} characters")]
+    TooLong { max: usize },
+}
+
+pub const MAX_PROMPT_CHARS: usize = 2000;
+
+/// Lower-cased words with the lexicon's phrases rewritten ("ready to eat" -> "ripe").
+fn words_of(prompt: &str) -> Vec<String> {
+    let spaced: String = prompt
+        .to_lowercase()
+        .chars()
+        .map(|c| if c.is_alphanumeric() { c } else { ' ' })
+        .collect();
+    let mut text = format!(
+        " {} ",
+        spaced.split_whitespace().collect::<Vec<_>>().join(" ")
+    );
+    for (phrase, with) in lexicon::PHRASES {
+        text = text.replace(&format!(" {phrase} "), &format!(" {with} "));
+    }
+    text.split_whitespace().map(str::to_string).collect()
+}
+
+/// Words a quantifier may look past to reach its noun ("all of the three ripe bananas").
+const LOOK_PAST: &[&str] = &[
+    "the", "of", "these", "those", "my", "your", "ripe", "unripe",
+];
+
+pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> {
+    let trimmed = prompt.trim();
+    if trimmed.is_empty() {
+        return Err(QueryError::Empty);
+    }
+    if trimmed.chars().count() > MAX_PROMPT_CHARS {
+        return Err(QueryError::TooLong {
+            max: MAX_PROMPT_CHARS,
+        });
+    }
+    let words = words_of(trimmed);
+    let at = |i: usize| words.get(i).map(String::as_str);
+    let is_fruit = |w: &str| catalog.find_word(w).is_some();
+    let is_noun = |w: &str| is_fruit(w) || lexicon::GENERIC_NOUNS.contains(&w);
+    // The first noun after position i, looking past articles, counts and colours.
+    let noun_after = |i: usize| -> Option<&str> {
+        words[i + 1..]
+            .iter()
+            .map(String::as_str)
+            .take(4)
+            .find(|w| {
+                !(LOOK_PAST.contains(w)
+                    || lexicon::count_word(w).is_some()
+                    || lexicon::COLOURS.contains(w))
+            })
+            .filter(|w| is_noun(w))
+    };
+    let has = |set: &[&str]| words.iter().any(|w| set.contains(&w.as_str()));
+
+    let mut targets: Vec<String> = Vec::new();
+    let mut exclude: Vec<String> = Vec::new();
+    let mut unknown: Vec<String> = Vec::new();
+    let mut filters = Filters::default();
+    let mut positions: Vec<&str> = Vec::new();
+    let mut excluding = false;
+    let mut generic = false;
+    // "all", "every", "fruits": a summary; "the fruit on the left", "the yellow one": one.
+    let mut generic_plural = false;
+    let mut plural = false;
+    // (property, degree, points to the low end)
+    let mut properties: Vec<(Property, Degree, bool)> = Vec::new();
+    for (i, w) in words.iter().enumerate() {
+        let w = w.as_str();
+        let prev = if i > 0 { at(i - 1) } else { None };
+        if lexicon::EXCLUDING.contains(&w) {
+            excluding = true;
+            continue;
+        }
+        if lexicon::COLOURS.contains(&w) {
+            let names_noun = at(i + 1).is_some_and(|n| is_noun(n) || lexicon::COLOURS.contains(&n));
+            // "the orange" is the fruit, "the orange one" a colour. "Is the banana green?"
+            // asks about ripeness; "the green apple" filters by colour.
+            if names_noun {
+                filters.color.get_or_insert_with(|| w.to_string());
+                continue;
+            }
+            if w == "green" {
+                properties.push((Property::Ripeness, Degree::Base, true));
+                continue;
+            }
+            if !is_fruit(w) {
+                filters.color.get_or_insert_with(|| w.to_string());
+                continue;
+            }
+        }
+        if let Some(f) = catalog.find_word(w) {
+            let list = if excluding {
+                &mut exclude
+            } else {
+                &mut targets
+            };
+            if !list.contains(&f.name) {
+                list.push(f.name.clone());
+            }
+            plural |= !excluding && w != f.name && w.ends_with('s');
+            continue;
+        }
+        if lexicon::OTHER_FRUITS.contains(&w) {
+            let name = lexicon::singular(w);
+            if !unknown.contains(&name) {
+                unknown.push(name);
+            }
+            continue;
+        }
+        if lexicon::GENERIC.contains(&w) {
+            // "kiwi fruit", "all bananas", "one of the limes": the word belongs to a fruit
+            // name, not to every fruit.
+            let after_fruit = prev.is_some_and(is_fruit);
+            let quantifies_fruit = noun_after(i).is_some_and(is_fruit);
+            if !(after_fruit || quantifies_fruit) {
+                generic = true;
+                generic_plural |= !matches!(w, "fruit" | "object" | "item" | "thing" | "one");
+            }
+            continue;
+        }
+        if let Some(n) = lexicon::count_word(w) {
+            if noun_after(i).is_some() || w == "both" {
+                filters.count.get_or_insert(n);
+            }
+            continue;
+        }
+        if let Some(p) = lexicon::position_word(w) {
+            // "left" and "right" are positions only in place ("on the left", "the right
+            // one", "leftmost"): "is that right?" is not.
+            let placed = !matches!(w, "left" | "right")
+                || prev.is_some_and(|p| {
+                    matches!(p, "the" | "on" | "to" | "at" | "far" | "most")
+                        || lexicon::position_word(p).is_some()
+                })
+                || at(i + 1).is_some_and(|n| n == "side" || is_noun(n));
+            if placed && !positions.contains(&p) {
+                positions.push(p);
+            }
+            continue;
+        }
+        if let Some(pw) = lexicon::property_word(w) {
+            let (degree, flipped) = match (pw.degree, prev) {
+                (Degree::Base, Some("most")) => (Degree::Superlative, false),
+                (Degree::Base, Some("least")) => (Degree::Superlative, true),
+                (Degree::Base, Some("more")) => (Degree::Comparative, false),
+                (Degree::Base, Some("less")) => (Degree::Comparative, true),
+                (d, _) => (d, false),
+            };
+            properties.push((pw.property, degree, pw.inverted ^ flipped));
+        }
+    }
+    targets.retain(|t| !exclude.contains(t));
+    filters.position = position_phrase(&positions);
+
+    let known = || catalog.names().join(", ");
+    let filtered = filters.color.is_some() || filters.position.is_some();
+    let all = generic || !exclude.is_empty() || (targets.is_empty() && filtered);
+    if targets.is_empty() && !all {
+        return Err(match unknown.first() {
+            Some(name) => QueryError::UnknownFruit {
+                name: name.clone(),
+                known: known(),
+            },
+            None => QueryError::NoTarget {
+                prompt: trimmed.to_string(),
+                known: known(),
+            },
+        });
+    }
+
+    let superlatives = properties
+        .iter()
+        .filter(|p| p.1 == Degree::Superlative)
+        .count();
+    let ranked = has(lexicon::RANKING) || (superlatives >= 2 && has(&["from"]) && has(&["to"]));
+    // The property and direction come from the first property word: "from softest to
+    // hardest" ranks by softness.
+    let (property, _, flipped) =
+        properties
+            .first()
+            .copied()
+            .unwrap_or((Property::Hardness, Degree::Base, false));
+    let comparative = properties.iter().any(|p| p.1 == Degree::Comparative);
+    let superlative = superlatives > 0;
+    let intent = if ranked {
+        Intent::Summarize
+    } else if (comparative || has(lexicon::COMPARING)) && targets.len() >= 2 {
+        Intent::Compare
+    } else if superlative || comparative {
+        // "Which of the two bananas is softer?" picks one of a kind.
+        Intent::Extreme
+    } else if generic_plural
+        || !exclude.is_empty()
+        || targets.len() > 1
+        || plural
+        || filters.count.is_some_and(|n| n > 1)
+        || has(lexicon::SUMMARISING)
+    {
+        Intent::Summarize
+    } else {
+        Intent::Identify
+    };
+    let extreme = (intent == Intent::Extreme).then_some(if flipped {
+        Extreme::Least
+    } else {
+        Extreme::Most
+    });
+    // Named kinds bound an extreme, a comparison or an identification ("which fruit is
+    // softer, the kiwi or the peach"); a summary may add "all other fruits" to named ones.
+    let all = all && (intent == Intent::Summarize || targets.is_empty());
+    Ok(Query {
+        intent,
+        property,
+        extreme,
+        targets,
+        all,
+        exclude,
+        filters,
+        ranked,
+        unknown,
+    })
+}
+
+/// Position words in `explain::location_words` order: left/right/centre, then front/back.
+fn position_phrase(positions: &[&str]) -> Option<String> {
+    let lr = positions
+        .iter()
+        .find(|p| matches!(**p, "left" | "right"))
+        .copied();
+    let fb = positions
+        .iter()
+        .find(|p| matches!(**p, "front" | "back"))
+        .copied();
+    match (lr, fb) {
+        (Some(a), Some(b)) => Some(format!("{a} {b}")),
+        (Some(a), None) | (None, Some(a)) => Some(a.to_string()),
+        (None, None) => positions.contains(&"centre").then(|| "centre".to_string()),
+    }
+}
+
+impl Query {
+    /// Whether an object with this label is among those the query asks about.
+    pub fn wants(&self, label: &str) -> bool {
+        !self.exclude.iter().any(|e| e == label)
+            && (self.all || self.targets.iter().any(|t| t == label))
+    }
+
+    /// Whether an object with this label, location words and colour name passes the
+    /// query's targets and filters.
+    pub fn admits(&self, label: &str, location: &str, colour: Option<&str>) -> bool {
+        self.wants(label)
+            && self
+                .filters
+                .color
+                .as_deref()
+                .is_none_or(|c| colour == Some(c))
+            && self
+                .filters
+                .position
+                .as_deref()
+                .is_none_or(|p| position_matches(p, location))
+    }
+}
+
+/// Whether location words ("left front") satisfy a position filter ("left", "left front").
+pub fn position_matches(filter: &str, location: &str) -> bool {
+    let at: Vec<&str> = location.split(' ').collect();
+    filter.split(' ').all(|w| at.contains(&w))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn q(p: &str) -> Query {
+        parse(p, &FruitCatalog::builtin()).unwrap_or_else(|e| panic!("{p}: {e}"))
+    }
+
+    fn names(v: &[&str]) -> Vec<String> {
+        v.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn tier_1_identifies_the_property_of_one_object() {
+        for p in [
+            "Identify the hardness of the lemon",
+            "I want to know the hardness of the lemon",
+            "How hard is the lemon?",
+            "how firm is the lemon",
+        ] {
+            let query = q(p);
+            assert_eq!(
+                (
+                    query.intent,
+                    query.property,
+                    query.targets.clone(),
+                    query.all
+                ),
+                (
+                    Intent::Identify,
+                    Property::Hardness,
+                    names(&["lemon"]),
+                    false
+                ),
+                "{p}"
+            );
+        }
+        let query = q("Is the avocado ripe?");
+        assert_eq!(
+            (query.intent, query.property),
+            (Intent::Identify, Property::Ripeness)
+        );
+    }
+
+    #[test]
+    fn tier_2_picks_the_most_or_least_of_a_kind() {
+        let cases = [
+            (
+                "Which banana is the softest?",
+                Property::Softness,
+                Extreme::Most,
+            ),
+            ("the softest banana", Property::Softness, Extreme::Most),
+            ("which lemon is ripest", Property::Ripeness, Extreme::Most),
+            (
+                "Which lemon is the most ripe?",
+                Property::Ripeness,
+                Extreme::Most,
+            ),
+            (
+                "Which lemon is least ripe?",
+                Property::Ripeness,
+                Extreme::Least,
+            ),
+            (
+                "Which banana is the greenest?",
+                Property::Ripeness,
+                Extreme::Least,
+            ),
+            ("Find the firmest banana", Property::Hardness, Extreme::Most),
+            (
+                "Which banana is the least hard?",
+                Property::Hardness,
+                Extreme::Least,
+            ),
+            (
+                "Which of the two bananas is squishier?",
+                Property::Softness,
+                Extreme::Most,
+            ),
+        ];
+        for (p, property, extreme) in cases {
+            let query = q(p);
+            assert_eq!(
+                (query.intent, query.property, query.extreme, query.all),
+                (Intent::Extreme, property, Some(extreme), false),
+                "{p}"
+            );
+            let t = if p.contains("banana") {
+                "banana"
+            } else {
+                "lemon"
+            };
+            assert_eq!(query.targets, names(&[t]), "{p}");
+        }
+    }
+
+    #[test]
+    fn tier_3_summarises_named_objects() {
+        let query = q("Summarize the hardness of the mango and the kiwi");
+        assert_eq!(
+            (query.intent, query.targets.clone(), query.all),
+            (Intent::Summarize, names(&["mango", "kiwi"]), false)
+        );
+        let query = q("How ripe are the lemon, the lime and the peach?");
+        assert_eq!(
+            (query.intent, query.property, query.targets.len()),
+            (Intent::Summarize, Property::Ripeness, 3)
+        );
+    }
+
+    #[test]
+    fn tier_4_summarises_all_fruits() {
+        for p in [
+            "Summarize the hardness of all fruits",
+            "Describe how hard every fruit is",
+            "How firm is each item on the table?",
+        ] {
+            let query = q(p);
+            assert_eq!(
+                (query.intent, query.all, query.targets.len()),
+                (Intent::Summarize, true, 0),
+                "{p}"
+            );
+        }
+    }
+
+    #[test]
+    fn softest_fruit_is_an_extreme_over_all() {
+        let query = q("Which fruit is the softest?");
+        assert_eq!(
+            (query.intent, query.property, query.extreme, query.all),
+            (
+                Intent::Extreme,
+                Property::Softness,
+                Some(Extreme::Most),
+                true
+            )
+        );
+        let query = q("Which fruit is the hardest?");
+        assert_eq!(
+            (query.intent, query.property),
+            (Intent::Extreme, Property::Hardness)
+        );
+        let query = q("Which fruit is ready to eat?");
+        assert_eq!(query.property, Property::Ripeness);
+    }
+
+    #[test]
+    fn comparisons_between_named_objects() {
+        let query = q("Is the mango harder than the avocado?");
+        assert_eq!(
+            (query.intent, query.property, query.extreme),
+            (Intent::Compare, Property::Hardness, None)
+        );
+        assert_eq!(query.targets, names(&["mango", "avocado"]));
+        let query = q("Which is softer, the kiwi or the peach?");
+        assert_eq!(
+            (query.intent, query.property),
+            (Intent::Compare, Property::Softness)
+        );
+        let query = q("Compare the apple and the orange");
+        assert_eq!(
+            (query.intent, query.targets.clone()),
+            (Intent::Compare, names(&["apple", "orange"]))
+        );
+        let query = q("Is the lime less ripe than the lemon?");
+        assert_eq!(
+            (query.intent, query.property),
+            (Intent::Compare, Property::Ripeness)
+        );
+        let query = q("Which fruit is softest, the kiwi or the mango?");
+        assert_eq!(
+            (query.intent, query.all, query.targets.len()),
+            (Intent::Extreme, false, 2)
+        );
+    }
+
+    #[test]
+    fn rankings_order_every_object() {
+        let query = q("Rank the fruits from softest to hardest");
+        assert_eq!(
+            (query.intent, query.ranked, query.property, query.all),
+            (Intent::Summarize, true, Property::Softness, true)
+        );
+        let query = q("Order the bananas by ripeness");
+        assert_eq!(
+            (
+                query.intent,
+                query.ranked,
+                query.property,
+                query.targets.clone()
+            ),
+            (
+                Intent::Summarize,
+                true,
+                Property::Ripeness,
+                names(&["banana"])
+            )
+        );
+    }
+
+    #[test]
+    fn plurals_and_counts() {
+        let query = q("How soft are both bananas?");
+        assert_eq!(
+            (
+                query.intent,
+                query.targets.clone(),
+                query.filters.count,
+                query.all
+            ),
+            (Intent::Summarize, names(&["banana"]), Some(2), false)
+        );
+        let query = q("Tell me the firmness of the two limes");
+        assert_eq!(
+            (query.intent, query.filters.count, query.property),
+            (Intent::Summarize, Some(2), Property::Hardness)
+        );
+        let query = q("How hard are all 3 apples?");
+        assert_eq!(
+            (query.filters.count, query.all, query.targets.clone()),
+            (Some(3), false, names(&["apple"]))
+        );
+        let query = q("How hard are the tomatoes?");
+        assert_eq!(query.intent, Intent::Summarize);
+    }
+
+    #[test]
+    fn synonyms_map_to_the_catalog_and_properties() {
+        assert_eq!(q("How squishy is the peach?").property, Property::Softness);
+        assert_eq!(q("How firm is the kiwifruit?").targets, names(&["kiwi"]));
+        assert_eq!(q("Is the kiwi fruit soft?").all, false);
+        assert_eq!(q("Is the mango ready-to-eat?").property, Property::Ripeness);
+        let query = q("Is the banana still green?");
+        assert_eq!(
+            (query.property, query.filters.color.clone()),
+            (Property::Ripeness, None)
+        );
+        assert_eq!(
+            q("Which mango is the most unripe?").extreme,
+            Some(Extreme::Least)
+        );
+        assert_eq!(q("How stiff are the mangos?").targets, names(&["mango"]));
+    }
+
+    #[test]
+    fn filters_by_colour_and_position() {
+        let query = q("How hard is the fruit on the left?");
+        assert_eq!(
+            (query.intent, query.all, query.filters.position.clone()),
+            (Intent::Identify, true, Some("left".to_string()))
+        );
+        let query = q("How soft is the yellow one?");
+        assert_eq!(
+            (query.all, query.filters.color.clone()),
+            (true, Some("yellow".to_string()))
+        );
+        let query = q("Is the orange one riper than the green apple?");
+        assert_eq!(query.filters.color.as_deref(), Some("orange"));
+        assert_eq!(query.targets, names(&["apple"]));
+        let query = q("How firm is the orange?");
+        assert_eq!(
+            (query.targets.clone(), query.filters.color.clone()),
+            (names(&["orange"]), None)
+        );
+        let query = q("Which fruit in the front right is the softest?");
+        assert_eq!(query.filters.position.as_deref(), Some("right front"));
+        let query = q("How hard is the leftmost banana?");
+        assert_eq!(
+            (query.filters.position.as_deref(), query.targets.clone()),
+            (Some("left"), names(&["banana"]))
+        );
+        let query = q("Is that right, the apple is hard?");
+        assert_eq!(query.filters.position, None);
+        let query = q("How hard is the fruit in the middle?");
+        assert_eq!(query.filters.position.as_deref(), Some("centre"));
+    }
+
+    #[test]
+    fn exclusions() {
+        let query = q("Tell me how hard all fruits except the kiwi are");
+        assert_eq!(
+            (query.intent, query.all, query.exclude.clone()),
+            (Intent::Summarize, true, names(&["kiwi"]))
+        );
+        let query = q("Which fruit other than the banana and the lime is the softest?");
+        assert_eq!(
+            (query.intent, query.all, query.exclude.clone()),
+            (Intent::Extreme, true, names(&["banana", "lime"]))
+        );
+        assert!(!query.wants("banana") && query.wants("apple"));
+    }
+
+    #[test]
+    fn filters_admit_by_label_colour_and_location() {
+        let query = q("How hard is the yellow fruit on the left?");
+        assert!(query.admits("lemon", "left front", Some("yellow")));
+        assert!(!query.admits("lemon", "right front", Some("yellow")));
+        assert!(!query.admits("lime", "left", Some("green")));
+        let query = q("How hard is the banana at the front left?");
+        assert!(query.admits("banana", "left front", None));
+        assert!(!query.admits("banana", "left back", None));
+    }
+
+    #[test]
+    fn unparseable_prompts_say_why() {
+        let c = FruitCatalog::builtin();
+        assert_eq!(parse("   ", &c), Err(QueryError::Empty));
+        let e = parse("How hard is the pineapple?", &c)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("prompt: 'pineapple' is not in the fruit catalog"),
+            "{e}"
+        );
+        let e = parse("What is the weather like?", &c)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("prompt: names no known fruit"), "{e}");
+        assert!(parse(&"a".repeat(MAX_PROMPT_CHARS + 1), &c).is_err());
+        // An unknown fruit beside known ones is kept, so the answer can say so.
+        let query = parse("Compare the kiwi and the grapes", &c).unwrap();
+        assert_eq!(
+            (query.targets.clone(), query.unknown.clone()),
+            (names(&["kiwi"]), names(&["grape"]))
+        );
+    }
+}
