@@ -1,7 +1,9 @@
 //! The simulated RGB-D camera: a CPU z-buffer rasterizer of the table and the objects at the
-//! scene's intrinsics and pose, with Lambertian shading, per-object surface texture, and
-//! seeded per-frame colour and depth noise (depth noise grows with Z^2 as on a stereo camera).
+//! scene's intrinsics and pose, with ambient plus directional light (Lambertian with a soft
+//! specular highlight), per-object surface texture, seeded per-frame colour noise and the
+//! RealSense D435 depth noise model (`depth_noise`).
 
+use crate::depth_noise::{CleanDepth, RealSenseNoise};
 use crate::world::SharedWorld;
 use glam::{DVec2, DVec3};
 use image::{ImageBuffer, Luma, Rgb, RgbImage};
@@ -19,6 +21,8 @@ pub type InstanceImage = ImageBuffer<Luma<u16>, Vec<u16>>;
 #[derive(Clone)]
 pub struct CleanRender {
     pub color: Vec<[f64; 3]>,
+    /// The specular part of `color` (grey level in [0, 1]); specular spots lose depth.
+    pub specular: Vec<f64>,
     pub depth_m: Vec<f64>,
     pub instances: InstanceImage,
 }
@@ -29,9 +33,9 @@ pub struct SimCamera {
     pose: Pose,
     clean: Option<CleanRender>,
     rng: ChaCha8Rng,
-    /// Colour noise (grey levels) and depth noise at 1 m (m), 1 sigma.
+    /// Colour noise (grey levels, 1 sigma).
     pub color_noise: f64,
-    pub depth_noise_at_1m: f64,
+    pub depth_noise: RealSenseNoise,
     pub frame_rate_hz: f64,
 }
 
@@ -71,7 +75,7 @@ impl SimCamera {
             clean: None,
             rng: ChaCha8Rng::seed_from_u64(seed ^ 0x00ca_3e7a),
             color_noise: 2.0,
-            depth_noise_at_1m: 0.002,
+            depth_noise: RealSenseNoise::default(),
             frame_rate_hz: 30.0,
         }
     }
@@ -144,7 +148,9 @@ impl SimCamera {
         let light = LIGHT.normalize();
         let mut zbuf = vec![f64::INFINITY; w * h];
         let mut color = vec![[0.0; 3]; w * h];
+        let mut specular = vec![0.0; w * h];
         let mut ids = vec![0u16; w * h];
+        let eye = self.pose.position;
         for tri in self.triangles() {
             let cam = tri.p.map(|p| to_cam.transform_point(p));
             if cam.iter().any(|p| p.z <= 0.01) {
@@ -187,10 +193,21 @@ impl SimCamera {
                     let n = ((tri.n[0] * wz[0] + tri.n[1] * wz[1] + tri.n[2] * wz[2]) * z)
                         .normalize_or(DVec3::Z);
                     let shade = 0.38 + 0.62 * n.dot(light).max(0.0);
+                    // Fruit skins are waxy: a soft Blinn-Phong highlight; the table is matte.
+                    let spec = if tri.id > 0 {
+                        let at = (tri.p[0] * wz[0] + tri.p[1] * wz[1] + tri.p[2] * wz[2]) * z;
+                        let half = (light + (eye - at).normalize_or(DVec3::Z)).normalize();
+                        0.35 * n.dot(half).max(0.0).powi(60)
+                    } else {
+                        0.0
+                    };
+                    specular[i] = spec;
                     color[i] = std::array::from_fn(|c| {
-                        (tri.c[0][c] * wz[0] + tri.c[1][c] * wz[1] + tri.c[2][c] * wz[2])
+                        ((tri.c[0][c] * wz[0] + tri.c[1][c] * wz[1] + tri.c[2][c] * wz[2])
                             * z
                             * shade
+                            + spec)
+                            .min(1.0)
                     });
                     ids[i] = tri.id;
                 }
@@ -202,6 +219,7 @@ impl SimCamera {
             .collect();
         CleanRender {
             color,
+            specular,
             depth_m,
             instances: InstanceImage::from_raw(w as u32, h as u32, ids).expect("sized"),
         }
@@ -237,17 +255,17 @@ impl RgbdCamera for SimCamera {
                     .clamp(0.0, 255.0) as u8
             }));
         }
-        let depth: Vec<f32> = clean
-            .depth_m
-            .iter()
-            .map(|z| {
-                if *z > 0.0 {
-                    (*z + self.depth_noise_at_1m * z * z * unit.sample(rng)) as f32
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let depth = self.depth_noise.apply(
+            &CleanDepth {
+                width: k.width as usize,
+                height: k.height as usize,
+                depth_m: &clean.depth_m,
+                color: &clean.color,
+                specular: &clean.specular,
+                fx: k.fx,
+            },
+            rng,
+        );
         let mut world = self.world.lock().expect("world lock");
         world.time_s += 1.0 / self.frame_rate_hz;
         Ok(RgbdFrame {

@@ -8,6 +8,7 @@
 pub mod arm;
 pub mod camera;
 pub mod contact;
+pub mod depth_noise;
 pub mod elastic;
 pub mod gel_render;
 pub mod gelsight;
