@@ -24,6 +24,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::estimate::HertzSlopeEstimator;
+use tactex_core::perception::detect::ClassicalDetector;
 use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_sim::SimDevices;
@@ -156,6 +157,7 @@ fn ask(
             tactile: &mut sim.tactile,
             arm: &mut sim.arm,
         },
+        &ClassicalDetector::new(&catalog),
         &HertzSlopeEstimator::default(),
         &config,
     )?;

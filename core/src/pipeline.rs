@@ -9,7 +9,7 @@ use crate::geometry::Pose;
 use crate::hardness::HardnessReport;
 use crate::perception::centroid::{back_project_mask, median_depth, median_point};
 use crate::perception::colour_name::{colour_name, mean_colour};
-use crate::perception::detect::ClassicalDetector;
+use crate::perception::detect::{DetectError, Detector, RgbdView};
 use crate::perception::markers::{detect_markers, mean_moved_displacement, track};
 use crate::perception::mask::refine_mask;
 use crate::perception::ssim::ssim_rgb;
@@ -66,6 +66,8 @@ pub enum PipelineError {
     Device(#[from] DeviceError),
     #[error("camera: {0}")]
     Camera(String),
+    #[error(transparent)]
+    Detect(#[from] DetectError),
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -134,6 +136,7 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     prompt: &str,
     catalog: &FruitCatalog,
     devices: Devices<'_, C, T, A>,
+    detector: &dyn Detector,
     estimator: &dyn HardnessEstimator,
     config: &PipelineConfig,
 ) -> Result<Answer, PipelineError> {
@@ -159,7 +162,7 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     lap("parse", arm, t);
 
     let t = start(arm);
-    let targets = ground(&query, catalog, camera, config)?;
+    let targets = ground(&query, camera, detector, config)?;
     lap("ground", arm, t);
     let not_found: Vec<String> = query
         .targets
@@ -246,8 +249,8 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
 /// Detections for the query's targets, with refined-mask centroids from the depth median.
 fn ground<C: RgbdCamera>(
     query: &Query,
-    catalog: &FruitCatalog,
     camera: &mut C,
+    detector: &dyn Detector,
     config: &PipelineConfig,
 ) -> Result<Vec<Target>, PipelineError> {
     let frames = (0..config.depth_frames.max(1))
@@ -258,11 +261,15 @@ fn ground<C: RgbdCamera>(
         PipelineError::Camera(format!("{}: depth frames differ in size", camera.name()))
     })?;
     let (k, pose) = (camera.intrinsics(), camera.pose());
-    let detector = ClassicalDetector::new(catalog);
+    let view = RgbdView {
+        color: &frames[0].color,
+        depth: &depth,
+        intrinsics: &k,
+        pose: &pose,
+    };
     let candidates: Vec<(Target, String)> = detector
-        .detect(&frames[0].color, &depth, &k, &pose)
+        .detect_for(&view, query)?
         .into_iter()
-        .filter(|d| query.wants(&d.label))
         .filter_map(|d| {
             let inner = refine_mask(&d.mask);
             let mut points = back_project_mask(&inner, &depth, &k, &pose);

@@ -15,6 +15,7 @@ pub mod gelsight;
 pub mod layer;
 pub mod mesh;
 pub mod press_protocol;
+pub mod scene_random;
 pub mod tactile_sample;
 pub mod world;
 

@@ -1,9 +1,11 @@
-//! The classical detector: points above the table plane (from depth), connected components,
-//! each classified by colour and size against the fruit catalog. Needs no model weights.
+//! Object detection on RGB-D views behind one `Detector` trait, and the default classical
+//! detector: points above the table plane (from depth), connected components, each
+//! classified by colour and size against the fruit catalog. Needs no model weights.
 
 use crate::catalog::FruitCatalog;
 use crate::frames::DepthImage;
 use crate::geometry::{CameraIntrinsics, Pose};
+use crate::query::Query;
 use glam::DVec3;
 use image::{GrayImage, Luma, RgbImage};
 use imageproc::region_labelling::{Connectivity, connected_components};
@@ -18,6 +20,46 @@ pub struct Detection {
     pub mask: GrayImage,
     /// Footprint extents seen from above: length, width, height (m).
     pub size_m: [f64; 3],
+}
+
+/// What a detector sees: one colour frame, a depth image registered to it (the pipeline
+/// passes the per-pixel median of several frames), and the camera.
+#[derive(Clone, Copy)]
+pub struct RgbdView<'a> {
+    pub color: &'a RgbImage,
+    pub depth: &'a DepthImage,
+    pub intrinsics: &'a CameraIntrinsics,
+    pub pose: &'a Pose,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum DetectError {
+    /// The detector's model failed on this view.
+    #[error("detector {detector}: {message}")]
+    Model { detector: String, message: String },
+}
+
+/// A detector of catalog objects in RGB-D views: the classical one, a YOLOv8-seg model, or
+/// ground truth perturbed by a perception-error model. The pipeline does not ask which.
+pub trait Detector {
+    fn name(&self) -> &str;
+
+    /// Every object it finds, best first or in any order.
+    fn detect(&self, view: &RgbdView<'_>) -> Result<Vec<Detection>, DetectError>;
+
+    /// The detections of the kinds a query asks for (prompt-conditioned, as in the paper:
+    /// the parsed targets filter what the detector returns).
+    fn detect_for(
+        &self,
+        view: &RgbdView<'_>,
+        query: &Query,
+    ) -> Result<Vec<Detection>, DetectError> {
+        Ok(self
+            .detect(view)?
+            .into_iter()
+            .filter(|d| query.wants(&d.label))
+            .collect())
+    }
 }
 
 pub struct ClassicalDetector<'a> {
@@ -36,13 +78,14 @@ impl<'a> ClassicalDetector<'a> {
         }
     }
 
-    pub fn detect(
-        &self,
-        color: &RgbImage,
-        depth: &DepthImage,
-        k: &CameraIntrinsics,
-        camera: &Pose,
-    ) -> Vec<Detection> {
+    /// Detections in one view (infallible: no model to fail).
+    pub fn find(&self, view: &RgbdView<'_>) -> Vec<Detection> {
+        let RgbdView {
+            color,
+            depth,
+            intrinsics: k,
+            pose: camera,
+        } = *view;
         let (w, h) = depth.dimensions();
         let mut world = vec![None; (w * h) as usize];
         let foreground = GrayImage::from_fn(w, h, |u, v| {
@@ -121,6 +164,16 @@ impl<'a> ClassicalDetector<'a> {
         let (d0, label) = *best.first()?;
         let total: f64 = best.iter().map(|(d, _)| (-(d - d0) / 2.0).exp()).sum();
         Some((label.to_string(), 1.0 / total))
+    }
+}
+
+impl Detector for ClassicalDetector<'_> {
+    fn name(&self) -> &str {
+        "classical"
+    }
+
+    fn detect(&self, view: &RgbdView<'_>) -> Result<Vec<Detection>, DetectError> {
+        Ok(self.find(view))
     }
 }
 

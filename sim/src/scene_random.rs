@@ -1,0 +1,178 @@
+//! The scene randomiser: N catalog fruits of chosen kinds, each at a random ripeness stage
+//! with its own colour and size within the kind's natural spread, placed on the table
+//! without overlap, inside the camera's valid depth, and settled by rapier3d (`SimWorld`).
+
+use rand::seq::IndexedRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::path::Path;
+use tactex_core::catalog::FruitCatalog;
+use tactex_core::scene::{ObjectKind, Scene, SceneError};
+
+/// How much fruits of one kind differ from each other.
+#[derive(Clone, Debug)]
+pub struct Variation {
+    /// Relative 1-sigma spread of size per axis and of brightness.
+    pub size_sigma: f64,
+    pub brightness_sigma: f64,
+    /// 1-sigma shift of each colour channel (absolute, in [0, 1] units): hue variation.
+    pub channel_sigma: f64,
+    /// Gap kept between fruit footprints (m).
+    pub gap_m: f64,
+    /// Margin from the table edge (m).
+    pub margin_m: f64,
+}
+
+impl Default for Variation {
+    fn default() -> Self {
+        Self {
+            size_sigma: 0.06,
+            brightness_sigma: 0.07,
+            channel_sigma: 0.025,
+            gap_m: 0.015,
+            margin_m: 0.03,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum RandomSceneError {
+    #[error("random scene: unknown fruit kind '{kind}' (known: {known})")]
+    UnknownKind { kind: String, known: String },
+    #[error("random scene: {count} fruits do not fit on the table without overlap")]
+    NoRoom { count: usize },
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+}
+
+/// A scene of the given fruit kinds (catalog names, repeats allowed), drawn from `seed`.
+pub fn random_scene(
+    kinds: &[&str],
+    catalog: &FruitCatalog,
+    seed: u64,
+    variation: &Variation,
+) -> Result<Scene, RandomSceneError> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5ce7_e5eed);
+    // The camera, table and defaults come from the scene parser, so they match scene files.
+    let mut scene = Scene::parse(
+        "name = \"random\"\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n",
+        Path::new(&format!("random-scene-{seed}")),
+        catalog,
+    )?;
+    scene.name = format!("random-{seed}");
+    let template = scene.objects.remove(0);
+    let [tw, th] = scene.table.size_m;
+    // The D435 sees no depth in a band on the left (f B / Z pixels): keep fruit out of it.
+    let k = scene.intrinsics;
+    let z_cam = scene.camera_pose.position.z;
+    let band_px = k.fx * crate::depth_noise::RealSenseNoise::default().baseline_m / z_cam + 4.0;
+    let x_min_view = (band_px - k.cx) * z_cam / k.fx;
+    let mut placed: Vec<([f64; 2], f64)> = Vec::new();
+    for &kind in kinds {
+        let fruit = catalog
+            .get(kind)
+            .ok_or_else(|| RandomSceneError::UnknownKind {
+                kind: kind.to_string(),
+                known: catalog.names().join(", "),
+            })?;
+        let stage = fruit
+            .stages
+            .choose(&mut rng)
+            .expect("validated non-empty")
+            .clone();
+        let scale: [f64; 3] = std::array::from_fn(|_| {
+            (1.0 + variation.size_sigma * normal(&mut rng)).clamp(0.8, 1.2)
+        });
+        let size_m: [f64; 3] = std::array::from_fn(|i| fruit.size_m[i] * scale[i]);
+        let radius = size_m[0].max(size_m[1]) / 2.0;
+        let lo_x = (-tw / 2.0 + variation.margin_m + radius).max(x_min_view + radius);
+        let hi_x = tw / 2.0 - variation.margin_m - radius;
+        let (lo_y, hi_y) = (
+            -th / 2.0 + variation.margin_m + radius,
+            th / 2.0 - variation.margin_m - radius,
+        );
+        let spot = (0..500).find_map(|_| {
+            let p = [rng.random_range(lo_x..hi_x), rng.random_range(lo_y..hi_y)];
+            placed
+                .iter()
+                .all(|(q, r)| (p[0] - q[0]).hypot(p[1] - q[1]) > r + radius + variation.gap_m)
+                .then_some(p)
+        });
+        let Some(position_m) = spot else {
+            return Err(RandomSceneError::NoRoom { count: kinds.len() });
+        };
+        placed.push((position_m, radius));
+        let brightness = 1.0 + variation.brightness_sigma * normal(&mut rng);
+        let color = stage.color.map(|c| {
+            (c * brightness + variation.channel_sigma * normal(&mut rng)).clamp(0.02, 0.98)
+        });
+        let mut object = template.clone();
+        object.label = fruit.name.clone();
+        object.kind = ObjectKind::Fruit {
+            name: fruit.name.clone(),
+            shape: fruit.shape,
+            size_m,
+        };
+        object.position_m = position_m;
+        object.yaw_deg = rng.random_range(-180.0..180.0);
+        object.hardness = tactex_core::hardness::Hardness::ModulusMpa(stage.modulus_mpa);
+        object.ripeness = Some(stage.name.clone());
+        object.color = color;
+        object.poisson = fruit.poisson;
+        scene.objects.push(object);
+    }
+    Ok(scene)
+}
+
+fn normal(rng: &mut ChaCha8Rng) -> f64 {
+    // Box-Muller: one standard normal draw.
+    let (u, v): (f64, f64) = (rng.random::<f64>().max(1e-12), rng.random());
+    (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::world::SimWorld;
+
+    #[test]
+    fn random_fruit_rest_apart_on_the_table_and_the_seed_decides() {
+        let catalog = FruitCatalog::builtin();
+        let kinds = ["banana", "apple", "lime", "avocado", "kiwi"];
+        let a = random_scene(&kinds, &catalog, 7, &Variation::default()).unwrap();
+        let b = random_scene(&kinds, &catalog, 7, &Variation::default()).unwrap();
+        assert_eq!(a, b);
+        let c = random_scene(&kinds, &catalog, 8, &Variation::default()).unwrap();
+        assert_ne!(a.objects[0].position_m, c.objects[0].position_m);
+        let world = SimWorld::from_scene(&a).unwrap();
+        assert!(
+            world.settle_shift_m < 0.01,
+            "moved {} m",
+            world.settle_shift_m
+        );
+        for (i, o) in world.objects.iter().enumerate() {
+            let (lo, hi) = o.mesh.bounds();
+            assert!(lo.z.abs() < 0.003, "{} floats at {} m", o.label, lo.z);
+            for p in &world.objects[i + 1..] {
+                let (plo, phi) = p.mesh.bounds();
+                let apart = lo.x > phi.x || plo.x > hi.x || lo.y > phi.y || plo.y > hi.y;
+                let d = o.centre.truncate().distance(p.centre.truncate());
+                assert!(apart || d > 0.04, "{} and {} overlap", o.label, p.label);
+            }
+        }
+    }
+
+    #[test]
+    fn too_many_fruits_and_unknown_kinds_are_errors() {
+        let catalog = FruitCatalog::builtin();
+        let e = random_scene(&["pineapple"], &catalog, 1, &Variation::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown fruit kind 'pineapple'"), "{e}");
+        let many = vec!["mango"; 60];
+        assert!(matches!(
+            random_scene(&many, &catalog, 1, &Variation::default()),
+            Err(RandomSceneError::NoRoom { .. })
+        ));
+    }
+}
