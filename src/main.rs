@@ -8,6 +8,7 @@ mod bench_render;
 mod calibrate;
 mod compare;
 mod datagen_tactile;
+mod eval_grounding;
 mod eval_hardness;
 mod eval_ripeness;
 mod learned_model;
@@ -104,6 +105,8 @@ enum BenchCommand {
 
 #[derive(Subcommand)]
 enum EvalCommand {
+    /// The paper's grounding protocol: detectors' success, IoU and centroid error.
+    Grounding(eval_grounding::GroundingEvalArgs),
     /// Hardness estimators on held-out synthetic presses of unseen shapes.
     Hardness(eval_hardness::HardnessEvalArgs),
     /// The paper's Table III: ripeness stages of five fruits told apart by pressing.
@@ -287,6 +290,9 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Markers(args) => markers::run(&args),
+        Command::Eval {
+            command: EvalCommand::Grounding(args),
+        } => eval_grounding::run(&args),
         Command::Eval {
             command: EvalCommand::Hardness(args),
         } => eval_hardness::run(&args),

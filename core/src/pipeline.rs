@@ -7,11 +7,11 @@ use crate::estimate::{Evidence, HardnessEstimator, PressSequence};
 use crate::explain::{self, Measured, location_words};
 use crate::geometry::Pose;
 use crate::hardness::HardnessReport;
-use crate::perception::centroid::{back_project_mask, median_depth, median_point};
+use crate::perception::centroid::median_depth;
 use crate::perception::colour_name::{colour_name, mean_colour};
 use crate::perception::detect::{DetectError, Detector, RgbdView};
+use crate::perception::grounding::locate;
 use crate::perception::markers::{detect_markers, mean_moved_displacement, track};
-use crate::perception::mask::refine_mask;
 use crate::perception::ssim::ssim_rgb;
 use crate::query::{self, Query, QueryError};
 use glam::DVec3;
@@ -271,33 +271,15 @@ fn ground<C: RgbdCamera>(
         .detect_for(&view, query)?
         .into_iter()
         .filter_map(|d| {
-            let inner = refine_mask(&d.mask);
-            let mut points = back_project_mask(&inner, &depth, &k, &pose);
-            let mut region = &inner;
-            if points.len() < 20 {
-                points = back_project_mask(&d.mask, &depth, &k, &pose);
-                region = &d.mask;
-            }
-            let colour = mean_colour(&frames[0].color, region).map(colour_name);
-            let surface = median_point(&points)?;
-            let mut heights: Vec<f64> = points.iter().map(|p| p.z).collect();
-            heights.sort_by(f64::total_cmp);
-            let top = heights[((heights.len() - 1) as f64 * 0.98).round() as usize];
-            // Press the object's crest near the centroid (a curved fruit's centroid can fall
-            // beside it): the highest mask point within 15 mm, else the nearest one.
-            let near = |p: &&DVec3| p.truncate().distance(surface.truncate());
-            let touch = *points
-                .iter()
-                .filter(|p| near(p) <= 0.015)
-                .max_by(|a, b| a.z.total_cmp(&b.z))
-                .or_else(|| points.iter().min_by(|a, b| near(a).total_cmp(&near(b))))?;
+            let at = locate(&d.mask, true, &depth, &k, &pose)?;
+            let colour = mean_colour(&frames[0].color, &at.mask).map(colour_name);
             Some((
                 Target {
                     label: d.label,
                     score: d.score,
-                    centre: DVec3::new(surface.x, surface.y, top / 2.0),
-                    surface,
-                    touch,
+                    centre: at.centre,
+                    surface: at.surface,
+                    touch: at.touch,
                 },
                 colour.unwrap_or("grey").to_string(),
             ))

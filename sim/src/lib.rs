@@ -14,6 +14,7 @@ pub mod gel_render;
 pub mod gelsight;
 pub mod layer;
 pub mod mesh;
+pub mod perception_error;
 pub mod press_protocol;
 pub mod scene_random;
 pub mod tactile_sample;

@@ -67,7 +67,8 @@ pub fn random_scene(
     let z_cam = scene.camera_pose.position.z;
     let band_px = k.fx * crate::depth_noise::RealSenseNoise::default().baseline_m / z_cam + 4.0;
     let x_min_view = (band_px - k.cx) * z_cam / k.fx;
-    let mut placed: Vec<([f64; 2], f64)> = Vec::new();
+    // Footprints: rotated rectangles (centre, half extents, yaw) tested by separating axes.
+    let mut placed: Vec<Footprint> = Vec::new();
     for &kind in kinds {
         let fruit = catalog
             .get(kind)
@@ -84,24 +85,36 @@ pub fn random_scene(
             (1.0 + variation.size_sigma * normal(&mut rng)).clamp(0.8, 1.2)
         });
         let size_m: [f64; 3] = std::array::from_fn(|i| fruit.size_m[i] * scale[i]);
-        let radius = size_m[0].max(size_m[1]) / 2.0;
-        let lo_x = (-tw / 2.0 + variation.margin_m + radius).max(x_min_view + radius);
-        let hi_x = tw / 2.0 - variation.margin_m - radius;
-        let (lo_y, hi_y) = (
-            -th / 2.0 + variation.margin_m + radius,
-            th / 2.0 - variation.margin_m - radius,
-        );
-        let spot = (0..500).find_map(|_| {
-            let p = [rng.random_range(lo_x..hi_x), rng.random_range(lo_y..hi_y)];
+        let half = [
+            size_m[0] / 2.0 + variation.gap_m / 2.0,
+            size_m[1] / 2.0 + variation.gap_m / 2.0,
+        ];
+        let spot = (0..2000).find_map(|_| {
+            let yaw: f64 = rng.random_range(-180.0..180.0);
+            let (c, s) = (yaw.to_radians().cos().abs(), yaw.to_radians().sin().abs());
+            let reach = [c * half[0] + s * half[1], s * half[0] + c * half[1]];
+            let lo_x = (-tw / 2.0 + variation.margin_m).max(x_min_view) + reach[0];
+            let hi_x = tw / 2.0 - variation.margin_m - reach[0];
+            let lo_y = -th / 2.0 + variation.margin_m + reach[1];
+            let hi_y = th / 2.0 - variation.margin_m - reach[1];
+            if lo_x >= hi_x || lo_y >= hi_y {
+                return None;
+            }
+            let here = Footprint {
+                centre: [rng.random_range(lo_x..hi_x), rng.random_range(lo_y..hi_y)],
+                half,
+                yaw_rad: yaw.to_radians(),
+            };
             placed
                 .iter()
-                .all(|(q, r)| (p[0] - q[0]).hypot(p[1] - q[1]) > r + radius + variation.gap_m)
-                .then_some(p)
+                .all(|p| !p.overlaps(&here))
+                .then_some((here, yaw))
         });
-        let Some(position_m) = spot else {
+        let Some((footprint, yaw_deg)) = spot else {
             return Err(RandomSceneError::NoRoom { count: kinds.len() });
         };
-        placed.push((position_m, radius));
+        let position_m = footprint.centre;
+        placed.push(footprint);
         let brightness = 1.0 + variation.brightness_sigma * normal(&mut rng);
         let color = stage.color.map(|c| {
             (c * brightness + variation.channel_sigma * normal(&mut rng)).clamp(0.02, 0.98)
@@ -114,7 +127,7 @@ pub fn random_scene(
             size_m,
         };
         object.position_m = position_m;
-        object.yaw_deg = rng.random_range(-180.0..180.0);
+        object.yaw_deg = yaw_deg;
         object.hardness = tactex_core::hardness::Hardness::ModulusMpa(stage.modulus_mpa);
         object.ripeness = Some(stage.name.clone());
         object.color = color;
@@ -122,6 +135,37 @@ pub fn random_scene(
         scene.objects.push(object);
     }
     Ok(scene)
+}
+
+/// A fruit's footprint on the table: a rectangle of half extents along its length and width,
+/// turned by its yaw.
+struct Footprint {
+    centre: [f64; 2],
+    half: [f64; 2],
+    yaw_rad: f64,
+}
+
+impl Footprint {
+    fn axes(&self) -> [[f64; 2]; 2] {
+        let (c, s) = (self.yaw_rad.cos(), self.yaw_rad.sin());
+        [[c, s], [-s, c]]
+    }
+
+    /// Separating-axis test of two rotated rectangles.
+    fn overlaps(&self, other: &Footprint) -> bool {
+        let d = [
+            other.centre[0] - self.centre[0],
+            other.centre[1] - self.centre[1],
+        ];
+        let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+        let (ea, eb) = (self.axes(), other.axes());
+        let reach = |f: &Footprint, axes: &[[f64; 2]; 2], n: [f64; 2]| {
+            f.half[0] * dot(axes[0], n).abs() + f.half[1] * dot(axes[1], n).abs()
+        };
+        ea.iter()
+            .chain(eb.iter())
+            .all(|&n| dot(d, n).abs() <= reach(self, &ea, n) + reach(other, &eb, n))
+    }
 }
 
 fn normal(rng: &mut ChaCha8Rng) -> f64 {

@@ -7,6 +7,7 @@ pub mod colour_name;
 pub mod contact;
 pub mod depth;
 pub mod detect;
+pub mod grounding;
 pub mod markers;
 pub mod mask;
 pub mod slopes;
