@@ -11,7 +11,7 @@ use crate::plot::{self, StageGroup};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::DVec3;
-use image::{GrayImage, Luma};
+use image::GrayImage;
 use indicatif::{ProgressBar, ProgressStyle};
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
@@ -28,6 +28,7 @@ use tactex_core::perception::grounding::locate;
 use tactex_core::query;
 use tactex_core::stats::{self, Alternative};
 use tactex_sim::SimDevices;
+use tactex_sim::camera::{InstanceImage, instance_mask};
 use tactex_sim::perception_error::{ErrorProfile, PerceptionErrorDetector};
 use tactex_sim::scene_random::{Variation, random_scene};
 
@@ -116,42 +117,40 @@ struct Report {
     trials: Vec<(String, Vec<Trial>)>,
 }
 
-fn build_detector<'a>(
-    name: &str,
-    catalog: &'a FruitCatalog,
-    truth: &GrayTruth,
-    seed: u64,
-) -> Result<Box<dyn Detector + 'a>> {
+/// The error profile a detector name asks for (None: the classical detector).
+fn error_profile(name: &str) -> Result<Option<ErrorProfile>> {
     if name == "classical" {
-        return Ok(Box::new(ClassicalDetector::new(catalog)));
+        return Ok(None);
     }
     match ErrorProfile::by_name(name) {
-        Some(profile) => Ok(Box::new(PerceptionErrorDetector::new(
-            profile,
-            truth.instances.clone(),
-            truth.labels.clone(),
-            seed,
-        ))),
+        Some(profile) => Ok(Some(profile)),
         None => bail!(
             "--detector: unknown detector '{name}' (known: classical, error-gsam, error-yolo)"
         ),
     }
 }
 
-struct GrayTruth {
-    instances: tactex_sim::camera::InstanceImage,
-    labels: Vec<String>,
+fn build_detector<'a>(
+    name: &str,
+    catalog: &'a FruitCatalog,
+    truth: &Truth,
+    seed: u64,
+) -> Result<Box<dyn Detector + 'a>> {
+    Ok(match error_profile(name)? {
+        None => Box::new(ClassicalDetector::new(catalog)),
+        Some(profile) => Box::new(PerceptionErrorDetector::new(
+            profile,
+            truth.instances.clone(),
+            truth.labels.clone(),
+            seed,
+        )),
+    })
 }
 
-fn mask_of(instances: &tactex_sim::camera::InstanceImage, id: u16) -> GrayImage {
-    let (w, h) = instances.dimensions();
-    GrayImage::from_fn(w, h, |x, y| {
-        Luma([if instances.get_pixel(x, y)[0] == id {
-            255
-        } else {
-            0
-        }])
-    })
+/// The scene's instance ids and the label of each.
+struct Truth {
+    instances: InstanceImage,
+    labels: Vec<String>,
 }
 
 fn iou(a: &GrayImage, b: &GrayImage) -> f64 {
@@ -199,14 +198,14 @@ fn run_instance(i: usize, args: &GroundingEvalArgs, catalog: &FruitCatalog) -> R
     )
     .context("clean depth size")?;
     // The target is object 0 (instance id 1); it is the only one of its kind.
-    let truth_mask = mask_of(&clean.instances, 1);
+    let truth_mask = instance_mask(&clean.instances, 1);
     // The true centroid is the paper's centroid on perfect data: the refined true mask over
     // noise-free depth.
     let truth_centroid = locate(&truth_mask, true, &clean_depth, &k, &pose)
         .context("the target is not visible")?
         .surface;
     let labels: Vec<String> = scene.objects.iter().map(|o| o.label.clone()).collect();
-    let truth = GrayTruth {
+    let truth = Truth {
         instances: clean.instances.clone(),
         labels,
     };
@@ -399,11 +398,7 @@ pub fn run(args: &GroundingEvalArgs) -> Result<()> {
     anyhow::ensure!(!args.detector.is_empty(), "--detector: name at least one");
     let catalog = FruitCatalog::builtin();
     for name in &args.detector {
-        if name != "classical" && ErrorProfile::by_name(name).is_none() {
-            bail!(
-                "--detector: unknown detector '{name}' (known: classical, error-gsam, error-yolo)"
-            );
-        }
+        error_profile(name)?;
     }
     let n = KINDS.len() * args.per_kind;
     let bar = ProgressBar::new(n as u64).with_style(

@@ -267,24 +267,25 @@ fn ground<C: RgbdCamera>(
         intrinsics: &k,
         pose: &pose,
     };
-    let candidates: Vec<(Target, String)> = detector
+    let candidates: Vec<Target> = detector
         .detect_for(&view, query)?
         .into_iter()
         .filter_map(|d| {
             let at = locate(&d.mask, true, &depth, &k, &pose)?;
-            let colour = mean_colour(&frames[0].color, &at.mask).map(colour_name);
-            Some((
-                Target {
-                    label: d.label,
-                    score: d.score,
-                    centre: at.centre,
-                    surface: at.surface,
-                    touch: at.touch,
-                },
-                colour.unwrap_or("grey").to_string(),
-            ))
+            if query.filters.color.is_some() {
+                let colour = mean_colour(&frames[0].color, &at.mask).map_or("grey", colour_name);
+                if !query.filters.colour_matches(colour) {
+                    return None;
+                }
+            }
+            Some(Target {
+                label: d.label,
+                score: d.score,
+                centre: at.centre,
+                surface: at.surface,
+                touch: at.touch,
+            })
         })
-        .filter(|(_, colour)| query.filters.color.as_deref().is_none_or(|c| c == colour))
         .collect();
     let mut targets = apply_position(query, candidates);
     // A stable order: left to right, then front to back.
@@ -298,20 +299,14 @@ fn ground<C: RgbdCamera>(
 
 /// Targets whose location matches the query's position filter. When none does ("the fruit
 /// on the left" with every fruit right of centre), the one furthest that way answers.
-fn apply_position(query: &Query, candidates: Vec<(Target, String)>) -> Vec<Target> {
-    let targets: Vec<Target> = candidates.into_iter().map(|(t, _)| t).collect();
+fn apply_position(query: &Query, targets: Vec<Target>) -> Vec<Target> {
     let Some(filter) = query.filters.position.as_deref() else {
         return targets;
     };
     let located = |t: &Target| location_words(t.centre.x, t.centre.y);
-    if targets
-        .iter()
-        .any(|t| query::position_matches(filter, &located(t)))
-    {
-        return targets
-            .into_iter()
-            .filter(|t| query::position_matches(filter, &located(t)))
-            .collect();
+    let matches = |t: &Target| query.filters.position_matches(&located(t));
+    if targets.iter().any(matches) {
+        return targets.into_iter().filter(matches).collect();
     }
     // How far a target lies in the filter's direction (x right, y back).
     let toward = |t: &Target| -> f64 {

@@ -17,6 +17,18 @@ use tactex_core::geometry::{CameraIntrinsics, Pose};
 /// Instance ids per pixel: 0 for the table and floor, i + 1 for object i.
 pub type InstanceImage = ImageBuffer<Luma<u16>, Vec<u16>>;
 
+/// The mask (255 inside) of one instance id.
+pub fn instance_mask(instances: &InstanceImage, id: u16) -> image::GrayImage {
+    let (w, h) = instances.dimensions();
+    image::GrayImage::from_fn(w, h, |x, y| {
+        Luma([if instances.get_pixel(x, y)[0] == id {
+            255
+        } else {
+            0
+        }])
+    })
+}
+
 /// A noise-free render with ground truth.
 #[derive(Clone)]
 pub struct CleanRender {

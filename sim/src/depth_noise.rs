@@ -130,8 +130,38 @@ mod tests {
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
-    fn plane(w: usize, h: usize, z: f64) -> (Vec<f64>, Vec<[f64; 3]>, Vec<f64>) {
-        (vec![z; w * h], vec![[0.5; 3]; w * h], vec![0.0; w * h])
+    /// A flat clean render at depth z, mid-grey, matte; tests then edit its pixels.
+    struct Plane {
+        w: usize,
+        h: usize,
+        fx: f64,
+        depth: Vec<f64>,
+        color: Vec<[f64; 3]>,
+        specular: Vec<f64>,
+    }
+
+    impl Plane {
+        fn new(w: usize, h: usize, fx: f64, z: f64) -> Self {
+            Self {
+                w,
+                h,
+                fx,
+                depth: vec![z; w * h],
+                color: vec![[0.5; 3]; w * h],
+                specular: vec![0.0; w * h],
+            }
+        }
+
+        fn view(&self) -> CleanDepth<'_> {
+            CleanDepth {
+                width: self.w,
+                height: self.h,
+                depth_m: &self.depth,
+                color: &self.color,
+                specular: &self.specular,
+                fx: self.fx,
+            }
+        }
     }
 
     #[test]
@@ -142,16 +172,8 @@ mod tests {
         };
         let (w, h, fx) = (200, 100, 600.0);
         for z in [0.5, 1.0, 2.0] {
-            let (d, c, s) = plane(w, h, z);
-            let clean = CleanDepth {
-                width: w,
-                height: h,
-                depth_m: &d,
-                color: &c,
-                specular: &s,
-                fx,
-            };
-            let frame = noise.apply(&clean, &mut ChaCha8Rng::seed_from_u64(1));
+            let plane = Plane::new(w, h, fx, z);
+            let frame = noise.apply(&plane.view(), &mut ChaCha8Rng::seed_from_u64(1));
             let valid: Vec<f64> = frame
                 .iter()
                 .filter(|v| **v > 0.0)
@@ -172,16 +194,8 @@ mod tests {
     fn the_left_band_is_invalid_and_as_wide_as_the_disparity() {
         let noise = RealSenseNoise::default();
         let (w, h, fx, z) = (300, 10, 600.0, 0.6);
-        let (d, c, s) = plane(w, h, z);
-        let clean = CleanDepth {
-            width: w,
-            height: h,
-            depth_m: &d,
-            color: &c,
-            specular: &s,
-            fx,
-        };
-        let frame = noise.apply(&clean, &mut ChaCha8Rng::seed_from_u64(2));
+        let plane = Plane::new(w, h, fx, z);
+        let frame = noise.apply(&plane.view(), &mut ChaCha8Rng::seed_from_u64(2));
         let band = noise.invalid_band_px(z, fx);
         assert_eq!(band, 50.0);
         for y in 0..h {
@@ -194,23 +208,15 @@ mod tests {
     fn edges_fly_and_dark_or_specular_spots_drop_out() {
         let noise = RealSenseNoise::default();
         let (w, h, fx) = (200, 40, 600.0);
-        let (mut d, mut c, mut s) = plane(w, h, 0.7);
+        let mut plane = Plane::new(w, h, fx, 0.7);
         for y in 0..h {
             for x in 120..w {
-                d[y * w + x] = 0.6;
+                plane.depth[y * w + x] = 0.6;
             }
-            c[y * w + 100] = [0.02; 3];
-            s[y * w + 110] = 0.6;
+            plane.color[y * w + 100] = [0.02; 3];
+            plane.specular[y * w + 110] = 0.6;
         }
-        let clean = CleanDepth {
-            width: w,
-            height: h,
-            depth_m: &d,
-            color: &c,
-            specular: &s,
-            fx,
-        };
-        let frame = noise.apply(&clean, &mut ChaCha8Rng::seed_from_u64(3));
+        let frame = noise.apply(&plane.view(), &mut ChaCha8Rng::seed_from_u64(3));
         let frame = &frame;
         let col = |x: usize| (0..h).map(move |y| frame[y * w + x]);
         let between = col(119)

@@ -4,7 +4,7 @@
 //! set after the TactEx paper's YOLOv8 and Grounded-SAM (GSAM) comparison, for ablations of
 //! the rest of the pipeline against detector quality.
 
-use crate::camera::InstanceImage;
+use crate::camera::{InstanceImage, instance_mask};
 use image::{GrayImage, Luma};
 use imageproc::distance_transform::Norm;
 use rand::{Rng, SeedableRng};
@@ -120,13 +120,7 @@ impl Detector for PerceptionErrorDetector {
         let mut out = Vec::new();
         for (i, label) in self.labels.iter().enumerate() {
             let id = (i + 1) as u16;
-            let truth = GrayImage::from_fn(w, h, |x, y| {
-                Luma([if self.instances.get_pixel(x, y)[0] == id {
-                    255
-                } else {
-                    0
-                }])
-            });
+            let truth = instance_mask(&self.instances, id);
             // Draw every number whether or not the object is missed, so that one object's
             // miss does not change the next one's draws.
             let missed = rng.random::<f64>() < p.miss_rate;

@@ -48,16 +48,26 @@ pub fn colour_name(rgb: [f64; 3]) -> &'static str {
     }
 }
 
-/// Mean colour in [0, 1] of the pixels a mask (255 inside) covers, leaving out clipped
-/// highlights and near-black pixels, which say little about the surface colour.
+/// Mean colour in [0, 1] of the pixels a mask (255 inside) covers.
 pub fn mean_colour(image: &image::RgbImage, mask: &image::GrayImage) -> Option<[f64; 3]> {
+    mean_surface_colour(
+        image
+            .pixels()
+            .zip(mask.pixels())
+            .filter(|(_, m)| m[0] > 0)
+            .map(|(p, _)| p),
+    )
+}
+
+/// Mean colour in [0, 1] of pixels, leaving out clipped highlights and near-black pixels,
+/// which say little about the surface colour.
+pub fn mean_surface_colour<'a>(
+    pixels: impl Iterator<Item = &'a image::Rgb<u8>>,
+) -> Option<[f64; 3]> {
     let mut sum = [0.0; 3];
     let mut n = 0usize;
-    for (p, m) in image.pixels().zip(mask.pixels()) {
-        if m[0] == 0
-            || p.0.iter().any(|c| *c >= 250)
-            || p.0.iter().map(|c| *c as u32).sum::<u32>() <= 30
-        {
+    for p in pixels {
+        if p.0.iter().any(|c| *c >= 250) || p.0.iter().map(|c| *c as u32).sum::<u32>() <= 30 {
             continue;
         }
         for c in 0..3 {

@@ -5,6 +5,7 @@
 use crate::catalog::FruitCatalog;
 use crate::frames::DepthImage;
 use crate::geometry::{CameraIntrinsics, Pose};
+use crate::perception::colour_name::mean_surface_colour;
 use crate::query::Query;
 use glam::DVec3;
 use image::{GrayImage, Luma, RgbImage};
@@ -183,19 +184,7 @@ fn chromaticity(rgb: [f64; 3]) -> [f64; 2] {
 }
 
 fn mean_chromaticity(img: &RgbImage, pixels: &[(u32, u32)]) -> Option<[f64; 2]> {
-    let mut sum = [0.0; 3];
-    let mut n = 0;
-    for &(u, v) in pixels {
-        let p = img.get_pixel(u, v);
-        // Specular and very dark pixels say little about the surface colour.
-        if p.0.iter().all(|c| *c < 250) && p.0.iter().map(|c| *c as u32).sum::<u32>() > 30 {
-            for c in 0..3 {
-                sum[c] += p[c] as f64;
-            }
-            n += 1;
-        }
-    }
-    (n > 0).then(|| chromaticity(sum))
+    mean_surface_colour(pixels.iter().map(|&(u, v)| img.get_pixel(u, v))).map(chromaticity)
 }
 
 /// Length and width of the points' footprint on the table (2nd-98th percentile along its

@@ -321,28 +321,26 @@ impl Query {
         !self.exclude.iter().any(|e| e == label)
             && (self.all || self.targets.iter().any(|t| t == label))
     }
-
-    /// Whether an object with this label, location words and colour name passes the
-    /// query's targets and filters.
-    pub fn admits(&self, label: &str, location: &str, colour: Option<&str>) -> bool {
-        self.wants(label)
-            && self
-                .filters
-                .color
-                .as_deref()
-                .is_none_or(|c| colour == Some(c))
-            && self
-                .filters
-                .position
-                .as_deref()
-                .is_none_or(|p| position_matches(p, location))
-    }
 }
 
 /// Whether location words ("left front") satisfy a position filter ("left", "left front").
 pub fn position_matches(filter: &str, location: &str) -> bool {
     let at: Vec<&str> = location.split(' ').collect();
     filter.split(' ').all(|w| at.contains(&w))
+}
+
+impl Filters {
+    /// Whether an object of this colour name passes the colour filter (if any).
+    pub fn colour_matches(&self, colour: &str) -> bool {
+        self.color.as_deref().is_none_or(|c| c == colour)
+    }
+
+    /// Whether an object at these location words passes the position filter (if any).
+    pub fn position_matches(&self, location: &str) -> bool {
+        self.position
+            .as_deref()
+            .is_none_or(|p| position_matches(p, location))
+    }
 }
 
 #[cfg(test)]
@@ -639,15 +637,22 @@ mod tests {
         assert!(!query.wants("banana") && query.wants("apple"));
     }
 
+    /// What the pipeline keeps: the label wanted, the colour and the position matching.
+    fn admits(q: &Query, label: &str, location: &str, colour: Option<&str>) -> bool {
+        q.wants(label)
+            && colour.map_or(q.filters.color.is_none(), |c| q.filters.colour_matches(c))
+            && q.filters.position_matches(location)
+    }
+
     #[test]
     fn filters_admit_by_label_colour_and_location() {
         let query = q("How hard is the yellow fruit on the left?");
-        assert!(query.admits("lemon", "left front", Some("yellow")));
-        assert!(!query.admits("lemon", "right front", Some("yellow")));
-        assert!(!query.admits("lime", "left", Some("green")));
+        assert!(admits(&query, "lemon", "left front", Some("yellow")));
+        assert!(!admits(&query, "lemon", "right front", Some("yellow")));
+        assert!(!admits(&query, "lime", "left", Some("green")));
         let query = q("How hard is the banana at the front left?");
-        assert!(query.admits("banana", "left front", None));
-        assert!(!query.admits("banana", "left back", None));
+        assert!(admits(&query, "banana", "left front", None));
+        assert!(!admits(&query, "banana", "left back", None));
     }
 
     #[test]
