@@ -6,9 +6,10 @@
 //! depth and the true mask),
 //! with and without the mask refinement and the 10-frame depth median.
 
+use crate::detector_choice::{DetectorChoice, GroundTruth};
 use crate::output::{write_bytes_atomic, write_json_atomic};
 use crate::plot::{self, StageGroup};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Args;
 use glam::DVec3;
 use image::GrayImage;
@@ -23,13 +24,12 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
 use tactex_core::frames::DepthImage;
 use tactex_core::perception::centroid::median_depth;
-use tactex_core::perception::detect::{ClassicalDetector, Detector, RgbdView};
+use tactex_core::perception::detect::RgbdView;
 use tactex_core::perception::grounding::locate;
 use tactex_core::query;
 use tactex_core::stats::{self, Alternative};
 use tactex_sim::SimDevices;
-use tactex_sim::camera::{InstanceImage, instance_mask};
-use tactex_sim::perception_error::{ErrorProfile, PerceptionErrorDetector};
+use tactex_sim::camera::instance_mask;
 use tactex_sim::scene_random::{Variation, random_scene};
 
 /// The paper's ten fruit kinds.
@@ -39,7 +39,8 @@ pub const KINDS: [&str; 10] = [
 
 #[derive(Args)]
 pub struct GroundingEvalArgs {
-    /// Detectors to compare: classical, error-gsam, error-yolo (perception-error models).
+    /// Detectors to compare: classical, yolo:FILE.onnx (a YOLOv8-seg export), error-gsam,
+    /// error-yolo (perception-error models).
     #[arg(
         long,
         value_delimiter = ',',
@@ -117,42 +118,6 @@ struct Report {
     trials: Vec<(String, Vec<Trial>)>,
 }
 
-/// The error profile a detector name asks for (None: the classical detector).
-fn error_profile(name: &str) -> Result<Option<ErrorProfile>> {
-    if name == "classical" {
-        return Ok(None);
-    }
-    match ErrorProfile::by_name(name) {
-        Some(profile) => Ok(Some(profile)),
-        None => bail!(
-            "--detector: unknown detector '{name}' (known: classical, error-gsam, error-yolo)"
-        ),
-    }
-}
-
-fn build_detector<'a>(
-    name: &str,
-    catalog: &'a FruitCatalog,
-    truth: &Truth,
-    seed: u64,
-) -> Result<Box<dyn Detector + 'a>> {
-    Ok(match error_profile(name)? {
-        None => Box::new(ClassicalDetector::new(catalog)),
-        Some(profile) => Box::new(PerceptionErrorDetector::new(
-            profile,
-            truth.instances.clone(),
-            truth.labels.clone(),
-            seed,
-        )),
-    })
-}
-
-/// The scene's instance ids and the label of each.
-struct Truth {
-    instances: InstanceImage,
-    labels: Vec<String>,
-}
-
 fn iou(a: &GrayImage, b: &GrayImage) -> f64 {
     let (mut inter, mut union) = (0usize, 0usize);
     for (p, q) in a.pixels().zip(b.pixels()) {
@@ -179,7 +144,12 @@ fn instance_kinds(i: usize, per_kind: usize, seed: u64) -> (String, Vec<&'static
     (kind.to_string(), kinds)
 }
 
-fn run_instance(i: usize, args: &GroundingEvalArgs, catalog: &FruitCatalog) -> Result<Vec<Trial>> {
+fn run_instance(
+    i: usize,
+    args: &GroundingEvalArgs,
+    detectors: &[DetectorChoice],
+    catalog: &FruitCatalog,
+) -> Result<Vec<Trial>> {
     let seed = args.seed.wrapping_mul(7919).wrapping_add(i as u64);
     let (fruit, kinds) = instance_kinds(i, args.per_kind, args.seed);
     let scene = random_scene(&kinds, catalog, seed, &Variation::default())?;
@@ -205,10 +175,6 @@ fn run_instance(i: usize, args: &GroundingEvalArgs, catalog: &FruitCatalog) -> R
         .context("the target is not visible")?
         .surface;
     let labels: Vec<String> = scene.objects.iter().map(|o| o.label.clone()).collect();
-    let truth = Truth {
-        instances: clean.instances.clone(),
-        labels,
-    };
     let query = query::parse(
         &format!("I want to know the hardness of the {fruit}"),
         catalog,
@@ -233,8 +199,12 @@ fn run_instance(i: usize, args: &GroundingEvalArgs, catalog: &FruitCatalog) -> R
         locate(mask, refine, depth, &k, &pose).map(|at| horizontal_mm(at.surface, truth_centroid))
     };
     let mut trials = Vec::new();
-    for name in &args.detector {
-        let detector = build_detector(name, catalog, &truth, seed)?;
+    for choice in detectors {
+        let truth = GroundTruth {
+            instances: &clean.instances,
+            labels: &labels,
+        };
+        let detector = choice.detector(catalog, Some(truth), seed)?;
         let best = detector
             .detect_for(&view, &query)?
             .into_iter()
@@ -397,9 +367,11 @@ pub fn run(args: &GroundingEvalArgs) -> Result<()> {
     anyhow::ensure!(args.per_kind >= 1, "--per-kind: must be at least 1");
     anyhow::ensure!(!args.detector.is_empty(), "--detector: name at least one");
     let catalog = FruitCatalog::builtin();
-    for name in &args.detector {
-        error_profile(name)?;
-    }
+    let detectors = args
+        .detector
+        .iter()
+        .map(|spec| DetectorChoice::parse(spec))
+        .collect::<Result<Vec<_>>>()?;
     let n = KINDS.len() * args.per_kind;
     let bar = ProgressBar::new(n as u64).with_style(
         ProgressStyle::with_template("eval grounding [{bar:30}] {pos}/{len} instances, eta {eta}")
@@ -408,7 +380,8 @@ pub fn run(args: &GroundingEvalArgs) -> Result<()> {
     let rows: Vec<Vec<Trial>> = (0..n)
         .into_par_iter()
         .map(|i| {
-            let r = run_instance(i, args, &catalog).with_context(|| format!("instance {i}"));
+            let r = run_instance(i, args, &detectors, &catalog)
+                .with_context(|| format!("instance {i}"));
             bar.inc(1);
             r
         })

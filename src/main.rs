@@ -7,7 +7,9 @@ mod bench_datagen;
 mod bench_render;
 mod calibrate;
 mod compare;
+mod datagen_scenes;
 mod datagen_tactile;
+mod detector_choice;
 mod eval_grounding;
 mod eval_hardness;
 mod eval_ripeness;
@@ -25,7 +27,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::estimate::HertzSlopeEstimator;
-use tactex_core::perception::detect::ClassicalDetector;
 use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_sim::SimDevices;
@@ -57,6 +58,10 @@ enum Command {
         /// Leave out wall-clock times so that the output is byte-reproducible.
         #[arg(long)]
         reproducible: bool,
+        /// Object detector: classical, yolo:FILE.onnx (a YOLOv8-seg export), or a
+        /// perception-error model on the twin's ground truth (error-gsam, error-yolo).
+        #[arg(long, default_value = "classical")]
+        detector: String,
         /// The question.
         prompt: String,
     },
@@ -118,6 +123,9 @@ enum DatagenCommand {
     /// Press sequences (8 frames from first contact, 0.25 mm apart) of randomised objects
     /// and sensors, with hardness labels: pretraining data for tactile hardness models.
     Tactile(datagen_tactile::TactileDatagenArgs),
+    /// RGB-D scenes of random fruits with YOLO segmentation labels and a data.yaml that
+    /// Ultralytics trains on as is; depth, instance masks and ground truth beside them.
+    Scenes(datagen_scenes::SceneDatagenArgs),
 }
 
 #[derive(Subcommand)]
@@ -140,6 +148,7 @@ fn ask(
     seed: u64,
     json: bool,
     reproducible: bool,
+    detector: &str,
     prompt: &str,
 ) -> Result<()> {
     let catalog = FruitCatalog::builtin();
@@ -147,7 +156,19 @@ fn ask(
     tactex_core::query::parse(prompt, &catalog)?;
     let path = scene.unwrap_or_else(default_scene);
     let scene = Scene::load(&path, &catalog)?;
+    let choice = detector_choice::DetectorChoice::parse(detector)?;
     let mut sim = SimDevices::from_scene(&scene, seed)?;
+    // Only the perception-error models look at the ground truth.
+    let instances = matches!(choice, detector_choice::DetectorChoice::PerceptionError(_))
+        .then(|| sim.camera.render_clean().instances);
+    let labels: Vec<String> = scene.objects.iter().map(|o| o.label.clone()).collect();
+    let truth = instances
+        .as_ref()
+        .map(|instances| detector_choice::GroundTruth {
+            instances,
+            labels: &labels,
+        });
+    let detector = choice.detector(&catalog, truth, seed)?;
     let config = PipelineConfig {
         measure_wall_time: !reproducible,
         ..PipelineConfig::default()
@@ -160,7 +181,7 @@ fn ask(
             tactile: &mut sim.tactile,
             arm: &mut sim.arm,
         },
-        &ClassicalDetector::new(&catalog),
+        detector.as_ref(),
         &HertzSlopeEstimator::default(),
         &config,
     )?;
@@ -283,8 +304,9 @@ fn main() -> ExitCode {
             seed,
             json,
             reproducible,
+            detector,
             prompt,
-        } => ask(scene, seed, json, reproducible, &prompt),
+        } => ask(scene, seed, json, reproducible, &detector, &prompt),
         Command::Parse(args) => parse_prompt::run(&args),
         Command::Press(args) => press::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
@@ -302,6 +324,9 @@ fn main() -> ExitCode {
         Command::Datagen {
             command: DatagenCommand::Tactile(args),
         } => datagen_tactile::run(&args),
+        Command::Datagen {
+            command: DatagenCommand::Scenes(args),
+        } => datagen_scenes::run(&args),
         Command::Bench {
             command: BenchCommand::Contact(args),
         } => bench_contact::run(&args),

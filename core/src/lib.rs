@@ -19,6 +19,7 @@ pub mod hertz;
 pub mod indentation_estimator;
 pub mod layer_compliance;
 pub mod onnx_estimator;
+pub mod onnx_metadata;
 pub mod onnx_runtime;
 pub mod perception;
 pub mod photometric;

@@ -103,8 +103,13 @@ impl SimWorld {
             let (lo, _) = rotated.bounds();
             // Rest the lowest point 1 mm above the table and let it drop.
             let start = DVec3::new(o.position_m[0], o.position_m[1], -lo.z + 1e-3);
-            let points = hull_points(local);
-            let collider = ColliderBuilder::convex_hull(&points)
+            // Snapping can leave a degenerate point set for rapier's f32 quickhull (about one
+            // random fruit in 1500): a coarser grid, then the raw vertices, are tried next.
+            let collider = [1e-3, 1.7e-3]
+                .into_iter()
+                .map(|grid| hull_points(local, grid))
+                .chain(std::iter::once(raw_points(local)))
+                .find_map(|points| ColliderBuilder::convex_hull(&points))
                 .ok_or_else(|| WorldError::Object {
                     scene: shown.clone(),
                     index,
@@ -174,18 +179,28 @@ impl SimWorld {
     }
 }
 
-/// Mesh vertices snapped to a 1 mm grid and deduplicated: clusters of nearly coincident
+/// Mesh vertices snapped to a grid (m) and deduplicated: clusters of nearly coincident
 /// points (tapered tips, dense scans) make convex hulls that rapier cannot rest stably.
-fn hull_points(mesh: &TriMesh) -> Vec<Vector> {
+fn hull_points(mesh: &TriMesh, grid_m: f64) -> Vec<Vector> {
     let mut keys: Vec<[i64; 3]> = mesh
         .vertices
         .iter()
-        .map(|v| (*v * 1e3).round().as_i64vec3().to_array())
+        .map(|v| (*v / grid_m).round().as_i64vec3().to_array())
         .collect();
     keys.sort_unstable();
     keys.dedup();
     keys.into_iter()
-        .map(|k| Vector::new(k[0] as f32 * 1e-3, k[1] as f32 * 1e-3, k[2] as f32 * 1e-3))
+        .map(|k| {
+            let p = glam::I64Vec3::from_array(k).as_dvec3() * grid_m;
+            Vector::new(p.x as f32, p.y as f32, p.z as f32)
+        })
+        .collect()
+}
+
+fn raw_points(mesh: &TriMesh) -> Vec<Vector> {
+    mesh.vertices
+        .iter()
+        .map(|v| Vector::new(v.x as f32, v.y as f32, v.z as f32))
         .collect()
 }
 

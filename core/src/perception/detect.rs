@@ -63,6 +63,25 @@ pub trait Detector {
     }
 }
 
+/// A borrowed detector detects as its owner does (one loaded model serves many views).
+impl<D: Detector + ?Sized> Detector for &D {
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+
+    fn detect(&self, view: &RgbdView<'_>) -> Result<Vec<Detection>, DetectError> {
+        (**self).detect(view)
+    }
+
+    fn detect_for(
+        &self,
+        view: &RgbdView<'_>,
+        query: &Query,
+    ) -> Result<Vec<Detection>, DetectError> {
+        (**self).detect_for(view, query)
+    }
+}
+
 pub struct ClassicalDetector<'a> {
     pub catalog: &'a FruitCatalog,
     /// Points this far above the table belong to objects.
@@ -189,6 +208,22 @@ fn mean_chromaticity(img: &RgbImage, pixels: &[(u32, u32)]) -> Option<[f64; 2]> 
 
 /// Length and width of the points' footprint on the table (2nd-98th percentile along its
 /// principal axes) and their height (98th percentile of z).
+/// Footprint extents (length, width, height in m) of the depth points under a mask.
+pub fn mask_footprint(view: &RgbdView<'_>, mask: &GrayImage) -> Option<[f64; 3]> {
+    let points: Vec<DVec3> = mask
+        .enumerate_pixels()
+        .filter(|(_, _, m)| m[0] > 0)
+        .filter_map(|(u, v, _)| {
+            let z = f64::from(view.depth.get_pixel_checked(u, v)?[0]);
+            (z > 0.0 && z.is_finite()).then(|| {
+                view.pose
+                    .transform_point(view.intrinsics.back_project(u as f64, v as f64, z))
+            })
+        })
+        .collect();
+    footprint(&points)
+}
+
 fn footprint(points: &[DVec3]) -> Option<[f64; 3]> {
     if points.len() < 10 {
         return None;

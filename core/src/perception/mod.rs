@@ -12,3 +12,4 @@ pub mod markers;
 pub mod mask;
 pub mod slopes;
 pub mod ssim;
+pub mod yolo_seg;
