@@ -339,7 +339,7 @@ fn preview(rendered: &[Rendered]) -> Option<RgbImage> {
     Some(sheet)
 }
 
-fn class_colour(class: usize) -> Rgb<u8> {
+pub fn class_colour(class: usize) -> Rgb<u8> {
     const PALETTE: [[u8; 3]; 8] = [
         [255, 56, 56],
         [50, 205, 50],

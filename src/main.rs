@@ -9,6 +9,7 @@ mod calibrate;
 mod compare;
 mod datagen_scenes;
 mod datagen_tactile;
+mod detect_image;
 mod detector_choice;
 mod eval_grounding;
 mod eval_hardness;
@@ -76,6 +77,8 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Marker centroids on a tactile frame, and displacements against a reference frame.
     Markers(markers::MarkersArgs),
+    /// A YOLOv8-seg ONNX model on one colour image: boxes, scores, masks, an overlay PNG.
+    Detect(detect_image::DetectArgs),
     /// Evaluations on the twin.
     Eval {
         #[command(subcommand)]
@@ -312,6 +315,7 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Markers(args) => markers::run(&args),
+        Command::Detect(args) => detect_image::run(&args),
         Command::Eval {
             command: EvalCommand::Grounding(args),
         } => eval_grounding::run(&args),
