@@ -32,6 +32,7 @@ use std::path::{Path, PathBuf};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
+use tactex_core::perception::mask::mask_box;
 use tactex_sim::SimDevices;
 use tactex_sim::camera::{InstanceImage, instance_mask};
 use tactex_sim::scene_random::{Variation, random_scene};
@@ -117,8 +118,10 @@ pub fn parse_range(text: &str) -> Result<[usize; 2]> {
     }
 }
 
-fn is_val(index: usize, fraction: f64) -> bool {
-    ((index + 1) as f64 * fraction).floor() > (index as f64 * fraction).floor()
+/// The split of scene `index`: validation scenes spread evenly over the indices.
+fn split(index: usize, val_fraction: f64) -> &'static str {
+    let val = ((index + 1) as f64 * val_fraction).floor() > (index as f64 * val_fraction).floor();
+    if val { "val" } else { "train" }
 }
 
 fn scene_seed(seed: u64, index: usize) -> u64 {
@@ -160,18 +163,6 @@ fn label_line(class: usize, polygon: &[Point<i32>], width: u32, height: u32) -> 
     line
 }
 
-fn mask_box(mask: &GrayImage) -> Option<([u32; 4], u32)> {
-    let mut b = [u32::MAX, u32::MAX, 0, 0];
-    let mut n = 0;
-    for (x, y, p) in mask.enumerate_pixels() {
-        if p[0] > 0 {
-            b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
-            n += 1;
-        }
-    }
-    (n > 0).then_some((b, n))
-}
-
 struct Rendered {
     color: RgbImage,
     depth_mm: Vec<u16>,
@@ -181,13 +172,8 @@ struct Rendered {
     polygons: Vec<(usize, Vec<Point<i32>>)>,
 }
 
-fn render_scene(
-    index: usize,
-    args: &SceneDatagenArgs,
-    info: &DatasetInfo,
-    catalog: &FruitCatalog,
-) -> Result<Rendered> {
-    let seed = scene_seed(args.seed, index);
+fn render_scene(index: usize, info: &DatasetInfo, catalog: &FruitCatalog) -> Result<Rendered> {
+    let seed = scene_seed(info.seed, index);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let n = rng.random_range(info.fruits[0]..=info.fruits[1]);
     let kinds: Vec<&str> = (0..n)
@@ -250,11 +236,7 @@ fn render_scene(
         instances: clean.instances,
         meta: SceneMeta {
             index,
-            split: if is_val(index, info.val_fraction) {
-                "val"
-            } else {
-                "train"
-            },
+            split: split(index, info.val_fraction),
             seed,
             intrinsics: k,
             camera_pose: pose,
@@ -436,15 +418,8 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
                 .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
         }
     }
-    let split_of = |i: usize| {
-        if is_val(i, info.val_fraction) {
-            "val"
-        } else {
-            "train"
-        }
-    };
     let todo: Vec<usize> = (0..args.count)
-        .filter(|&i| !scene_paths(&root, i, split_of(i))[1].exists())
+        .filter(|&i| !scene_paths(&root, i, split(i, info.val_fraction))[1].exists())
         .collect();
     let bar = ProgressBar::new(todo.len() as u64).with_style(
         ProgressStyle::with_template("scenes [{bar:40}] {pos}/{len}, {per_sec}, eta {eta}")
@@ -457,7 +432,7 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
     let labels = todo
         .par_iter()
         .map(|&i| -> Result<(usize, Option<Rendered>)> {
-            let r = render_scene(i, args, &info, &catalog)?;
+            let r = render_scene(i, &info, &catalog)?;
             write_scene(&root, &r)?;
             bar.inc(1);
             let n = r.polygons.len();

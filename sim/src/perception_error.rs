@@ -12,6 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use std::sync::Mutex;
 use tactex_core::perception::detect::{DetectError, Detection, Detector, RgbdView};
+use tactex_core::perception::mask::mask_box;
 
 /// How one detector errs.
 #[derive(Clone, Debug, PartialEq)]
@@ -147,22 +148,9 @@ impl Detector for PerceptionErrorDetector {
                     Luma([0])
                 }
             });
-            let mut bbox = [u32::MAX, u32::MAX, 0, 0];
-            let mut any = false;
-            for (x, y, v) in mask.enumerate_pixels() {
-                if v[0] > 0 {
-                    any = true;
-                    bbox = [
-                        bbox[0].min(x),
-                        bbox[1].min(y),
-                        bbox[2].max(x),
-                        bbox[3].max(y),
-                    ];
-                }
-            }
-            if !any {
+            let Some((bbox, _)) = mask_box(&mask) else {
                 continue;
-            }
+            };
             out.push(Detection {
                 label: label.clone(),
                 score,

@@ -4,6 +4,20 @@
 use image::{GrayImage, Luma};
 use imageproc::distance_transform::Norm;
 
+/// The box of a mask's set pixels, [x_min, y_min, x_max, y_max] (inclusive), and their
+/// count; None for an empty mask.
+pub fn mask_box(mask: &GrayImage) -> Option<([u32; 4], u32)> {
+    let mut b = [u32::MAX, u32::MAX, 0, 0];
+    let mut n = 0;
+    for (x, y, p) in mask.enumerate_pixels() {
+        if p[0] > 0 {
+            b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+            n += 1;
+        }
+    }
+    (n > 0).then_some((b, n))
+}
+
 /// Binary mask (255 inside) -> inner mask.
 pub fn refine_mask(mask: &GrayImage) -> GrayImage {
     let edges = imageproc::edges::canny(mask, 50.0, 100.0);
@@ -24,6 +38,15 @@ pub fn refine_mask(mask: &GrayImage) -> GrayImage {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mask_box_spans_the_set_pixels_inclusively() {
+        let mut m = GrayImage::new(10, 8);
+        assert_eq!(mask_box(&m), None);
+        m.put_pixel(2, 5, Luma([255]));
+        m.put_pixel(7, 1, Luma([1]));
+        assert_eq!(mask_box(&m), Some(([2, 1, 7, 5], 2)));
+    }
 
     #[test]
     fn refinement_shrinks_a_disc_by_its_edge_band() {
