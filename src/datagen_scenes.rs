@@ -29,13 +29,16 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::perception::mask::mask_box;
 use tactex_sim::SimDevices;
 use tactex_sim::camera::{InstanceImage, instance_mask};
+use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_random::{Variation, random_scene};
+use tactex_sim::scene_render::{SceneRenderer, open_scene_renderer};
 
 const FORMAT: &str = "tactex-scene-dataset/1";
 /// Douglas-Peucker tolerance of the label polygons (px): keeps them within a pixel of the
@@ -64,6 +67,10 @@ pub struct SceneDatagenArgs {
     /// Share of scenes in the validation split, spread evenly over the indices.
     #[arg(long, default_value_t = 0.2)]
     pub val_fraction: f64,
+    /// Device that renders the scenes: cpu (the default, so that the data never depends on
+    /// the machine), gpu (any Vulkan adapter) or auto (a hardware GPU if there is one).
+    #[arg(long, default_value = "cpu")]
+    pub device: DeviceChoice,
 }
 
 /// Settings every run into one directory shares.
@@ -79,6 +86,14 @@ struct DatasetInfo {
     width: u32,
     height: u32,
     depth_unit_m: f64,
+    /// "cpu" or "gpu": the two agree to f32 precision, not to the byte, so one data set
+    /// keeps to one. Sets from before the GPU path were rendered on the CPU.
+    #[serde(default = "cpu_renderer")]
+    renderer: String,
+}
+
+fn cpu_renderer() -> String {
+    "cpu".into()
 }
 
 #[derive(Serialize)]
@@ -172,7 +187,12 @@ struct Rendered {
     polygons: Vec<(usize, Vec<Point<i32>>)>,
 }
 
-fn render_scene(index: usize, info: &DatasetInfo, catalog: &FruitCatalog) -> Result<Rendered> {
+fn render_scene(
+    index: usize,
+    info: &DatasetInfo,
+    catalog: &FruitCatalog,
+    renderer: &Arc<dyn SceneRenderer>,
+) -> Result<Rendered> {
     let seed = scene_seed(info.seed, index);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let n = rng.random_range(info.fruits[0]..=info.fruits[1]);
@@ -182,7 +202,8 @@ fn render_scene(index: usize, info: &DatasetInfo, catalog: &FruitCatalog) -> Res
     let scene = random_scene(&kinds, catalog, seed, &Variation::default())
         .with_context(|| format!("scene {index}"))?;
     let mut sim = SimDevices::from_scene(&scene, seed).with_context(|| format!("scene {index}"))?;
-    let clean = sim.camera.render_clean();
+    sim.camera.set_renderer(renderer.clone());
+    let clean = sim.camera.clean()?.clone();
     let frame = sim
         .camera
         .capture()
@@ -378,6 +399,12 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
         }
         args.kinds.clone()
     };
+    // The renderer first: a missing device fails before anything is written.
+    let choice = open_scene_renderer(args.device)?;
+    if let Some(note) = &choice.note {
+        eprintln!("note: {note}");
+    }
+    let renderer = choice.renderer;
     let info = DatasetInfo {
         format: FORMAT.into(),
         count: args.count,
@@ -389,6 +416,12 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
         width: 640,
         height: 480,
         depth_unit_m: 0.001,
+        renderer: if renderer.name() == "cpu" {
+            "cpu"
+        } else {
+            "gpu"
+        }
+        .into(),
     };
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("{}: cannot create the directory", args.out.display()))?;
@@ -403,9 +436,18 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
         let theirs: DatasetInfo = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a tactex scene data set", info_path.display()))?;
         if theirs != info {
+            let (theirs, ours) = (serde_json::to_value(&theirs)?, serde_json::to_value(&info)?);
+            let fields: Vec<&str> = ours
+                .as_object()
+                .expect("a struct")
+                .iter()
+                .filter(|(k, v)| theirs.get(k.as_str()) != Some(*v))
+                .map(|(k, _)| k.as_str())
+                .collect();
             bail!(
-                "{}: this directory holds a data set with other settings; use another --out",
-                info_path.display()
+                "{}: this directory holds a data set with other settings (differing: {}); use another --out",
+                info_path.display(),
+                fields.join(", ")
             );
         }
     } else {
@@ -432,7 +474,7 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
     let labels = todo
         .par_iter()
         .map(|&i| -> Result<(usize, Option<Rendered>)> {
-            let r = render_scene(i, &info, &catalog)?;
+            let r = render_scene(i, &info, &catalog, &renderer)?;
             write_scene(&root, &r)?;
             bar.inc(1);
             let n = r.polygons.len();

@@ -20,6 +20,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
+use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
 use tactex_core::frames::DepthImage;
@@ -30,7 +31,9 @@ use tactex_core::query;
 use tactex_core::stats::{self, Alternative};
 use tactex_sim::SimDevices;
 use tactex_sim::camera::instance_mask;
+use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_random::{Variation, random_scene};
+use tactex_sim::scene_render::{SceneRenderer, open_scene_renderer};
 
 /// The paper's ten fruit kinds.
 pub const KINDS: [&str; 10] = [
@@ -63,6 +66,10 @@ pub struct GroundingEvalArgs {
     /// Write results.json, table.md and PNG plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Device that renders the scenes: cpu (the default, so that the figures never depend
+    /// on the machine), gpu (any Vulkan adapter) or auto (a hardware GPU if there is one).
+    #[arg(long, default_value = "cpu")]
+    pub device: DeviceChoice,
 }
 
 /// One detector on one instance.
@@ -149,12 +156,14 @@ fn run_instance(
     args: &GroundingEvalArgs,
     detectors: &[DetectorChoice],
     catalog: &FruitCatalog,
+    renderer: &Arc<dyn SceneRenderer>,
 ) -> Result<Vec<Trial>> {
     let seed = args.seed.wrapping_mul(7919).wrapping_add(i as u64);
     let (fruit, kinds) = instance_kinds(i, args.per_kind, args.seed);
     let scene = random_scene(&kinds, catalog, seed, &Variation::default())?;
     let mut sim = SimDevices::from_scene(&scene, seed)?;
-    let clean = sim.camera.render_clean();
+    sim.camera.set_renderer(renderer.clone());
+    let clean = sim.camera.clean()?.clone();
     let (k, pose) = (sim.camera.intrinsics(), sim.camera.pose());
     let frames = (0..args.depth_frames.max(1))
         .map(|_| sim.camera.capture())
@@ -372,6 +381,11 @@ pub fn run(args: &GroundingEvalArgs) -> Result<()> {
         .iter()
         .map(|spec| DetectorChoice::parse(spec))
         .collect::<Result<Vec<_>>>()?;
+    let choice = open_scene_renderer(args.device)?;
+    if let Some(note) = &choice.note {
+        eprintln!("note: {note}");
+    }
+    let renderer = choice.renderer;
     let n = KINDS.len() * args.per_kind;
     let bar = ProgressBar::new(n as u64).with_style(
         ProgressStyle::with_template("eval grounding [{bar:30}] {pos}/{len} instances, eta {eta}")
@@ -380,7 +394,7 @@ pub fn run(args: &GroundingEvalArgs) -> Result<()> {
     let rows: Vec<Vec<Trial>> = (0..n)
         .into_par_iter()
         .map(|i| {
-            let r = run_instance(i, args, &detectors, &catalog)
+            let r = run_instance(i, args, &detectors, &catalog, &renderer)
                 .with_context(|| format!("instance {i}"));
             bar.inc(1);
             r

@@ -5,6 +5,7 @@ mod ball_presses;
 mod bench_contact;
 mod bench_datagen;
 mod bench_render;
+mod bench_scene;
 mod calibrate;
 mod compare;
 mod datagen_scenes;
@@ -31,6 +32,8 @@ use tactex_core::estimate::HertzSlopeEstimator;
 use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_sim::SimDevices;
+use tactex_sim::render_device::DeviceChoice;
+use tactex_sim::scene_render::open_scene_renderer;
 
 #[derive(Parser)]
 #[command(
@@ -63,6 +66,11 @@ enum Command {
         /// perception-error model on the twin's ground truth (error-gsam, error-yolo).
         #[arg(long, default_value = "classical")]
         detector: String,
+        /// Device that renders the camera's frames: cpu, gpu (any Vulkan adapter, software
+        /// included) or auto (a hardware GPU if there is one). One clean render serves a
+        /// whole question, so the CPU default costs little (see `tactex bench scene`).
+        #[arg(long, default_value = "cpu")]
+        device: DeviceChoice,
         /// The question.
         prompt: String,
     },
@@ -109,6 +117,8 @@ enum BenchCommand {
     Render(bench_render::RenderBenchArgs),
     /// Press sequences per second of `datagen tactile` for each fidelity level.
     Datagen(bench_datagen::DatagenBenchArgs),
+    /// RGB-D scene rendering (640x480 colour, depth, instance ids), CPU and GPU paths.
+    Scene(bench_scene::SceneBenchArgs),
 }
 
 #[derive(Subcommand)]
@@ -137,7 +147,7 @@ enum SceneCommand {
     Check { file: PathBuf },
 }
 
-fn default_scene() -> PathBuf {
+pub(crate) fn default_scene() -> PathBuf {
     let local = Path::new("scenes/demo.toml");
     if local.is_file() {
         local.to_path_buf()
@@ -152,6 +162,7 @@ fn ask(
     json: bool,
     reproducible: bool,
     detector: &str,
+    device: DeviceChoice,
     prompt: &str,
 ) -> Result<()> {
     let catalog = FruitCatalog::builtin();
@@ -160,10 +171,18 @@ fn ask(
     let path = scene.unwrap_or_else(default_scene);
     let scene = Scene::load(&path, &catalog)?;
     let choice = detector_choice::DetectorChoice::parse(detector)?;
+    let renderer = open_scene_renderer(device)?;
+    if let Some(note) = &renderer.note {
+        eprintln!("note: {note}");
+    }
     let mut sim = SimDevices::from_scene(&scene, seed)?;
+    sim.camera.set_renderer(renderer.renderer);
     // Only the perception-error models look at the ground truth.
-    let instances = matches!(choice, detector_choice::DetectorChoice::PerceptionError(_))
-        .then(|| sim.camera.render_clean().instances);
+    let instances = if matches!(choice, detector_choice::DetectorChoice::PerceptionError(_)) {
+        Some(sim.camera.clean()?.instances.clone())
+    } else {
+        None
+    };
     let labels: Vec<String> = scene.objects.iter().map(|o| o.label.clone()).collect();
     let truth = instances
         .as_ref()
@@ -308,8 +327,9 @@ fn main() -> ExitCode {
             json,
             reproducible,
             detector,
+            device,
             prompt,
-        } => ask(scene, seed, json, reproducible, &detector, &prompt),
+        } => ask(scene, seed, json, reproducible, &detector, device, &prompt),
         Command::Parse(args) => parse_prompt::run(&args),
         Command::Press(args) => press::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
@@ -340,6 +360,9 @@ fn main() -> ExitCode {
         Command::Bench {
             command: BenchCommand::Datagen(args),
         } => bench_datagen::run(&args),
+        Command::Bench {
+            command: BenchCommand::Scene(args),
+        } => bench_scene::run(&args),
         Command::Scene {
             command: SceneCommand::Check { file },
         } => scene_check(&file),

@@ -82,6 +82,50 @@ fn demo_scene_answers_the_softest_fruit_with_positions_hardness_and_latency() {
 }
 
 #[test]
+fn the_gpu_rendered_camera_finds_the_same_fruit_at_the_same_place() {
+    let run = |device| {
+        tactex(&[
+            "ask",
+            "--json",
+            "--reproducible",
+            "--device",
+            device,
+            "--scene",
+            "scenes/demo.toml",
+            "Which fruit is the softest?",
+        ])
+    };
+    let gpu = run("gpu");
+    let err = String::from_utf8_lossy(&gpu.stderr).to_string();
+    // In CI (CI=true) the GPU path must really run (lavapipe); elsewhere it may be missing.
+    if !gpu.status.success() && err.contains("no Vulkan adapter") && std::env::var("CI").is_err() {
+        eprintln!("skipping the GPU path: {err}");
+        return;
+    }
+    assert!(gpu.status.success(), "{err}");
+    let cpu = run("cpu");
+    let (gpu, cpu): (Value, Value) = (
+        serde_json::from_slice(&gpu.stdout).unwrap(),
+        serde_json::from_slice(&cpu.stdout).unwrap(),
+    );
+    assert_eq!(selected_labels(&gpu), vec!["tomato"]);
+    let (g, c) = (
+        gpu["objects"].as_array().unwrap(),
+        cpu["objects"].as_array().unwrap(),
+    );
+    assert_eq!(g.len(), c.len());
+    for (g, c) in g.iter().zip(c) {
+        assert_eq!(g["label"], c["label"]);
+        // The renders agree to f32 precision; the noise drawn over them differs where a
+        // pixel's fate differs, so centroids agree to a fraction of the 5 mm tolerance.
+        for k in 0..3 {
+            let d = g["position_m"][k].as_f64().unwrap() - c["position_m"][k].as_f64().unwrap();
+            assert!(d.abs() < 3e-3, "{}: {d} m apart", g["label"]);
+        }
+    }
+}
+
+#[test]
 fn five_fruits_are_found_placed_and_ordered_by_hardness() {
     let catalog = FruitCatalog::builtin();
     let scene = Scene::load(&repo("tests/scenes/five.toml"), &catalog).unwrap();

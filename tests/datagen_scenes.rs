@@ -242,9 +242,41 @@ fn same_seed_same_bytes_and_an_interrupted_run_resumes() {
     // Other settings into the same directory are refused.
     let err = one_line_error(&datagen(&a, "5"));
     assert!(
-        err.contains("dataset.json") && err.contains("other settings"),
+        err.contains("dataset.json") && err.contains("other settings") && err.contains("seed"),
         "{err}"
     );
+}
+
+#[test]
+fn gpu_rendered_sets_say_so_and_are_not_mixed_with_cpu_renders() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("gpu");
+    let args = |device: &'static str| {
+        let dir = dir.to_str().unwrap().to_string();
+        move |extra: &[&str]| {
+            let mut all = vec!["datagen", "scenes", "--count", "2", "--seed", "9"];
+            all.extend_from_slice(&["--out", &dir, "--device", device]);
+            all.extend_from_slice(extra);
+            tactex(&all)
+        }
+    };
+    let out = args("gpu")(&[]);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    // In CI (CI=true) the GPU path must really run (lavapipe); elsewhere it may be missing.
+    if !out.status.success() && err.contains("no Vulkan adapter") && std::env::var("CI").is_err() {
+        eprintln!("skipping the GPU path: {err}");
+        return;
+    }
+    ok(out);
+    let info: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("dataset.json")).unwrap()).unwrap();
+    assert_eq!(info["renderer"], "gpu");
+    assert_eq!(
+        files(&dir.join("labels/train")).len() + files(&dir.join("labels/val")).len(),
+        2
+    );
+    let err = one_line_error(&args("cpu")(&[]));
+    assert!(err.contains("renderer"), "{err}");
 }
 
 #[test]

@@ -16,7 +16,9 @@ pub mod layer;
 pub mod mesh;
 pub mod perception_error;
 pub mod press_protocol;
+pub mod render_device;
 pub mod scene_random;
+pub mod scene_render;
 pub mod tactile_sample;
 pub mod world;
 

@@ -78,7 +78,7 @@ pub struct PerceptionErrorDetector {
 }
 
 impl PerceptionErrorDetector {
-    /// `instances` from `SimCamera::render_clean`, `labels` in the world's object order.
+    /// `instances` from `SimCamera::clean`, `labels` in the world's object order.
     pub fn new(
         profile: ErrorProfile,
         instances: InstanceImage,

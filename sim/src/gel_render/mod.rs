@@ -14,9 +14,10 @@ mod fields;
 mod gpu;
 mod noise;
 
+pub use crate::render_device::{DeviceChoice, RenderError, adapters};
 pub use calibration::{CALIBRATION_FORMAT, FitReport, GelCalibration};
 pub use cpu::CpuRenderer;
-pub use device::{DeviceChoice, RendererChoice, adapters, open_renderer};
+pub use device::{RendererChoice, open_renderer};
 pub use fields::image_fields;
 pub use fields::{pad_rect, pixel_centre_mm};
 pub use gpu::{GpuRenderer, SHADER_SOURCES, shader_source};
@@ -87,18 +88,6 @@ impl GelImageFields {
 pub struct PressFrame<'a> {
     pub fields: &'a GelImageFields,
     pub seed: u32,
-}
-
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum RenderError {
-    #[error("{field}: {message}")]
-    Invalid { field: String, message: String },
-    #[error(
-        "--device gpu: no Vulkan adapter found ({found}); install a GPU driver, or Debian's mesa-vulkan-drivers and libvulkan1 for software Vulkan, or use --device cpu"
-    )]
-    NoAdapter { found: String },
-    #[error("GPU device {adapter}: {message}")]
-    Device { adapter: String, message: String },
 }
 
 pub(crate) fn invalid(field: &str, message: impl Into<String>) -> RenderError {
