@@ -5,6 +5,7 @@
 //! path.
 
 use std::str::FromStr;
+use std::sync::{Arc, Mutex};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DeviceChoice {
@@ -110,5 +111,123 @@ pub fn pick_adapter(choice: DeviceChoice) -> Result<AdapterPick, RenderError> {
                 }),
             }
         }
+    }
+}
+
+/// A wgpu device on one adapter whose validation errors come back as `RenderError`s, never
+/// as panics.
+pub struct GpuDevice {
+    /// The adapter's name, type and backend, as errors and reports show it.
+    pub name: String,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub limits: wgpu::Limits,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+impl GpuDevice {
+    pub fn open(adapter: &wgpu::Adapter, label: &str) -> Result<Self, RenderError> {
+        let info = adapter.get_info();
+        let name = format!("{} ({:?}, {:?})", info.name, info.device_type, info.backend);
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some(label),
+            required_features: wgpu::Features::empty(),
+            required_limits: limits.clone(),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device {
+            adapter: name.clone(),
+            message: e.to_string(),
+        })?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock().expect("error sink").push(e.to_string());
+        }));
+        Ok(Self {
+            name,
+            device,
+            queue,
+            limits,
+            errors,
+        })
+    }
+
+    pub fn error(&self, message: impl ToString) -> RenderError {
+        RenderError::Device {
+            adapter: self.name.clone(),
+            message: message.to_string(),
+        }
+    }
+
+    /// The validation errors raised since the last call, as one error.
+    pub fn take_errors(&self) -> Result<(), RenderError> {
+        let mut errors = self.errors.lock().expect("error sink");
+        if errors.is_empty() {
+            return Ok(());
+        }
+        let message = errors.join("; ");
+        errors.clear();
+        Err(self.error(message))
+    }
+
+    /// Submits the commands, waits for them, and hands the mapped `readback` buffer to `read`.
+    pub fn submit_and_read<T>(
+        &self,
+        encoder: wgpu::CommandEncoder,
+        readback: &wgpu::Buffer,
+        read: impl FnOnce(&[u8]) -> T,
+    ) -> Result<T, RenderError> {
+        self.queue.submit([encoder.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        readback.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| self.error(e))?;
+        self.take_errors()?;
+        rx.recv()
+            .map_err(|e| self.error(e))?
+            .map_err(|e| self.error(e))?;
+        let view = readback.get_mapped_range(..).map_err(|e| self.error(e))?;
+        let out = read(&view);
+        drop(view);
+        readback.unmap();
+        Ok(out)
+    }
+}
+
+/// Shader checks shared by both renderers' unit tests.
+#[cfg(test)]
+pub(crate) mod shader_checks {
+    use wgpu::naga;
+
+    /// Parses and validates WGSL with naga, panicking with the located message.
+    pub fn validated(label: &str, source: &str) -> naga::Module {
+        let module = naga::front::wgsl::parse_str(source)
+            .unwrap_or_else(|e| panic!("{label}: {}", e.emit_to_string(source)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::empty(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{label}: {}", e.emit_to_string(source)));
+        module
+    }
+
+    /// The size in bytes of the WGSL struct `name`, laid out as the shader sees it.
+    pub fn struct_size(source: &str, name: &str) -> usize {
+        let module = naga::front::wgsl::parse_str(source).unwrap();
+        let ty = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no struct {name}"))
+            .0;
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        layouter[ty].size as usize
     }
 }

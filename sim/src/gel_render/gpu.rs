@@ -5,8 +5,8 @@
 use super::{
     GelImageFields, GelRenderer, PressFrame, RenderError, RenderParams, SensorOptics, Shading,
 };
+use crate::render_device::GpuDevice;
 use image::RgbImage;
-use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
 
 const COMMON: &str = include_str!("../../../shaders/common.wgsl");
@@ -43,81 +43,42 @@ pub fn shader_source(stage: &str) -> Option<String> {
 const MAX_FRAMES_PER_DISPATCH: usize = 64;
 
 pub struct GpuRenderer {
-    adapter: String,
-    device: wgpu::Device,
-    queue: wgpu::Queue,
+    gpu: GpuDevice,
     /// slopes, shading, marker displacement, exposure.
     pipelines: [wgpu::ComputePipeline; 4],
-    max_binding_bytes: u64,
-    errors: Arc<Mutex<Vec<String>>>,
 }
 
 impl GpuRenderer {
     pub fn new(adapter: &wgpu::Adapter) -> Result<Self, RenderError> {
-        let info = adapter.get_info();
-        let name = format!("{} ({:?}, {:?})", info.name, info.device_type, info.backend);
-        let limits = adapter.limits();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("tactex gel renderer"),
-            required_features: wgpu::Features::empty(),
-            required_limits: limits.clone(),
-            ..Default::default()
-        }))
-        .map_err(|e| RenderError::Device {
-            adapter: name.clone(),
-            message: e.to_string(),
-        })?;
-        // Validation errors come back as a render error, never a panic.
-        let errors = Arc::new(Mutex::new(Vec::new()));
-        let sink = errors.clone();
-        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-            sink.lock().expect("error sink").push(e.to_string());
-        }));
+        let gpu = GpuDevice::open(adapter, "tactex gel renderer")?;
         let pipelines = SHADER_SOURCES.map(|(stage, _)| {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(stage),
-                source: wgpu::ShaderSource::Wgsl(
-                    shader_source(stage).expect("listed stage").into(),
-                ),
-            });
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(stage),
-                layout: None,
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
+            let module = gpu
+                .device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(stage),
+                    source: wgpu::ShaderSource::Wgsl(
+                        shader_source(stage).expect("listed stage").into(),
+                    ),
+                });
+            gpu.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(stage),
+                    layout: None,
+                    module: &module,
+                    entry_point: Some("main"),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
         });
-        let renderer = Self {
-            adapter: name,
-            device,
-            queue,
-            pipelines,
-            max_binding_bytes: limits.max_storage_buffer_binding_size,
-            errors,
-        };
-        renderer.take_errors()?;
-        Ok(renderer)
-    }
-
-    fn take_errors(&self) -> Result<(), RenderError> {
-        let mut errors = self.errors.lock().expect("error sink");
-        if errors.is_empty() {
-            return Ok(());
-        }
-        let message = errors.join("; ");
-        errors.clear();
-        Err(RenderError::Device {
-            adapter: self.adapter.clone(),
-            message,
-        })
+        gpu.take_errors()?;
+        Ok(Self { gpu, pipelines })
     }
 
     fn storage(&self, label: &str, bytes: &[u8]) -> wgpu::Buffer {
         // Zero-sized bindings are invalid: pad empty inputs to one word.
         let contents: &[u8] = if bytes.is_empty() { &[0; 16] } else { bytes };
-        self.device
+        self.gpu
+            .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
                 contents,
@@ -126,7 +87,7 @@ impl GpuRenderer {
     }
 
     fn scratch(&self, label: &str, bytes: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
-        self.device.create_buffer(&wgpu::BufferDescriptor {
+        self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: bytes.max(16),
             usage: wgpu::BufferUsages::STORAGE | extra,
@@ -143,11 +104,13 @@ impl GpuRenderer {
                 resource: b.as_entire_binding(),
             })
             .collect();
-        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(SHADER_SOURCES[stage].0),
-            layout: &self.pipelines[stage].get_bind_group_layout(0),
-            entries: &entries,
-        })
+        self.gpu
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(SHADER_SOURCES[stage].0),
+                layout: &self.pipelines[stage].get_bind_group_layout(0),
+                entries: &entries,
+            })
     }
 
     fn render_chunk(
@@ -160,6 +123,7 @@ impl GpuRenderer {
         let count = frames.len();
         let params = RenderParams::new(optics, count as u32);
         let uniform = self
+            .gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("render params"),
@@ -190,7 +154,7 @@ impl GpuRenderer {
         let markers = (optics.markers.len() * count) as u64;
         let centres = self.scratch("marker centres", markers * 8, wgpu::BufferUsages::empty());
         let pixels = self.scratch("pixels", frame_px * 4, wgpu::BufferUsages::COPY_SRC);
-        let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
+        let readback = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size: frame_px * 4,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -223,6 +187,7 @@ impl GpuRenderer {
             tiles,
         ];
         let mut encoder = self
+            .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("gel render"),
@@ -243,39 +208,19 @@ impl GpuRenderer {
             }
         }
         encoder.copy_buffer_to_buffer(&pixels, 0, &readback, 0, frame_px * 4);
-        self.queue.submit([encoder.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        readback.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
-        let device_error = |message: String| RenderError::Device {
-            adapter: self.adapter.clone(),
-            message,
-        };
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| device_error(e.to_string()))?;
-        self.take_errors()?;
-        rx.recv()
-            .map_err(|e| device_error(e.to_string()))?
-            .map_err(|e| device_error(e.to_string()))?;
-        let view = readback
-            .get_mapped_range(..)
-            .map_err(|e| device_error(e.to_string()))?;
-        let packed: &[u32] = bytemuck::cast_slice(&view);
-        let images = packed
-            .chunks_exact(n)
-            .map(|frame| {
-                let mut bytes = Vec::with_capacity(3 * n);
-                for p in frame {
-                    bytes.extend_from_slice(&p.to_le_bytes()[..3]);
-                }
-                RgbImage::from_raw(w, h, bytes).expect("sized from the frame")
-            })
-            .collect();
-        drop(view);
-        readback.unmap();
-        Ok(images)
+        self.gpu.submit_and_read(encoder, &readback, |bytes| {
+            let packed: &[u32] = bytemuck::cast_slice(bytes);
+            packed
+                .chunks_exact(n)
+                .map(|frame| {
+                    let mut bytes = Vec::with_capacity(3 * n);
+                    for p in frame {
+                        bytes.extend_from_slice(&p.to_le_bytes()[..3]);
+                    }
+                    RgbImage::from_raw(w, h, bytes).expect("sized from the frame")
+                })
+                .collect()
+        })
     }
 }
 
@@ -288,7 +233,7 @@ struct OpticsBuffers {
 
 impl GelRenderer for GpuRenderer {
     fn name(&self) -> String {
-        self.adapter.clone()
+        self.gpu.name.clone()
     }
 
     fn render_batch(
@@ -298,17 +243,17 @@ impl GelRenderer for GpuRenderer {
     ) -> Result<Vec<RgbImage>, RenderError> {
         optics.check_frames(frames)?;
         let per_frame = optics.pixel_count() as u64 * 12;
-        if per_frame > self.max_binding_bytes {
+        if per_frame > self.gpu.limits.max_storage_buffer_binding_size {
             return Err(super::invalid(
                 "optics.size",
                 format!(
                     "a {} x {} frame needs {per_frame} bytes per buffer; the device binds at most {}",
-                    optics.width, optics.height, self.max_binding_bytes
+                    optics.width, optics.height, self.gpu.limits.max_storage_buffer_binding_size
                 ),
             ));
         }
-        let chunk =
-            ((self.max_binding_bytes / per_frame) as usize).clamp(1, MAX_FRAMES_PER_DISPATCH);
+        let chunk = ((self.gpu.limits.max_storage_buffer_binding_size / per_frame) as usize)
+            .clamp(1, MAX_FRAMES_PER_DISPATCH);
         let background: Vec<f32> = optics.background.iter().flatten().copied().collect();
         let table: &[f32] = match &optics.shading {
             Shading::Table(t) => &t.coefficients,
@@ -330,20 +275,12 @@ impl GelRenderer for GpuRenderer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use wgpu::naga;
+    use crate::render_device::shader_checks::{struct_size, validated};
 
     #[test]
     fn every_shader_parses_and_validates_with_naga() {
         for (stage, _) in SHADER_SOURCES {
-            let source = shader_source(stage).unwrap();
-            let module = naga::front::wgsl::parse_str(&source)
-                .unwrap_or_else(|e| panic!("{stage}: {}", e.emit_to_string(&source)));
-            naga::valid::Validator::new(
-                naga::valid::ValidationFlags::all(),
-                naga::valid::Capabilities::empty(),
-            )
-            .validate(&module)
-            .unwrap_or_else(|e| panic!("{stage}: {}", e.emit_to_string(&source)));
+            let module = validated(stage, &shader_source(stage).unwrap());
             assert!(
                 module.entry_points.iter().any(|e| e.name == "main"),
                 "{stage} has no main entry point"
@@ -354,17 +291,8 @@ mod tests {
     #[test]
     fn uniform_block_matches_the_shader_layout() {
         let source = shader_source("gel_slopes").unwrap();
-        let module = naga::front::wgsl::parse_str(&source).unwrap();
-        let params = module
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some("RenderParams"))
-            .unwrap()
-            .0;
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(module.to_ctx()).unwrap();
         assert_eq!(
-            layouter[params].size as usize,
+            struct_size(&source, "RenderParams"),
             std::mem::size_of::<RenderParams>()
         );
     }

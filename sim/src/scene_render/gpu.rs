@@ -6,8 +6,7 @@
 
 use super::geometry::NEAR_M;
 use super::{CleanRender, InstanceImage, SceneGeometry, SceneRenderer};
-use crate::render_device::RenderError;
-use std::sync::{Arc, Mutex};
+use crate::render_device::{GpuDevice, RenderError};
 use wgpu::util::DeviceExt;
 
 pub const SCENE_SHADER: &str = include_str!("../../../shaders/scene_raster.wgsl");
@@ -68,35 +67,14 @@ const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 4] = wgpu::vertex_attr_array![
 ];
 
 pub struct GpuSceneRenderer {
-    adapter: String,
-    device: wgpu::Device,
-    queue: wgpu::Queue,
+    gpu: GpuDevice,
     pipeline: wgpu::RenderPipeline,
-    max_side: u32,
-    errors: Arc<Mutex<Vec<String>>>,
 }
 
 impl GpuSceneRenderer {
     pub fn new(adapter: &wgpu::Adapter) -> Result<Self, RenderError> {
-        let info = adapter.get_info();
-        let name = format!("{} ({:?}, {:?})", info.name, info.device_type, info.backend);
-        let limits = adapter.limits();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("tactex scene renderer"),
-            required_features: wgpu::Features::empty(),
-            required_limits: limits.clone(),
-            ..Default::default()
-        }))
-        .map_err(|e| RenderError::Device {
-            adapter: name.clone(),
-            message: e.to_string(),
-        })?;
-        // Validation errors come back as a render error, never a panic.
-        let errors = Arc::new(Mutex::new(Vec::new()));
-        let sink = errors.clone();
-        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-            sink.lock().expect("error sink").push(e.to_string());
-        }));
+        let gpu = GpuDevice::open(adapter, "tactex scene renderer")?;
+        let device = &gpu.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("scene_raster"),
             source: wgpu::ShaderSource::Wgsl(SCENE_SHADER.into()),
@@ -148,33 +126,8 @@ impl GpuSceneRenderer {
             multiview_mask: None,
             cache: None,
         });
-        let renderer = Self {
-            adapter: name,
-            device,
-            queue,
-            pipeline,
-            max_side: limits.max_texture_dimension_2d,
-            errors,
-        };
-        renderer.take_errors()?;
-        Ok(renderer)
-    }
-
-    fn device_error(&self, message: impl ToString) -> RenderError {
-        RenderError::Device {
-            adapter: self.adapter.clone(),
-            message: message.to_string(),
-        }
-    }
-
-    fn take_errors(&self) -> Result<(), RenderError> {
-        let mut errors = self.errors.lock().expect("error sink");
-        if errors.is_empty() {
-            return Ok(());
-        }
-        let message = errors.join("; ");
-        errors.clear();
-        Err(self.device_error(message))
+        gpu.take_errors()?;
+        Ok(Self { gpu, pipeline })
     }
 
     fn target(
@@ -183,7 +136,7 @@ impl GpuSceneRenderer {
         format: wgpu::TextureFormat,
         size: wgpu::Extent3d,
     ) -> wgpu::Texture {
-        self.device.create_texture(&wgpu::TextureDescriptor {
+        self.gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
             size,
             mip_level_count: 1,
@@ -203,18 +156,22 @@ fn padded_row_bytes(width: u32, texel_bytes: u32) -> u32 {
 
 impl SceneRenderer for GpuSceneRenderer {
     fn name(&self) -> String {
-        self.adapter.clone()
+        self.gpu.name.clone()
     }
 
     fn render(&self, scene: &SceneGeometry) -> Result<CleanRender, RenderError> {
         let k = scene.intrinsics;
         let (w, h) = (k.width, k.height);
-        if w == 0 || h == 0 || w > self.max_side || h > self.max_side {
+        if w == 0
+            || h == 0
+            || w > self.gpu.limits.max_texture_dimension_2d
+            || h > self.gpu.limits.max_texture_dimension_2d
+        {
             return Err(RenderError::Invalid {
                 field: "camera.intrinsics".into(),
                 message: format!(
                     "a {w} x {h} image; the device renders 1 to {} pixels a side",
-                    self.max_side
+                    self.gpu.limits.max_texture_dimension_2d
                 ),
             });
         }
@@ -232,6 +189,7 @@ impl SceneRenderer for GpuSceneRenderer {
             .collect();
         let params = SceneParams::new(scene);
         let uniform = self
+            .gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("scene params"),
@@ -245,20 +203,24 @@ impl SceneRenderer for GpuSceneRenderer {
             bytemuck::cast_slice(&vertices)
         };
         let vertex_buffer = self
+            .gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("scene vertices"),
                 contents: vertex_bytes,
                 usage: wgpu::BufferUsages::VERTEX,
             });
-        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene params"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform.as_entire_binding(),
-            }],
-        });
+        let bind_group = self
+            .gpu
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("scene params"),
+                layout: &self.pipeline.get_bind_group_layout(0),
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniform.as_entire_binding(),
+                }],
+            });
         let size = wgpu::Extent3d {
             width: w,
             height: h,
@@ -267,7 +229,7 @@ impl SceneRenderer for GpuSceneRenderer {
         let colour = self.target("colour", COLOUR_FORMAT, size);
         let depth = self.target("depth", DEPTH_FORMAT, size);
         let instance = self.target("instance", INSTANCE_FORMAT, size);
-        let z_buffer = self.device.create_texture(&wgpu::TextureDescriptor {
+        let z_buffer = self.gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("z buffer"),
             size,
             mip_level_count: 1,
@@ -280,6 +242,7 @@ impl SceneRenderer for GpuSceneRenderer {
         let views = [&colour, &depth, &instance].map(|t| t.create_view(&Default::default()));
         let z_view = z_buffer.create_view(&Default::default());
         let mut encoder = self
+            .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("scene render"),
@@ -323,14 +286,10 @@ impl SceneRenderer for GpuSceneRenderer {
             }
         }
         // One readback buffer, the three images one after another.
-        let texel_bytes = [16u32, 4, 4];
-        let rows: Vec<u32> = texel_bytes
-            .iter()
-            .map(|b| padded_row_bytes(w, *b))
-            .collect();
-        let offsets = [0u64, (rows[0] * h) as u64, ((rows[0] + rows[1]) * h) as u64];
+        let rows = TEXEL_BYTES.map(|b| padded_row_bytes(w, b));
+        let offsets = image_offsets(&rows, h);
         let total = ((rows[0] + rows[1] + rows[2]) * h) as u64;
-        let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
+        let readback = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("scene readback"),
             size: total,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -355,68 +314,58 @@ impl SceneRenderer for GpuSceneRenderer {
                 size,
             );
         }
-        self.queue.submit([encoder.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        readback.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| self.device_error(e))?;
-        self.take_errors()?;
-        rx.recv()
-            .map_err(|e| self.device_error(e))?
-            .map_err(|e| self.device_error(e))?;
-        let view = readback
-            .get_mapped_range(..)
-            .map_err(|e| self.device_error(e))?;
-        let bytes: &[u8] = &view;
-        let n = (w * h) as usize;
-        let mut out = CleanRender {
-            color: Vec::with_capacity(n),
-            specular: Vec::with_capacity(n),
-            depth_m: Vec::with_capacity(n),
-            instances: InstanceImage::new(w, h),
-        };
-        let row = |i: usize, y: u32| {
-            let start = offsets[i] as usize + (y * rows[i]) as usize;
-            &bytes[start..start + (w * texel_bytes[i]) as usize]
-        };
-        for y in 0..h {
-            let colour_row: &[f32] = bytemuck::cast_slice(row(0, y));
-            for p in colour_row.chunks_exact(4) {
-                out.color.push([p[0], p[1], p[2]].map(f64::from));
-                out.specular.push(p[3] as f64);
-            }
-            let depth_row: &[f32] = bytemuck::cast_slice(row(1, y));
-            out.depth_m.extend(depth_row.iter().map(|z| *z as f64));
-            let id_row: &[u32] = bytemuck::cast_slice(row(2, y));
-            for (x, id) in id_row.iter().enumerate() {
-                out.instances
-                    .put_pixel(x as u32, y, image::Luma([*id as u16]));
-            }
-        }
-        drop(view);
-        readback.unmap();
-        Ok(out)
+        self.gpu
+            .submit_and_read(encoder, &readback, |bytes| unpack(bytes, w, h, &rows))
     }
+}
+
+/// Bytes per texel of the colour, depth and instance-id targets.
+const TEXEL_BYTES: [u32; 3] = [16, 4, 4];
+
+/// Where each of the three images starts in the readback buffer.
+fn image_offsets(rows: &[u32; 3], h: u32) -> [u64; 3] {
+    [0, rows[0], rows[0] + rows[1]].map(|r| r as u64 * h as u64)
+}
+
+/// The three images, one after another in the readback buffer, rows padded to `rows` bytes.
+fn unpack(bytes: &[u8], w: u32, h: u32, rows: &[u32; 3]) -> CleanRender {
+    let offsets = image_offsets(rows, h);
+    let n = (w * h) as usize;
+    let mut out = CleanRender {
+        color: Vec::with_capacity(n),
+        specular: Vec::with_capacity(n),
+        depth_m: Vec::with_capacity(n),
+        instances: InstanceImage::new(w, h),
+    };
+    let row = |i: usize, y: u32| {
+        let start = offsets[i] as usize + (y * rows[i]) as usize;
+        &bytes[start..start + (w * TEXEL_BYTES[i]) as usize]
+    };
+    for y in 0..h {
+        let colour_row: &[f32] = bytemuck::cast_slice(row(0, y));
+        for p in colour_row.chunks_exact(4) {
+            out.color.push([p[0], p[1], p[2]].map(f64::from));
+            out.specular.push(p[3] as f64);
+        }
+        let depth_row: &[f32] = bytemuck::cast_slice(row(1, y));
+        out.depth_m.extend(depth_row.iter().map(|z| *z as f64));
+        let id_row: &[u32] = bytemuck::cast_slice(row(2, y));
+        for (x, id) in id_row.iter().enumerate() {
+            out.instances
+                .put_pixel(x as u32, y, image::Luma([*id as u16]));
+        }
+    }
+    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use wgpu::naga;
+    use crate::render_device::shader_checks::{struct_size, validated};
 
     #[test]
     fn scene_shader_parses_and_validates_with_naga() {
-        let module = naga::front::wgsl::parse_str(SCENE_SHADER)
-            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(SCENE_SHADER)));
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::empty(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(SCENE_SHADER)));
+        let module = validated("scene_raster", SCENE_SHADER);
         for entry in ["vs_main", "fs_main"] {
             assert!(
                 module.entry_points.iter().any(|e| e.name == entry),
@@ -427,17 +376,8 @@ mod tests {
 
     #[test]
     fn uniform_block_matches_the_shader_layout() {
-        let module = naga::front::wgsl::parse_str(SCENE_SHADER).unwrap();
-        let params = module
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some("SceneParams"))
-            .unwrap()
-            .0;
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(module.to_ctx()).unwrap();
         assert_eq!(
-            layouter[params].size as usize,
+            struct_size(SCENE_SHADER, "SceneParams"),
             std::mem::size_of::<SceneParams>()
         );
     }
