@@ -1,6 +1,7 @@
 //! `tactex`: the TactEx twin command line. Wires the simulated devices (tactex-sim) into the
 //! backend-free pipeline (tactex-core).
 
+mod ask;
 mod ball_presses;
 mod bench_contact;
 mod bench_datagen;
@@ -15,6 +16,7 @@ mod detector_choice;
 mod eval_grounding;
 mod eval_hardness;
 mod eval_ripeness;
+mod eval_scenarios;
 mod learned_model;
 mod markers;
 mod npz;
@@ -23,17 +25,13 @@ mod parse_prompt;
 mod plot;
 mod press;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::estimate::HertzSlopeEstimator;
-use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_sim::SimDevices;
-use tactex_sim::render_device::DeviceChoice;
-use tactex_sim::scene_render::open_scene_renderer;
 
 #[derive(Parser)]
 #[command(
@@ -49,31 +47,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Answer a question about the fruit on the table, e.g. "Which fruit is the softest?"
-    Ask {
-        /// Scene file (TOML); default scenes/demo.toml.
-        #[arg(long)]
-        scene: Option<PathBuf>,
-        /// Seed of every random draw (sensor noise); same seed, same output.
-        #[arg(long, default_value_t = 0)]
-        seed: u64,
-        /// Print one JSON object on stdout.
-        #[arg(long)]
-        json: bool,
-        /// Leave out wall-clock times so that the output is byte-reproducible.
-        #[arg(long)]
-        reproducible: bool,
-        /// Object detector: classical, yolo:FILE.onnx (a YOLOv8-seg export), or a
-        /// perception-error model on the twin's ground truth (error-gsam, error-yolo).
-        #[arg(long, default_value = "classical")]
-        detector: String,
-        /// Device that renders the camera's frames: cpu, gpu (any Vulkan adapter, software
-        /// included) or auto (a hardware GPU if there is one). One clean render serves a
-        /// whole question, so the CPU default costs little (see `tactex bench scene`).
-        #[arg(long, default_value = "cpu")]
-        device: DeviceChoice,
-        /// The question.
-        prompt: String,
-    },
+    Ask(ask::AskArgs),
     /// What the prompt parser reads from a question (intent, property, targets, filters).
     Parse(parse_prompt::ParseArgs),
     /// Press the gel into one object and report force, contact and indentation.
@@ -129,6 +103,8 @@ enum EvalCommand {
     Hardness(eval_hardness::HardnessEvalArgs),
     /// The paper's Table III: ripeness stages of five fruits told apart by pressing.
     Ripeness(eval_ripeness::RipenessEvalArgs),
+    /// The paper's four query tiers end to end: object- and scenario-level success, latency.
+    Scenarios(eval_scenarios::ScenarioEvalArgs),
 }
 
 #[derive(Subcommand)]
@@ -153,104 +129,6 @@ pub(crate) fn default_scene() -> PathBuf {
         local.to_path_buf()
     } else {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/demo.toml")
-    }
-}
-
-fn ask(
-    scene: Option<PathBuf>,
-    seed: u64,
-    json: bool,
-    reproducible: bool,
-    detector: &str,
-    device: DeviceChoice,
-    prompt: &str,
-) -> Result<()> {
-    let catalog = FruitCatalog::builtin();
-    // The prompt is checked before the scene is built so that a bad question fails fast.
-    tactex_core::query::parse(prompt, &catalog)?;
-    let path = scene.unwrap_or_else(default_scene);
-    let scene = Scene::load(&path, &catalog)?;
-    let choice = detector_choice::DetectorChoice::parse(detector)?;
-    let renderer = open_scene_renderer(device)?;
-    if let Some(note) = &renderer.note {
-        eprintln!("note: {note}");
-    }
-    let mut sim = SimDevices::from_scene(&scene, seed)?;
-    sim.camera.set_renderer(renderer.renderer);
-    // Only the perception-error models look at the ground truth.
-    let instances = if matches!(choice, detector_choice::DetectorChoice::PerceptionError(_)) {
-        Some(sim.camera.clean()?.instances.clone())
-    } else {
-        None
-    };
-    let labels: Vec<String> = scene.objects.iter().map(|o| o.label.clone()).collect();
-    let truth = instances
-        .as_ref()
-        .map(|instances| detector_choice::GroundTruth {
-            instances,
-            labels: &labels,
-        });
-    let detector = choice.detector(&catalog, truth, seed)?;
-    let config = PipelineConfig {
-        measure_wall_time: !reproducible,
-        ..PipelineConfig::default()
-    };
-    let answer = pipeline::answer(
-        prompt,
-        &catalog,
-        Devices {
-            camera: &mut sim.camera,
-            tactile: &mut sim.tactile,
-            arm: &mut sim.arm,
-        },
-        detector.as_ref(),
-        &HertzSlopeEstimator::default(),
-        &config,
-    )?;
-    if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&answer).context("serialising the answer")?
-        );
-    } else {
-        print_answer(&answer);
-    }
-    Ok(())
-}
-
-fn print_answer(a: &Answer) {
-    println!("{}\n", a.answer);
-    println!(
-        "{:<3} {:<11} {:<13} {:>24} {:>9} {:>9} {:>10}  ripeness",
-        "#", "object", "location", "position (m)", "Shore A", "Shore 00", "E (MPa)"
-    );
-    for (i, o) in a.objects.iter().enumerate() {
-        let p = o.position_m;
-        let (sa, s00, e) = match &o.hardness {
-            Some(h) => (
-                format!("{:.1}", h.shore_a),
-                format!("{:.1}", h.shore_00),
-                h.modulus_mpa.map_or("rigid".into(), |e| format!("{e:.3}")),
-            ),
-            None => ("-".into(), "-".into(), "-".into()),
-        };
-        let mark = if a.selected.contains(&i) { "*" } else { " " };
-        println!(
-            "{mark}{i:<2} {:<11} {:<13} {:>24} {sa:>9} {s00:>9} {e:>10}  {}",
-            o.label,
-            o.location,
-            format!("({:+.3}, {:+.3}, {:.3})", p[0], p[1], p[2]),
-            o.ripeness.as_deref().unwrap_or("-")
-        );
-        for w in &o.warnings {
-            println!("    warning: {w}");
-        }
-    }
-    println!("\n{:<10} {:>10} {:>12}", "stage", "wall (ms)", "robot (s)");
-    for t in &a.timing {
-        let wall = t.wall_ms.map_or("-".into(), |v| format!("{v:.1}"));
-        let sim = t.sim_s.map_or("-".into(), |v| format!("{v:.2}"));
-        println!("{:<10} {wall:>10} {sim:>12}", t.stage);
     }
 }
 
@@ -321,15 +199,7 @@ fn main() -> ExitCode {
     ensure_runtime_dir();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Ask {
-            scene,
-            seed,
-            json,
-            reproducible,
-            detector,
-            device,
-            prompt,
-        } => ask(scene, seed, json, reproducible, &detector, device, &prompt),
+        Command::Ask(args) => ask::run(&args),
         Command::Parse(args) => parse_prompt::run(&args),
         Command::Press(args) => press::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
@@ -342,6 +212,9 @@ fn main() -> ExitCode {
         Command::Eval {
             command: EvalCommand::Hardness(args),
         } => eval_hardness::run(&args),
+        Command::Eval {
+            command: EvalCommand::Scenarios(args),
+        } => eval_scenarios::run(&args),
         Command::Eval {
             command: EvalCommand::Ripeness(args),
         } => eval_ripeness::run(&args),

@@ -284,3 +284,102 @@ pub fn stage_groups(path: &Path, title: &str, y_label: &str, groups: &[StageGrou
         Ok(())
     })
 }
+
+/// One named series of a bar chart: a value per category.
+pub struct BarSeries {
+    pub name: String,
+    pub values: Vec<f64>,
+}
+
+/// Bars per category, one per series side by side (`stacked` false: success rates of
+/// detectors per tier) or piled up (`stacked` true: latency stages adding up to the total).
+pub fn bars(
+    path: &Path,
+    title: &str,
+    y_label: &str,
+    categories: &[String],
+    series: &[BarSeries],
+    stacked: bool,
+) -> Result<()> {
+    anyhow::ensure!(
+        !categories.is_empty() && !series.is_empty(),
+        "nothing to plot"
+    );
+    let n = categories.len();
+    let top = (0..n)
+        .map(|c| {
+            let column = series
+                .iter()
+                .map(|s| s.values.get(c).copied().unwrap_or(0.0));
+            if stacked {
+                column.sum::<f64>()
+            } else {
+                column.fold(0.0, f64::max)
+            }
+        })
+        .fold(0.0, f64::max);
+    let top = if top > 0.0 { top * 1.25 } else { 1.0 };
+    let width = (260 + 150 * n as u32).max(900);
+    write_png(path, (width, 600), |root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 22))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..top)
+            .map_err(|e| anyhow!("{e}"))?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(n)
+            .x_label_formatter(&|x| {
+                let k = x.round();
+                if (x - k).abs() < 1e-6 && k >= 0.0 && (k as usize) < n {
+                    categories[k as usize].clone()
+                } else {
+                    String::new()
+                }
+            })
+            .x_label_style(("sans-serif", 15))
+            .y_desc(y_label)
+            .label_style(("sans-serif", 16))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        let m = series.len() as f64;
+        let mut base = vec![0.0; n];
+        for (k, s) in series.iter().enumerate() {
+            let colour = PALETTE[k % PALETTE.len()];
+            let rects: Vec<_> = s
+                .values
+                .iter()
+                .take(n)
+                .enumerate()
+                .map(|(c, v)| {
+                    let x = c as f64;
+                    let (x0, x1, y0) = if stacked {
+                        (x - 0.3, x + 0.3, base[c])
+                    } else {
+                        let w = 0.7 / m;
+                        (
+                            x - 0.35 + w * k as f64,
+                            x - 0.35 + w * (k as f64 + 1.0),
+                            0.0,
+                        )
+                    };
+                    if stacked {
+                        base[c] += v;
+                    }
+                    Rectangle::new([(x0, y0), (x1, y0 + v)], colour.filled())
+                })
+                .collect();
+            chart
+                .draw_series(rects)
+                .map_err(|e| anyhow!("{e}"))?
+                .label(s.name.clone())
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 6), (x + 12, y + 6)], colour.filled())
+                });
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperRight)
+    })
+}

@@ -1,6 +1,6 @@
-//! `tactex eval hardness`, `eval ripeness` and `eval grounding` end to end on small runs: their JSON
-//! contracts, plots and raw records, tests that recompute from the raw predictions, and bad
-//! input named.
+//! `tactex eval hardness`, `eval ripeness`, `eval grounding` and `eval scenarios` end to end
+//! on small runs: their JSON contracts, plots and raw records, tests that recompute from the
+//! raw predictions, and bad input named.
 
 use std::process::Command;
 
@@ -286,5 +286,82 @@ fn grounding_on_the_noisy_twin_finds_each_fruit_and_its_centroid() {
             &["--detector", "sam9"],
             "--detector: unknown detector 'sam9'",
         )],
+    );
+}
+
+#[test]
+fn scenarios_score_every_tier_end_to_end_with_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = tactex(&[
+        "eval",
+        "scenarios",
+        "--runs",
+        "1",
+        "--detector",
+        "classical",
+        "--json",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let detectors = v["detectors"].as_array().unwrap();
+    assert_eq!(detectors.len(), 1);
+    assert_eq!(detectors[0]["name"], "classical");
+    let tiers = detectors[0]["tiers"].as_array().unwrap();
+    assert_eq!(tiers.len(), 4);
+    let runs: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("runs.json")).unwrap()).unwrap();
+    let runs = runs.as_array().unwrap();
+    assert_eq!(runs.len(), 4);
+    for (t, tier) in tiers.iter().enumerate() {
+        assert_eq!(tier["tier"], t as u64 + 1);
+        assert_eq!(tier["runs"], 1);
+        // The rates recompute from the raw records.
+        let run = &runs[t];
+        let ol = run["object_successes"].as_f64().unwrap() / run["asked"].as_f64().unwrap();
+        assert!(
+            (tier["ol_sr"].as_f64().unwrap() - ol).abs() < 1e-12,
+            "{tier}"
+        );
+        let sl = if run["scenario_success"].as_bool().unwrap() {
+            1.0
+        } else {
+            0.0
+        };
+        assert_eq!(tier["sl_sr"].as_f64().unwrap(), sl, "{tier}");
+        // The classical detector on the noisy twin gets the paper's simple tiers right.
+        if t < 3 {
+            assert_eq!(sl, 1.0, "tier {}: {run}", t + 1);
+        }
+        let stages: Vec<&str> = tier["latency"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| l["stage"].as_str().unwrap())
+            .collect();
+        assert_eq!(stages, ["parse", "ground", "press", "hardness", "explain"]);
+        let press = &tier["latency"][2];
+        assert!(
+            press["sim_s"].as_f64().unwrap() > 1.0,
+            "pressing takes robot time"
+        );
+    }
+    for png in [
+        "object_success.png",
+        "scenario_success.png",
+        "latency_wall.png",
+        "latency_robot.png",
+    ] {
+        let bytes = std::fs::read(dir.path().join(png)).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG"), "{png}");
+    }
+    bad_arguments_are_named(
+        "scenarios",
+        &[
+            (&["--runs", "0"], "--runs"),
+            (&["--tiers", "5"], "--tiers"),
+            (&["--detector", "sonar"], "sonar"),
+        ],
     );
 }
