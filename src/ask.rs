@@ -44,6 +44,16 @@ pub struct AskArgs {
     pub prompt: String,
 }
 
+/// The scene renderer `device` names, telling the user on stderr when `auto` fell back to
+/// the CPU.
+pub fn scene_renderer(device: DeviceChoice) -> Result<Arc<dyn SceneRenderer>> {
+    let choice = open_scene_renderer(device)?;
+    if let Some(note) = &choice.note {
+        eprintln!("note: {note}");
+    }
+    Ok(choice.renderer)
+}
+
 /// An answer from the twin, with the ground truth an evaluation scores it against.
 pub struct TwinAnswer {
     pub answer: Answer,
@@ -108,23 +118,13 @@ pub fn run(args: &AskArgs) -> Result<()> {
     let path = args.scene.clone().unwrap_or_else(crate::default_scene);
     let scene = Scene::load(&path, &catalog)?;
     let choice = DetectorChoice::parse(&args.detector)?;
-    let renderer = open_scene_renderer(args.device)?;
-    if let Some(note) = &renderer.note {
-        eprintln!("note: {note}");
-    }
+    let renderer = scene_renderer(args.device)?;
     let config = PipelineConfig {
         measure_wall_time: !args.reproducible,
         ..PipelineConfig::default()
     };
-    let answer = answer_on_twin(
-        &scene,
-        args.seed,
-        &choice,
-        &renderer.renderer,
-        &args.prompt,
-        &config,
-    )?
-    .answer;
+    let answer =
+        answer_on_twin(&scene, args.seed, &choice, &renderer, &args.prompt, &config)?.answer;
     if args.json {
         println!(
             "{}",

@@ -38,7 +38,7 @@ use tactex_sim::SimDevices;
 use tactex_sim::camera::{InstanceImage, instance_mask};
 use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_random::{Variation, random_scene};
-use tactex_sim::scene_render::{SceneRenderer, open_scene_renderer};
+use tactex_sim::scene_render::SceneRenderer;
 
 const FORMAT: &str = "tactex-scene-dataset/1";
 /// Douglas-Peucker tolerance of the label polygons (px): keeps them within a pixel of the
@@ -400,11 +400,7 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
         args.kinds.clone()
     };
     // The renderer first: a missing device fails before anything is written.
-    let choice = open_scene_renderer(args.device)?;
-    if let Some(note) = &choice.note {
-        eprintln!("note: {note}");
-    }
-    let renderer = choice.renderer;
+    let renderer = crate::ask::scene_renderer(args.device)?;
     let info = DatasetInfo {
         format: FORMAT.into(),
         count: args.count,

@@ -33,7 +33,7 @@ use tactex_sim::SimDevices;
 use tactex_sim::camera::instance_mask;
 use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_random::{Variation, random_scene};
-use tactex_sim::scene_render::{SceneRenderer, open_scene_renderer};
+use tactex_sim::scene_render::SceneRenderer;
 
 /// The paper's ten fruit kinds.
 pub const KINDS: [&str; 10] = [
@@ -381,11 +381,7 @@ pub fn run(args: &GroundingEvalArgs) -> Result<()> {
         .iter()
         .map(|spec| DetectorChoice::parse(spec))
         .collect::<Result<Vec<_>>>()?;
-    let choice = open_scene_renderer(args.device)?;
-    if let Some(note) = &choice.note {
-        eprintln!("note: {note}");
-    }
-    let renderer = choice.renderer;
+    let renderer = crate::ask::scene_renderer(args.device)?;
     let n = KINDS.len() * args.per_kind;
     let bar = ProgressBar::new(n as u64).with_style(
         ProgressStyle::with_template("eval grounding [{bar:30}] {pos}/{len} instances, eta {eta}")

@@ -29,13 +29,11 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
-use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::pipeline::{Answer, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_random::{Variation, random_scene};
-use tactex_sim::scene_render::{SceneRenderer, open_scene_renderer};
 
 /// Pairs whose true moduli differ by less than this factor are not judged for order: the
 /// twin's hardness estimates scatter by about 10%, as the paper's did.
@@ -561,11 +559,7 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
         .iter()
         .map(|spec| DetectorChoice::parse(spec))
         .collect::<Result<Vec<_>>>()?;
-    let choice = open_scene_renderer(args.device)?;
-    if let Some(note) = &choice.note {
-        eprintln!("note: {note}");
-    }
-    let renderer: Arc<dyn SceneRenderer> = choice.renderer;
+    let renderer = crate::ask::scene_renderer(args.device)?;
     let scenarios = tiers
         .iter()
         .flat_map(|&t| (0..args.runs).map(move |r| (t, r)))
