@@ -2,6 +2,7 @@
 //! pipeline), and the same wiring for evaluations that ask many questions.
 
 use crate::detector_choice::{DetectorChoice, GroundTruth};
+use crate::llm_explainer::{ExplainerChoice, explainer};
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -9,6 +10,7 @@ use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
 use tactex_core::estimate::HertzSlopeEstimator;
+use tactex_core::explain::Explainer;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
 use tactex_core::scene::Scene;
@@ -40,6 +42,15 @@ pub struct AskArgs {
     /// whole question, so the CPU default costs little (see `tactex bench scene`).
     #[arg(long, default_value = "cpu")]
     pub device: DeviceChoice,
+    /// Who writes the answer: template (deterministic, offline) or llm (an
+    /// OpenAI-compatible endpoint from TACTEX_LLM_BASE_URL / TACTEX_LLM_MODEL /
+    /// TACTEX_LLM_API_KEY or --llm-config; an ungrounded or failed reply falls back to the
+    /// template with a notice).
+    #[arg(long, value_enum, default_value = "template")]
+    pub explainer: ExplainerChoice,
+    /// TOML with base_url, model, api_key_env and timeout_s for --explainer llm.
+    #[arg(long)]
+    pub llm_config: Option<PathBuf>,
     /// The question.
     pub prompt: String,
 }
@@ -72,6 +83,7 @@ pub fn answer_on_twin(
     seed: u64,
     choice: &DetectorChoice,
     renderer: &Arc<dyn SceneRenderer>,
+    explainer: &dyn Explainer,
     prompt: &str,
     config: &PipelineConfig,
 ) -> Result<TwinAnswer> {
@@ -100,6 +112,7 @@ pub fn answer_on_twin(
         },
         detector.as_ref(),
         &HertzSlopeEstimator::default(),
+        explainer,
         config,
     )?;
     Ok(TwinAnswer {
@@ -119,12 +132,21 @@ pub fn run(args: &AskArgs) -> Result<()> {
     let scene = Scene::load(&path, &catalog)?;
     let choice = DetectorChoice::parse(&args.detector)?;
     let renderer = scene_renderer(args.device)?;
+    let explainer = explainer(args.explainer, args.llm_config.as_ref())?;
     let config = PipelineConfig {
         measure_wall_time: !args.reproducible,
         ..PipelineConfig::default()
     };
-    let answer =
-        answer_on_twin(&scene, args.seed, &choice, &renderer, &args.prompt, &config)?.answer;
+    let answer = answer_on_twin(
+        &scene,
+        args.seed,
+        &choice,
+        &renderer,
+        explainer.as_ref(),
+        &args.prompt,
+        &config,
+    )?
+    .answer;
     if args.json {
         println!(
             "{}",
@@ -137,6 +159,9 @@ pub fn run(args: &AskArgs) -> Result<()> {
 }
 
 fn print_answer(a: &Answer) {
+    if let Some(notice) = &a.explain_notice {
+        eprintln!("note: {notice}");
+    }
     println!("{}\n", a.answer);
     println!(
         "{:<3} {:<11} {:<13} {:>24} {:>9} {:>9} {:>10}  ripeness",

@@ -30,6 +30,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
+use tactex_core::explain::TemplateExplainer;
 use tactex_core::pipeline::{Answer, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_sim::render_device::DeviceChoice;
@@ -582,6 +583,7 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
                 sc.seed,
                 &detectors[d],
                 &renderer,
+                &TemplateExplainer,
                 &sc.prompt,
                 &config,
             )
@@ -691,7 +693,7 @@ mod tests {
             })
             .collect();
         let selected = tactex_core::explain::select(&query, &measured, &catalog);
-        let text = tactex_core::explain::explain(&query, &measured, &selected, &[]);
+        let text = tactex_core::explain::template::explain(&query, &measured, &selected, &[]);
         TwinAnswer {
             answer: Answer {
                 query,
@@ -700,6 +702,8 @@ mod tests {
                 answer: text,
                 not_found: Vec::new(),
                 estimator: "test".into(),
+                explainer: "template".into(),
+                explain_notice: None,
                 timing: Vec::new(),
             },
             true_centres_m: centres,

@@ -18,6 +18,7 @@ mod eval_hardness;
 mod eval_ripeness;
 mod eval_scenarios;
 mod learned_model;
+mod llm_explainer;
 mod markers;
 mod npz;
 mod output;

@@ -366,3 +366,118 @@ fn colour_and_position_filters_choose_the_fruit() {
     let a = ask_json(scene, "How firm is the fruit at the front left?");
     assert_eq!(selected_labels(&a), ["banana"]);
 }
+
+/// A chat-completions endpoint on 127.0.0.1 that answers every request with `reply(data)`,
+/// where `data` is the JSON the explainer put in the user message.
+fn fake_llm(reply: fn(&Value) -> String) -> String {
+    use std::io::{BufRead, BufReader, Read, Write};
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let url = format!("http://{}/v1", listener.local_addr().unwrap());
+    std::thread::spawn(move || {
+        for mut stream in listener.incoming().flatten() {
+            let mut reader = BufReader::new(stream.try_clone().unwrap());
+            let mut length = 0;
+            loop {
+                let mut line = String::new();
+                if reader.read_line(&mut line).unwrap_or(0) == 0 || line == "\r\n" {
+                    break;
+                }
+                if let Some(v) = line.to_lowercase().strip_prefix("content-length:") {
+                    length = v.trim().parse().unwrap_or(0);
+                }
+            }
+            let mut body = vec![0; length];
+            reader.read_exact(&mut body).ok();
+            let request: Value = serde_json::from_slice(&body).unwrap_or_default();
+            let user = request["messages"][1]["content"].as_str().unwrap_or("");
+            let data: Value = user
+                .strip_prefix("Data: ")
+                .and_then(|s| s.lines().next())
+                .and_then(|s| serde_json::from_str(s).ok())
+                .unwrap_or_default();
+            let payload = serde_json::json!({"choices": [{"message": {"content": reply(&data)}}]})
+                .to_string();
+            let _ = write!(
+                stream,
+                "HTTP/1.1 200 OK\r\ncontent-type: application/json\r\ncontent-length: {}\r\nconnection: close\r\n\r\n{payload}",
+                payload.len()
+            );
+        }
+    });
+    url
+}
+
+fn ask_llm(url: &str, prompt: &str) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args(["ask", "--json", "--reproducible", "--explainer", "llm"])
+        .args(["--scene", "tests/scenes/one.toml", prompt])
+        .env("TACTEX_LLM_BASE_URL", url)
+        .env("TACTEX_LLM_MODEL", "fake")
+        .env_remove("TACTEX_LLM_API_KEY")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("runs tactex")
+}
+
+#[test]
+fn the_llm_explainer_is_used_when_grounded_and_replaced_when_it_invents() {
+    // A model that says what the data says, in its own words.
+    let url = fake_llm(|data| {
+        let o = &data["objects"][0];
+        format!(
+            "I pressed the {} at the {}: {} ({}), so it is {}.",
+            o["label"].as_str().unwrap_or("?"),
+            o["location"].as_str().unwrap_or("?"),
+            o["hardness"]["shore"].as_str().unwrap_or("?"),
+            o["hardness"]["modulus"].as_str().unwrap_or("?"),
+            o["ripeness"].as_str().unwrap_or("?"),
+        )
+    });
+    let out = ask_llm(&url, "How hard is the mango?");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let a: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(a["explainer"], "llm:fake");
+    assert_eq!(a["explain_notice"], Value::Null);
+    let text = a["answer"].as_str().unwrap();
+    assert!(text.starts_with("I pressed the mango at the"), "{text}");
+
+    // A model that makes up a number: the template answers and the notice says why.
+    let url = fake_llm(|_| "The mango is 9.99 MPa and ripe.".into());
+    let out = ask_llm(&url, "How hard is the mango?");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let a: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(a["explainer"], "template");
+    let notice = a["explain_notice"].as_str().unwrap();
+    assert!(
+        notice.contains("9.99 mpa is not a measured value"),
+        "{notice}"
+    );
+    assert!(
+        a["answer"]
+            .as_str()
+            .unwrap()
+            .starts_with("The mango at the")
+    );
+}
+
+#[test]
+fn the_llm_explainer_without_an_endpoint_is_a_one_line_error() {
+    let out = Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args(["ask", "--explainer", "llm", "How hard is the mango?"])
+        .env_remove("TACTEX_LLM_BASE_URL")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("TACTEX_LLM_BASE_URL"), "{err}");
+}

@@ -3,8 +3,8 @@
 //! Types (poses, intrinsics, frames), the device traits that the simulated (`tactex-sim`),
 //! real (`tactex-hw`) and replay backends implement, the fruit catalog and scene format,
 //! Hertz contact theory, perception (detection, mask refinement, centroids, tactile
-//! helpers), hardness estimation, the template explainer and the question pipeline that is
-//! generic over the device traits. Nothing in here knows which backend it runs against.
+//! helpers), hardness estimation, explanation (template, groundedness check, LLM prompt) and
+//! the question pipeline that is generic over the device traits. Nothing in here knows which backend it runs against.
 
 pub mod ball_calibration;
 pub mod catalog;

@@ -4,7 +4,7 @@
 use crate::catalog::FruitCatalog;
 use crate::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
 use crate::estimate::{Evidence, HardnessEstimator, PressSequence};
-use crate::explain::{self, Measured, location_words};
+use crate::explain::{self, Explainer, Facts, Measured, location_words};
 use crate::geometry::Pose;
 use crate::hardness::HardnessReport;
 use crate::perception::centroid::median_depth;
@@ -107,6 +107,10 @@ pub struct Answer {
     pub answer: String,
     pub not_found: Vec<String>,
     pub estimator: String,
+    /// "template", or "llm:<model>" when a model's grounded reply is the answer.
+    pub explainer: String,
+    /// Why a model's reply was not used, when the template stood in for it.
+    pub explain_notice: Option<String>,
     pub timing: Vec<StageTiming>,
 }
 
@@ -138,6 +142,7 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     devices: Devices<'_, C, T, A>,
     detector: &dyn Detector,
     estimator: &dyn HardnessEstimator,
+    explainer: &dyn Explainer,
     config: &PipelineConfig,
 ) -> Result<Answer, PipelineError> {
     let Devices {
@@ -232,16 +237,25 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
         })
         .collect();
     let selected = explain::select(&query, &measured, catalog);
-    let text = explain::explain(&query, &measured, &selected, &not_found);
+    let facts = Facts {
+        prompt: prompt.into(),
+        query,
+        objects: measured,
+        selected,
+        not_found,
+    };
+    let explanation = explainer.explain(&facts);
     lap("explain", arm, t);
 
     Ok(Answer {
-        query,
+        query: facts.query,
         objects,
-        selected,
-        answer: text,
-        not_found,
+        selected: facts.selected,
+        answer: explanation.text,
+        not_found: facts.not_found,
         estimator: estimator.name().into(),
+        explainer: explanation.explainer,
+        explain_notice: explanation.notice,
         timing,
     })
 }

@@ -1,60 +1,79 @@
-//! The template explainer: deterministic, offline text from the measured result, with the
-//! rule-based location words (left/centre/right, front/centre/back) of the TactEx paper.
+//! The template explainer: deterministic, offline text from the measured result, with each
+//! hardness given with its one-standard-error uncertainty.
 
-use crate::catalog::FruitCatalog;
+use super::{Explainer, Explanation, Facts, Measured, stiffness};
 use crate::hardness::HardnessReport;
 use crate::query::{Extreme, Intent, Property, Query};
-use serde::Serialize;
 
-/// Objects this far (m) from the table centre line are "left"/"right" or "front"/"back".
-pub const LOCATION_BAND_M: f64 = 0.06;
+/// The default explainer: the same facts always give the same words.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TemplateExplainer;
 
-/// "left front", "centre back", "centre", ... from table coordinates (x right, y back).
-pub fn location_words(x: f64, y: f64) -> String {
-    let lr = if x < -LOCATION_BAND_M {
-        "left"
-    } else if x > LOCATION_BAND_M {
-        "right"
-    } else {
-        "centre"
-    };
-    let fb = if y < -LOCATION_BAND_M {
-        "front"
-    } else if y > LOCATION_BAND_M {
-        "back"
-    } else {
-        "centre"
-    };
-    match (lr, fb) {
-        ("centre", "centre") => "centre".into(),
-        (lr, fb) => format!("{lr} {fb}"),
+impl Explainer for TemplateExplainer {
+    fn name(&self) -> &str {
+        "template"
+    }
+
+    fn explain(&self, facts: &Facts) -> Explanation {
+        Explanation {
+            text: explain(
+                &facts.query,
+                &facts.objects,
+                &facts.selected,
+                &facts.not_found,
+            ),
+            explainer: "template".into(),
+            notice: None,
+        }
     }
 }
 
-/// One measured object as the explainer sees it.
-#[derive(Clone, Debug, Serialize)]
-pub struct Measured {
-    pub label: String,
-    pub location: String,
-    pub hardness: Option<HardnessReport>,
-    /// One-standard-error modulus interval (MPa).
-    pub modulus_interval_mpa: [Option<f64>; 2],
-    pub ripeness: Option<String>,
+/// Half the one-standard-error interval (MPa), when the estimator gave one.
+pub fn uncertainty_mpa(m: &Measured) -> Option<f64> {
+    match m.modulus_interval_mpa {
+        [Some(lo), Some(hi)] if hi >= lo && hi.is_finite() => Some((hi - lo) / 2.0),
+        _ => None,
+    }
 }
 
-fn describe_hardness(h: &HardnessReport) -> String {
-    match h.modulus_mpa {
-        None => "rigid".into(),
-        Some(e) if h.shore_a < 10.0 => format!("{:.0} Shore 00 ({e:.2} MPa)", h.shore_00),
-        Some(e) => format!("{:.0} Shore A ({e:.2} MPa)", h.shore_a),
+/// The uncertainty as a share of the modulus, written as a percentage ("8%", "0.3%").
+pub fn uncertainty_percent(e: f64, uncertainty_mpa: f64) -> String {
+    let pct = 100.0 * uncertainty_mpa / e;
+    if pct < 1.0 {
+        format!("{pct:.1}%")
+    } else {
+        format!("{pct:.0}%")
     }
+}
+
+/// "36 Shore A (1.46 MPa ± 8%)", "55 Shore 00 (0.29 MPa)", "rigid". The percentage is the
+/// estimator's one standard error, relative: a fit's error can be far below 0.01 MPa.
+pub fn describe_hardness(h: &HardnessReport, uncertainty_mpa: Option<f64>) -> String {
+    let Some(e) = h.modulus_mpa else {
+        return "rigid".into();
+    };
+    let modulus = match uncertainty_mpa {
+        Some(u) if e > 0.0 => format!("{e:.2} MPa ± {}", uncertainty_percent(e, u)),
+        _ => format!("{e:.2} MPa"),
+    };
+    if h.shore_a < 10.0 {
+        format!("{:.0} Shore 00 ({modulus})", h.shore_00)
+    } else {
+        format!("{:.0} Shore A ({modulus})", h.shore_a)
+    }
+}
+
+fn hardness_of(m: &Measured) -> Option<String> {
+    m.hardness
+        .as_ref()
+        .map(|h| describe_hardness(h, uncertainty_mpa(m)))
 }
 
 fn describe(m: &Measured) -> String {
     let mut s = format!("the {} at the {}", m.label, m.location);
-    match &m.hardness {
+    match hardness_of(m) {
         Some(h) => {
-            s += &format!(", {}", describe_hardness(h));
+            s += &format!(", {h}");
             if let Some(r) = &m.ripeness {
                 s += &format!(", {r}");
             }
@@ -64,9 +83,14 @@ fn describe(m: &Measured) -> String {
     s
 }
 
-fn stiffness(m: &Measured) -> f64 {
-    m.hardness
-        .map_or(f64::NAN, |h| h.modulus_mpa.unwrap_or(f64::INFINITY))
+/// Whether two measured moduli lie within each other's one-standard-error reach.
+fn within_uncertainty(a: &Measured, b: &Measured) -> bool {
+    let (ea, eb) = (stiffness(a), stiffness(b));
+    if !(ea.is_finite() && eb.is_finite()) {
+        return false;
+    }
+    let reach = uncertainty_mpa(a).unwrap_or(0.0) + uncertainty_mpa(b).unwrap_or(0.0);
+    (ea - eb).abs() <= reach
 }
 
 fn capitalise(s: &str) -> String {
@@ -74,40 +98,6 @@ fn capitalise(s: &str) -> String {
     c.next().map_or(String::new(), |f| {
         f.to_uppercase().collect::<String>() + c.as_str()
     })
-}
-
-/// Indices of `objects` that answer the query, in answer order.
-pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Vec<usize> {
-    let mut measured: Vec<usize> = (0..objects.len())
-        .filter(|&i| objects[i].hardness.is_some())
-        .collect();
-    // How much of the asked property an object has.
-    let key = |i: &usize| -> f64 {
-        let m = &objects[*i];
-        let e = stiffness(m);
-        match query.property {
-            Property::Hardness => e,
-            Property::Softness => -e,
-            // Ripeness: stiffness relative to the fruit's unripe stage, lower is riper.
-            Property::Ripeness => -catalog
-                .get(&m.label)
-                .map_or(e, |f| e / f.stages[0].modulus_mpa),
-        }
-    };
-    match query.intent {
-        Intent::Summarize if query.ranked => {
-            measured.sort_by(|a, b| key(b).total_cmp(&key(a)));
-            measured
-        }
-        Intent::Extreme => {
-            let pick = match query.extreme {
-                Some(Extreme::Least) => measured.iter().min_by(|a, b| key(a).total_cmp(&key(b))),
-                _ => measured.iter().max_by(|a, b| key(a).total_cmp(&key(b))),
-            };
-            pick.copied().into_iter().collect()
-        }
-        _ => measured,
-    }
 }
 
 /// The answer text for a query over measured objects; `missing` lists asked-for kinds the
@@ -147,12 +137,10 @@ pub fn explain(
                 ranked.sort_by(|a, b| stiffness(a).total_cmp(&stiffness(b)));
                 let list: Vec<String> = ranked
                     .iter()
-                    .map(|m| {
-                        format!(
-                            "{} ({})",
-                            m.label,
-                            describe_hardness(m.hardness.as_ref().unwrap())
-                        )
+                    // The list stays short: uncertainties are in the sentence before.
+                    .filter_map(|m| {
+                        let h = describe_hardness(m.hardness.as_ref()?, None);
+                        Some(format!("{} ({h})", m.label))
                     })
                     .collect();
                 parts.push(format!("From softest to hardest: {}.", list.join(", ")));
@@ -170,6 +158,13 @@ pub fn explain(
                 describe(a),
                 describe(b)
             )));
+            if within_uncertainty(a, b) {
+                parts.push(
+                    "The difference is within the measurement uncertainty, so they may be \
+                     equally hard."
+                        .into(),
+                );
+            }
         }
         Intent::Summarize if query.ranked && !selected.is_empty() => {
             let (most, least) = match query.property {
@@ -209,6 +204,8 @@ pub fn explain(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::catalog::FruitCatalog;
+    use crate::explain::{location_words, select};
     use crate::hardness::Hardness;
 
     fn m(label: &str, e: f64, x: f64, y: f64) -> Measured {
@@ -219,14 +216,6 @@ mod tests {
             modulus_interval_mpa: [None, None],
             ripeness: Some("ripe".into()),
         }
-    }
-
-    #[test]
-    fn locations_follow_the_table_frame() {
-        assert_eq!(location_words(-0.2, -0.1), "left front");
-        assert_eq!(location_words(0.2, 0.1), "right back");
-        assert_eq!(location_words(0.0, 0.0), "centre");
-        assert_eq!(location_words(0.0, 0.2), "centre back");
     }
 
     #[test]
@@ -292,5 +281,37 @@ mod tests {
             text.contains("I could not find a kiwi on the table."),
             "{text}"
         );
+    }
+
+    #[test]
+    fn hardness_is_given_with_its_uncertainty() {
+        let mut lime = m("lime", 1.46, 0.0, 0.0);
+        lime.modulus_interval_mpa = [Some(1.34), Some(1.58)];
+        let c = FruitCatalog::builtin();
+        let q = crate::query::parse("How hard is the lime?", &c).unwrap();
+        let text = explain(&q, std::slice::from_ref(&lime), &[0], &[]);
+        assert!(text.contains("36 Shore A (1.46 MPa ± 8%)"), "{text}");
+    }
+
+    #[test]
+    fn comparisons_inside_the_uncertainty_say_so() {
+        let c = FruitCatalog::builtin();
+        let q = crate::query::parse("Is the lime harder than the lemon?", &c).unwrap();
+        let mut lime = m("lime", 1.50, 0.1, 0.0);
+        let mut lemon = m("lemon", 1.40, -0.1, 0.0);
+        lime.modulus_interval_mpa = [Some(1.40), Some(1.60)];
+        lemon.modulus_interval_mpa = [Some(1.30), Some(1.50)];
+        let objs = [lime.clone(), lemon.clone()];
+        let text = explain(&q, &objs, &[0, 1], &[]);
+        assert!(text.contains("is harder than the lemon"), "{text}");
+        assert!(
+            text.contains("within the measurement uncertainty"),
+            "{text}"
+        );
+        // Far apart: no hedge.
+        lemon.hardness = Some(Hardness::ModulusMpa(0.5).into());
+        lemon.modulus_interval_mpa = [Some(0.45), Some(0.55)];
+        let text = explain(&q, &[lime, lemon], &[0, 1], &[]);
+        assert!(!text.contains("uncertainty"), "{text}");
     }
 }

@@ -1,0 +1,97 @@
+//! Explanation: measured objects and the question -> answer text. One contract
+//! (`Explainer`), a deterministic offline template (the default), the groundedness check
+//! that any generated reply must pass, and the chat messages a language model is given.
+//! The language-model client itself talks to a network peer, so it lives with the binary.
+
+pub mod grounded;
+pub mod llm_prompt;
+pub mod location;
+pub mod template;
+
+pub use location::{LOCATION_BAND_M, location_words};
+pub use template::TemplateExplainer;
+
+use crate::catalog::FruitCatalog;
+use crate::hardness::HardnessReport;
+use crate::query::{Extreme, Intent, Property, Query};
+use serde::Serialize;
+
+/// One measured object as the explainer sees it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Measured {
+    pub label: String,
+    pub location: String,
+    pub hardness: Option<HardnessReport>,
+    /// One-standard-error modulus interval (MPa).
+    pub modulus_interval_mpa: [Option<f64>; 2],
+    pub ripeness: Option<String>,
+}
+
+/// Everything an explanation may say: the question, what was measured, which objects answer
+/// it, and which asked-for kinds were not found.
+#[derive(Clone, Debug, Serialize)]
+pub struct Facts {
+    pub prompt: String,
+    pub query: Query,
+    pub objects: Vec<Measured>,
+    /// Indices into `objects` that answer the query, in answer order.
+    pub selected: Vec<usize>,
+    pub not_found: Vec<String>,
+}
+
+/// The answer text and who wrote it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Explanation {
+    pub text: String,
+    /// "template", or "llm:<model>" when a model's reply passed the groundedness check.
+    pub explainer: String,
+    /// Why a generated reply was not used (timeout, HTTP error, ungrounded claim).
+    pub notice: Option<String>,
+}
+
+/// Turns facts into text. Infallible: an explainer that cannot answer falls back to the
+/// template and says why in `notice`.
+pub trait Explainer: Send + Sync {
+    fn name(&self) -> &str;
+    fn explain(&self, facts: &Facts) -> Explanation;
+}
+
+/// A stiffness key: the modulus, infinite when rigid, NaN when unmeasured.
+pub(crate) fn stiffness(m: &Measured) -> f64 {
+    m.hardness
+        .map_or(f64::NAN, |h| h.modulus_mpa.unwrap_or(f64::INFINITY))
+}
+
+/// Indices of `objects` that answer the query, in answer order.
+pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Vec<usize> {
+    let mut measured: Vec<usize> = (0..objects.len())
+        .filter(|&i| objects[i].hardness.is_some())
+        .collect();
+    // How much of the asked property an object has.
+    let key = |i: &usize| -> f64 {
+        let m = &objects[*i];
+        let e = stiffness(m);
+        match query.property {
+            Property::Hardness => e,
+            Property::Softness => -e,
+            // Ripeness: stiffness relative to the fruit's unripe stage, lower is riper.
+            Property::Ripeness => -catalog
+                .get(&m.label)
+                .map_or(e, |f| e / f.stages[0].modulus_mpa),
+        }
+    };
+    match query.intent {
+        Intent::Summarize if query.ranked => {
+            measured.sort_by(|a, b| key(b).total_cmp(&key(a)));
+            measured
+        }
+        Intent::Extreme => {
+            let pick = match query.extreme {
+                Some(Extreme::Least) => measured.iter().min_by(|a, b| key(a).total_cmp(&key(b))),
+                _ => measured.iter().max_by(|a, b| key(a).total_cmp(&key(b))),
+            };
+            pick.copied().into_iter().collect()
+        }
+        _ => measured,
+    }
+}
