@@ -166,7 +166,7 @@ fn true_modulus(scene: &Scene, i: usize) -> f64 {
 }
 
 /// Distinct kinds other than `not`, shuffled.
-fn others(rng: &mut ChaCha8Rng, not: &[&str], n: usize) -> Vec<&'static str> {
+pub(crate) fn others(rng: &mut ChaCha8Rng, not: &[&str], n: usize) -> Vec<&'static str> {
     let mut pool: Vec<&'static str> = KINDS.iter().copied().filter(|k| !not.contains(k)).collect();
     pool.shuffle(rng);
     pool.truncate(n);

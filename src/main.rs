@@ -13,6 +13,7 @@ mod datagen_scenes;
 mod datagen_tactile;
 mod detect_image;
 mod detector_choice;
+mod eval_explanations;
 mod eval_grounding;
 mod eval_hardness;
 mod eval_ripeness;
@@ -106,6 +107,9 @@ enum EvalCommand {
     Ripeness(eval_ripeness::RipenessEvalArgs),
     /// The paper's four query tiers end to end: object- and scenario-level success, latency.
     Scenarios(eval_scenarios::ScenarioEvalArgs),
+    /// The explainer alone: 100 prompts over random scenes, scored for accuracy,
+    /// completeness and clarity against the truth.
+    Explanations(eval_explanations::ExplanationEvalArgs),
 }
 
 #[derive(Subcommand)]
@@ -216,6 +220,9 @@ fn main() -> ExitCode {
         Command::Eval {
             command: EvalCommand::Scenarios(args),
         } => eval_scenarios::run(&args),
+        Command::Eval {
+            command: EvalCommand::Explanations(args),
+        } => eval_explanations::run(&args),
         Command::Eval {
             command: EvalCommand::Ripeness(args),
         } => eval_ripeness::run(&args),

@@ -365,3 +365,36 @@ fn scenarios_score_every_tier_end_to_end_with_plots() {
         ],
     );
 }
+
+#[test]
+fn explanations_of_the_template_are_accurate_and_complete_on_every_prompt_kind() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = tactex(&[
+        "eval",
+        "explanations",
+        "--prompts",
+        "100",
+        "--json",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    assert_eq!(v["explainer"], "template");
+    assert_eq!(v["prompts"], 100);
+    assert_eq!(v["accuracy"], 1.0, "{v}");
+    assert_eq!(v["completeness"], 1.0, "{v}");
+    assert_eq!(v["categories"].as_array().unwrap().len(), 6);
+    let cases: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("cases.json")).unwrap()).unwrap();
+    let cases = cases.as_array().unwrap();
+    assert_eq!(cases.len(), 100);
+    // Some prompts ask for a fruit that is not there, and the answers say so.
+    let absent = cases
+        .iter()
+        .filter(|c| c["answer"].as_str().unwrap().contains("could not find"))
+        .count();
+    assert!(absent >= 5, "{absent}");
+    let png = std::fs::read(dir.path().join("scores.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+}

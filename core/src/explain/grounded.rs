@@ -39,22 +39,23 @@ const LOCATION_WORDS: &[&str] = &["left", "right", "front", "back"];
 
 /// A number as written: its value and how many decimals it was given with.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Written {
-    value: f64,
-    decimals: i32,
+pub struct Written {
+    pub value: f64,
+    pub decimals: i32,
 }
 
 impl Written {
     /// Whether `v` rounds to what was written (half a unit of the last digit, and 1% slack
     /// for a model that rounds 0.295 to 0.3 or converts units).
-    fn matches(&self, v: f64) -> bool {
+    pub fn matches(&self, v: f64) -> bool {
         let half = 0.5 * 10f64.powi(-self.decimals);
         (self.value - v).abs() <= half + 1e-9 || (self.value - v).abs() <= 0.01 * v.abs()
     }
 }
 
-/// Numbers in `text` with the word that follows each (lower case), e.g. (1.46, "mpa").
-fn numbers(text: &str) -> Vec<(Written, String)> {
+/// Numbers in `text` with the word that follows each (lower case), e.g. (1.46, "mpa"), or
+/// "%". "Shore 00" is a scale name, not a number.
+pub fn numbers_with_units(text: &str) -> Vec<(Written, String)> {
     let chars: Vec<char> = text.chars().collect();
     let mut out = Vec::new();
     let mut i = 0;
@@ -131,19 +132,25 @@ fn hardness_values(m: &Measured) -> Vec<f64> {
     v
 }
 
-/// Checks `reply` against `facts`; the first problem found is the error.
+/// Checks `reply` against `facts`: nothing invented, nothing dropped; the first problem
+/// found is the error.
 pub fn check(reply: &str, facts: &Facts, catalog: &FruitCatalog) -> Result<(), Ungrounded> {
+    check_invented(reply, facts, catalog)?;
+    check_dropped(reply, facts, catalog)
+}
+
+/// The first half of `check`: every fruit, number, ripeness and location word of `reply`
+/// comes from `facts`.
+pub fn check_invented(
+    reply: &str,
+    facts: &Facts,
+    catalog: &FruitCatalog,
+) -> Result<(), Ungrounded> {
     if reply.trim().is_empty() {
         return Err(Ungrounded::Empty);
     }
     let said = words(reply);
     let says = |w: &str| said.iter().any(|s| s == w);
-    let mentions_fruit = |name: &str| {
-        said.iter()
-            .any(|w| catalog.find_word(w).is_some_and(|f| f.name == name))
-    };
-
-    // Invented: fruits, numbers, ripeness and location words.
     for w in &said {
         if let Some(f) = catalog.find_word(w) {
             let known = facts.objects.iter().any(|o| o.label == f.name)
@@ -165,7 +172,7 @@ pub fn check(reply: &str, facts: &Facts, catalog: &FruitCatalog) -> Result<(), U
     .chain(1..=facts.objects.len())
     .map(|n| n as f64)
     .collect();
-    for (n, unit) in numbers(reply) {
+    for (n, unit) in numbers_with_units(reply) {
         let grounded = if HARDNESS_UNITS.contains(&unit.as_str()) || unit == PERCENT {
             hardness.iter().any(|&v| n.matches(v))
         } else {
@@ -202,7 +209,18 @@ pub fn check(reply: &str, facts: &Facts, catalog: &FruitCatalog) -> Result<(), U
         }
     }
 
-    // Dropped: each answering object with its hardness and ripeness, each kind not found.
+    Ok(())
+}
+
+/// The second half of `check`: every answering object with its hardness and ripeness, and
+/// every kind not found, is in `reply`.
+pub fn check_dropped(reply: &str, facts: &Facts, catalog: &FruitCatalog) -> Result<(), Ungrounded> {
+    let said = words(reply);
+    let says = |w: &str| said.iter().any(|s| s == w);
+    let mentions_fruit = |name: &str| {
+        said.iter()
+            .any(|w| catalog.find_word(w).is_some_and(|f| f.name == name))
+    };
     for &i in &facts.selected {
         let Some(m) = facts.objects.get(i) else {
             continue;
@@ -212,7 +230,7 @@ pub fn check(reply: &str, facts: &Facts, catalog: &FruitCatalog) -> Result<(), U
         }
         let values = hardness_values(m);
         if !values.is_empty()
-            && !numbers(reply)
+            && !numbers_with_units(reply)
                 .iter()
                 .any(|(n, _)| values.iter().any(|&v| n.matches(v)))
         {
@@ -265,7 +283,7 @@ mod tests {
 
     #[test]
     fn numbers_are_read_with_their_decimals_and_units() {
-        let n = numbers("It is 0.80 MPa ± 10 % (21 Shore 00), 3rd of 2.");
+        let n = numbers_with_units("It is 0.80 MPa ± 10 % (21 Shore 00), 3rd of 2.");
         let got: Vec<(f64, i32, &str)> = n
             .iter()
             .map(|(w, u)| (w.value, w.decimals, u.as_str()))

@@ -109,8 +109,17 @@ pub fn explain(
     missing: &[String],
 ) -> String {
     let mut parts = Vec::new();
-    if objects.is_empty() {
-        parts.push("I found no fruit to touch on the table.".to_string());
+    // Named kinds that are missing get their own sentence below; only a question about every
+    // fruit (perhaps of a colour or place) is answered with "none".
+    if objects.is_empty() && missing.is_empty() {
+        let mut which = String::from("fruit");
+        if let Some(c) = &query.filters.color {
+            which = format!("{c} {which}");
+        }
+        if let Some(p) = &query.filters.position {
+            which = format!("{which} at the {p}");
+        }
+        parts.push(format!("I found no {which} to touch on the table."));
     }
     match query.intent {
         Intent::Extreme if !selected.is_empty() => {
