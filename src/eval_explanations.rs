@@ -30,7 +30,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::explain::grounded::{self, numbers_with_units};
-use tactex_core::explain::{Explainer, Facts, Measured, location_words, select};
+use tactex_core::explain::{Explainer, Explanation, Facts, Measured, location_words, select};
 use tactex_core::hardness::Hardness;
 use tactex_core::perception::colour_name::colour_name;
 use tactex_core::query;
@@ -386,8 +386,14 @@ pub struct CaseScore {
     pub problems: Vec<String>,
 }
 
-/// Scores `answer` to `case`.
-pub fn score(case: &Case, answer: &str, facts: &Facts, catalog: &FruitCatalog) -> CaseScore {
+/// Scores the explanation given for `case`.
+pub fn score(
+    case: &Case,
+    explanation: &Explanation,
+    facts: &Facts,
+    catalog: &FruitCatalog,
+) -> CaseScore {
+    let answer = explanation.text.as_str();
     let mut accuracy = Vec::new();
     let mut completeness = Vec::new();
     let mut clarity = Vec::new();
@@ -523,8 +529,8 @@ pub fn score(case: &Case, answer: &str, facts: &Facts, catalog: &FruitCatalog) -
         category: case.category,
         prompt: case.prompt.clone(),
         answer: answer.to_string(),
-        explainer: String::new(),
-        notice: None,
+        explainer: explanation.explainer.clone(),
+        notice: explanation.notice.clone(),
         accurate: accuracy.is_empty(),
         complete: completeness.is_empty(),
         clear: clarity.is_empty(),
@@ -587,6 +593,7 @@ fn share(scores: &[&CaseScore], f: impl Fn(&CaseScore) -> bool) -> f64 {
 }
 
 pub fn run(args: &ExplanationEvalArgs) -> Result<()> {
+    anyhow::ensure!(args.prompts >= 1, "--prompts: must be at least 1");
     let catalog = FruitCatalog::builtin();
     let explainer: Box<dyn Explainer> = explainer(args.explainer, args.llm_config.as_ref())?;
     let cases = (0..args.prompts)
@@ -599,11 +606,7 @@ pub fn run(args: &ExplanationEvalArgs) -> Result<()> {
     let mut scores = Vec::new();
     for c in &cases {
         let f = facts(c, &catalog)?;
-        let e = explainer.explain(&f);
-        let mut s = score(c, &e.text, &f, &catalog);
-        s.explainer = e.explainer;
-        s.notice = e.notice;
-        scores.push(s);
+        scores.push(score(c, &explainer.explain(&f), &f, &catalog));
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -722,6 +725,15 @@ mod tests {
     use super::*;
     use tactex_core::explain::TemplateExplainer;
 
+    /// The template's words, or any other text, as an explanation to score.
+    fn said(text: &str) -> Explanation {
+        Explanation {
+            text: text.into(),
+            explainer: "test".into(),
+            notice: None,
+        }
+    }
+
     fn answered(index: usize) -> (Case, Facts, String) {
         let catalog = FruitCatalog::builtin();
         let c = case(index, 1, &catalog).unwrap();
@@ -742,7 +754,7 @@ mod tests {
         let catalog = FruitCatalog::builtin();
         for i in 0..36 {
             let (c, f, text) = answered(i);
-            let s = score(&c, &text, &f, &catalog);
+            let s = score(&c, &said(&text), &f, &catalog);
             assert!(
                 s.accurate && s.complete && s.clear,
                 "#{i} {}: {text}: {:?}",
@@ -763,7 +775,7 @@ mod tests {
         }]
         .modulus_mpa;
         let wrong = text.replace(&format!("{e:.2} MPa"), &format!("{:.2} MPa", e * 1.5));
-        let s = score(&c, &wrong, &f, &catalog);
+        let s = score(&c, &said(&wrong), &f, &catalog);
         assert!(!s.accurate, "{wrong}");
         // Ripeness left out.
         let (c, f, text) = first(
@@ -775,7 +787,7 @@ mod tests {
         };
         let r = c.truth[i].ripeness.clone().unwrap();
         let dropped = text.replace(&format!(", {r}"), "");
-        let s = score(&c, &dropped, &f, &catalog);
+        let s = score(&c, &said(&dropped), &f, &catalog);
         assert!(s.accurate && !s.complete, "{dropped}: {:?}", s.problems);
         // The wrong extreme named first.
         let (c, f, text) = first(|c| {
@@ -787,7 +799,7 @@ mod tests {
         };
         let other = (0..c.truth.len()).find(|&j| j != pick).unwrap();
         let swapped = format!("The {} is the one. {text}", c.truth[other].label);
-        let s = score(&c, &swapped, &f, &catalog);
+        let s = score(&c, &said(&swapped), &f, &catalog);
         assert!(!s.accurate, "{swapped}");
         // A ranking out of order.
         let (c, f, text) = first(|c| matches!(&c.expected, Expected::Ranked(v) if v.len() >= 3));
@@ -796,7 +808,7 @@ mod tests {
         let last = items.len() - 1;
         items.swap(0, last);
         let reordered = format!("{}: {}.", parts[0], items.join("; "));
-        let s = score(&c, &reordered, &f, &catalog);
+        let s = score(&c, &said(&reordered), &f, &catalog);
         assert!(!s.accurate, "{reordered}");
         // An absent fruit not reported.
         let (c, f, text) = first(|c| !c.absent.is_empty());
@@ -805,15 +817,15 @@ mod tests {
             .filter(|s| !s.contains("could not find"))
             .collect::<Vec<_>>()
             .join(". ");
-        let s = score(&c, &silent, &f, &catalog);
+        let s = score(&c, &said(&silent), &f, &catalog);
         assert!(!s.complete, "{silent}");
         // A number without a unit, and an invented fruit.
         let (c, f, text) = answered(6);
-        let s = score(&c, &format!("{text} It weighs 120."), &f, &catalog);
+        let s = score(&c, &said(&format!("{text} It weighs 120.")), &f, &catalog);
         assert!(!s.clear && !s.accurate, "{:?}", s.problems);
         let s = score(
             &c,
-            &format!("{text} The pineapple is a mango."),
+            &said(&format!("{text} The pineapple is a mango.")),
             &f,
             &catalog,
         );

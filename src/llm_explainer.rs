@@ -158,26 +158,22 @@ impl LlmExplainer {
         if let Some(key) = &self.config.api_key {
             request = request.header("Authorization", &format!("Bearer {key}"));
         }
-        let mut response = request.send_json(&body).map_err(|e| match e {
+        // One wording for a transport failure, whether sending or reading timed out.
+        let failed = |e: ureq::Error| match e {
             ureq::Error::Timeout(_) => format!(
                 "no reply from {url} within {:.1} s",
                 self.config.timeout.as_secs_f64()
             ),
             e => format!("{url}: {e}"),
-        })?;
+        };
+        let mut response = request.send_json(&body).map_err(failed)?;
         let status = response.status();
         let text = response
             .body_mut()
             .with_config()
             .limit(1 << 20)
             .read_to_string()
-            .map_err(|e| match e {
-                ureq::Error::Timeout(_) => format!(
-                    "no reply from {url} within {:.1} s",
-                    self.config.timeout.as_secs_f64()
-                ),
-                e => format!("{url}: reading the reply: {e}"),
-            })?;
+            .map_err(failed)?;
         if !status.is_success() {
             let first = text
                 .lines()

@@ -407,8 +407,9 @@ fn fake_llm(reply: fn(&Value) -> String) -> String {
     url
 }
 
-fn ask_llm(url: &str, prompt: &str) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tactex"))
+/// `tactex ask --json --explainer llm` on the one-fruit scene against the endpoint at `url`.
+fn ask_llm(url: &str, prompt: &str) -> Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_tactex"))
         .args(["ask", "--json", "--reproducible", "--explainer", "llm"])
         .args(["--scene", "tests/scenes/one.toml", prompt])
         .env("TACTEX_LLM_BASE_URL", url)
@@ -416,7 +417,13 @@ fn ask_llm(url: &str, prompt: &str) -> Output {
         .env_remove("TACTEX_LLM_API_KEY")
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
-        .expect("runs tactex")
+        .expect("runs tactex");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is one JSON object")
 }
 
 #[test]
@@ -433,13 +440,7 @@ fn the_llm_explainer_is_used_when_grounded_and_replaced_when_it_invents() {
             o["ripeness"].as_str().unwrap_or("?"),
         )
     });
-    let out = ask_llm(&url, "How hard is the mango?");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let a: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let a = ask_llm(&url, "How hard is the mango?");
     assert_eq!(a["explainer"], "llm:fake");
     assert_eq!(a["explain_notice"], Value::Null);
     let text = a["answer"].as_str().unwrap();
@@ -447,13 +448,7 @@ fn the_llm_explainer_is_used_when_grounded_and_replaced_when_it_invents() {
 
     // A model that makes up a number: the template answers and the notice says why.
     let url = fake_llm(|_| "The mango is 9.99 MPa and ripe.".into());
-    let out = ask_llm(&url, "How hard is the mango?");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let a: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let a = ask_llm(&url, "How hard is the mango?");
     assert_eq!(a["explainer"], "template");
     let notice = a["explain_notice"].as_str().unwrap();
     assert!(

@@ -1,6 +1,6 @@
-//! `tactex eval hardness`, `eval ripeness`, `eval grounding` and `eval scenarios` end to end
-//! on small runs: their JSON contracts, plots and raw records, tests that recompute from the
-//! raw predictions, and bad input named.
+//! `tactex eval hardness`, `eval ripeness`, `eval grounding`, `eval scenarios` and `eval
+//! explanations` end to end on small runs: their JSON contracts, plots and raw records, tests
+//! that recompute from the raw predictions, and bad input named.
 
 use std::process::Command;
 
@@ -9,6 +9,18 @@ fn tactex(args: &[&str]) -> std::process::Output {
         .args(args)
         .output()
         .expect("tactex runs")
+}
+
+/// `tactex eval ARGS --json --out DIR` into a fresh DIR: the directory and stdout's JSON.
+fn eval_json(args: &[&str]) -> (tempfile::TempDir, serde_json::Value) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut all = vec!["eval"];
+    all.extend(args);
+    all.extend(["--json", "--out", dir.path().to_str().unwrap()]);
+    let o = tactex(&all);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v = serde_json::from_slice(&o.stdout).expect("one JSON object on stdout");
+    (dir, v)
 }
 
 /// Each bad argument of `eval <command>` fails with a one-line error naming it.
@@ -137,20 +149,7 @@ fn the_trained_model_answers_alike_on_tract_and_onnx_runtime() {
 
 #[test]
 fn stages_are_told_apart_and_each_test_recomputes_from_the_predictions() {
-    let dir = tempfile::tempdir().unwrap();
-    let o = tactex(&[
-        "eval",
-        "ripeness",
-        "--fruits",
-        "lime",
-        "--presses",
-        "4",
-        "--json",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
+    let (dir, r) = eval_json(&["ripeness", "--fruits", "lime", "--presses", "4"]);
     assert_eq!(r["estimator"], "indentation");
     let lime = &r["fruits"][0];
     assert_eq!(lime["fruit"], "lime");
@@ -227,20 +226,7 @@ fn bad_ripeness_arguments_are_named() {
 
 #[test]
 fn grounding_on_the_noisy_twin_finds_each_fruit_and_its_centroid() {
-    let dir = tempfile::tempdir().unwrap();
-    let o = tactex(&[
-        "eval",
-        "grounding",
-        "--per-kind",
-        "1",
-        "--depth-frames",
-        "5",
-        "--json",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let (dir, v) = eval_json(&["grounding", "--per-kind", "1", "--depth-frames", "5"]);
     let detectors = v["detectors"].as_array().unwrap();
     assert_eq!(detectors.len(), 3);
     let classical = &detectors[0];
@@ -291,20 +277,7 @@ fn grounding_on_the_noisy_twin_finds_each_fruit_and_its_centroid() {
 
 #[test]
 fn scenarios_score_every_tier_end_to_end_with_plots() {
-    let dir = tempfile::tempdir().unwrap();
-    let o = tactex(&[
-        "eval",
-        "scenarios",
-        "--runs",
-        "1",
-        "--detector",
-        "classical",
-        "--json",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let (dir, v) = eval_json(&["scenarios", "--runs", "1", "--detector", "classical"]);
     let detectors = v["detectors"].as_array().unwrap();
     assert_eq!(detectors.len(), 1);
     assert_eq!(detectors[0]["name"], "classical");
@@ -368,18 +341,7 @@ fn scenarios_score_every_tier_end_to_end_with_plots() {
 
 #[test]
 fn explanations_of_the_template_are_accurate_and_complete_on_every_prompt_kind() {
-    let dir = tempfile::tempdir().unwrap();
-    let o = tactex(&[
-        "eval",
-        "explanations",
-        "--prompts",
-        "100",
-        "--json",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let (dir, v) = eval_json(&["explanations", "--prompts", "100"]);
     assert_eq!(v["explainer"], "template");
     assert_eq!(v["prompts"], 100);
     assert_eq!(v["accuracy"], 1.0, "{v}");
@@ -397,4 +359,8 @@ fn explanations_of_the_template_are_accurate_and_complete_on_every_prompt_kind()
     assert!(absent >= 5, "{absent}");
     let png = std::fs::read(dir.path().join("scores.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
+    bad_arguments_are_named(
+        "explanations",
+        &[(&["--prompts", "0"], "--prompts: must be at least 1")],
+    );
 }

@@ -2,7 +2,7 @@
 //! reply checkable by `grounded::check`, and the facts as JSON. Pure text; the client that
 //! sends them is the binary's.
 
-use super::template::{uncertainty_mpa, uncertainty_percent};
+use super::template::{shore_words, uncertainty_mpa, uncertainty_percent};
 use super::{Facts, Measured};
 use serde_json::{Value, json};
 
@@ -21,13 +21,8 @@ fn object(i: usize, m: &Measured, facts: &Facts) -> Value {
     let hardness = m.hardness.map(|h| match h.modulus_mpa {
         None => json!({ "rigid": true }),
         Some(e) => {
-            let shore = if h.shore_a < 10.0 {
-                format!("{:.0} Shore 00", h.shore_00)
-            } else {
-                format!("{:.0} Shore A", h.shore_a)
-            };
             json!({
-                "shore": shore,
+                "shore": shore_words(&h),
                 "modulus": format!("{e:.2} MPa"),
                 "uncertainty": uncertainty_mpa(m).map(|u| format!("± {}", uncertainty_percent(e, u))),
             })

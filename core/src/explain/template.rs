@@ -56,10 +56,16 @@ pub fn describe_hardness(h: &HardnessReport, uncertainty_mpa: Option<f64>) -> St
         Some(u) if e > 0.0 => format!("{e:.2} MPa ± {}", uncertainty_percent(e, u)),
         _ => format!("{e:.2} MPa"),
     };
+    format!("{} ({modulus})", shore_words(h))
+}
+
+/// The Shore reading on the scale that resolves it: "36 Shore A", or "55 Shore 00" for
+/// objects too soft for Shore A.
+pub fn shore_words(h: &HardnessReport) -> String {
     if h.shore_a < 10.0 {
-        format!("{:.0} Shore 00 ({modulus})", h.shore_00)
+        format!("{:.0} Shore 00", h.shore_00)
     } else {
-        format!("{:.0} Shore A ({modulus})", h.shore_a)
+        format!("{:.0} Shore A", h.shore_a)
     }
 }
 
