@@ -3,17 +3,20 @@
 
 use crate::detector_choice::{DetectorChoice, GroundTruth};
 use crate::llm_explainer::{ExplainerChoice, explainer};
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::devices::RgbdCamera;
+use tactex_core::devices::{Arm, RgbdCamera, TactileSensor};
 use tactex_core::estimate::HertzSlopeEstimator;
 use tactex_core::explain::Explainer;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
-use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
+use tactex_core::perception::detect::Detector;
+use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig, Progress};
 use tactex_core::scene::Scene;
+use tactex_hw::devices_toml::DevicesConfig;
+use tactex_hw::session::{SessionRecorder, open_session};
 use tactex_sim::SimDevices;
 use tactex_sim::camera::InstanceImage;
 use tactex_sim::render_device::DeviceChoice;
@@ -33,6 +36,39 @@ pub struct AskArgs {
     /// Leave out wall-clock times so that the output is byte-reproducible.
     #[arg(long)]
     pub reproducible: bool,
+    #[command(flatten)]
+    pub twin: TwinOptions,
+    /// Devices: sim (the twin of --scene), hw (the real devices --devices names) or
+    /// replay (a recorded --session).
+    #[arg(long, value_enum, default_value = "sim")]
+    pub backend: Backend,
+    /// devices.toml for --backend hw: the xArm's address and base, the RealSense's V4L2
+    /// nodes, intrinsics and pose, the GelSight Mini's node.
+    #[arg(long)]
+    pub devices: Option<PathBuf>,
+    /// The recorded session that --backend replay runs from.
+    #[arg(long)]
+    pub session: Option<PathBuf>,
+    /// Record every frame and move into a new session directory (replayable with
+    /// --backend replay --session DIR).
+    #[arg(long)]
+    pub record: Option<PathBuf>,
+    /// The question.
+    pub prompt: String,
+}
+
+/// Where the devices' data comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Backend {
+    Sim,
+    Hw,
+    Replay,
+}
+
+/// How the twin answers: the detector, the camera's render device and the explainer (shared
+/// by `ask` and `serve`).
+#[derive(Args)]
+pub struct TwinOptions {
     /// Object detector: classical, yolo:FILE.onnx (a YOLOv8-seg export), or a
     /// perception-error model on the twin's ground truth (error-gsam, error-yolo).
     #[arg(long, default_value = "classical")]
@@ -51,8 +87,24 @@ pub struct AskArgs {
     /// TOML with base_url, model, api_key_env and timeout_s for --explainer llm.
     #[arg(long)]
     pub llm_config: Option<PathBuf>,
-    /// The question.
-    pub prompt: String,
+}
+
+/// What `TwinOptions` name, opened once: a YOLO model is loaded, a GPU adapter found, an
+/// LLM endpoint's settings read.
+pub struct OpenedTwin {
+    pub detector: DetectorChoice,
+    pub renderer: Arc<dyn SceneRenderer>,
+    pub explainer: Box<dyn Explainer>,
+}
+
+impl TwinOptions {
+    pub fn open(&self) -> Result<OpenedTwin> {
+        Ok(OpenedTwin {
+            detector: DetectorChoice::parse(&self.detector)?,
+            renderer: scene_renderer(self.device)?,
+            explainer: explainer(self.explainer, self.llm_config.as_ref())?,
+        })
+    }
 }
 
 /// The scene renderer `device` names, telling the user on stderr when `auto` fell back to
@@ -76,77 +128,316 @@ pub struct TwinAnswer {
     pub camera_pose: Pose,
 }
 
-/// Answers `prompt` on the twin of `scene`: the sim devices seeded with `seed`, the camera
-/// rendering through `renderer`, grounding with `choice`.
-pub fn answer_on_twin(
-    scene: &Scene,
-    seed: u64,
-    choice: &DetectorChoice,
-    renderer: &Arc<dyn SceneRenderer>,
-    explainer: &dyn Explainer,
-    prompt: &str,
-    config: &PipelineConfig,
-) -> Result<TwinAnswer> {
-    let catalog = FruitCatalog::builtin();
-    let mut sim = SimDevices::from_scene(scene, seed)?;
-    sim.camera.set_renderer(renderer.clone());
-    let instances = sim.camera.clean()?.instances.clone();
-    let labels: Vec<String> = scene.objects.iter().map(|o| o.label.clone()).collect();
-    // Only the perception-error models look at the ground truth.
-    let truth = matches!(choice, DetectorChoice::PerceptionError(_)).then_some(GroundTruth {
-        instances: &instances,
-        labels: &labels,
-    });
-    let detector = choice.detector(&catalog, truth, seed)?;
-    let true_centres_m = {
-        let world = sim.world.lock().expect("world lock");
-        world.objects.iter().map(|o| o.centre.to_array()).collect()
-    };
-    let answer = pipeline::answer(
-        prompt,
-        &catalog,
-        Devices {
+/// What a question on the twin runs on: the scene, its sim devices' seed, the detector, the
+/// camera's renderer and the explainer.
+pub struct Twin<'a> {
+    pub scene: &'a Scene,
+    pub seed: u64,
+    pub detector: &'a DetectorChoice,
+    pub renderer: &'a Arc<dyn SceneRenderer>,
+    pub explainer: &'a dyn Explainer,
+}
+
+/// The sim devices of one question and what an evaluation needs from the twin beside them.
+struct Prepared<'d> {
+    sim: SimDevices,
+    detector: Box<dyn Detector + 'd>,
+    instances: InstanceImage,
+    true_centres_m: Vec<[f64; 3]>,
+}
+
+impl<'a> Twin<'a> {
+    fn prepare(&self, catalog: &'a FruitCatalog) -> Result<Prepared<'a>> {
+        let mut sim = SimDevices::from_scene(self.scene, self.seed)?;
+        sim.camera.set_renderer(self.renderer.clone());
+        let instances = sim.camera.clean()?.instances.clone();
+        let labels: Vec<String> = self.scene.objects.iter().map(|o| o.label.clone()).collect();
+        // Only the perception-error models look at the ground truth.
+        let truth =
+            matches!(self.detector, DetectorChoice::PerceptionError(_)).then_some(GroundTruth {
+                instances: &instances,
+                labels: &labels,
+            });
+        let detector = self.detector.detector(catalog, truth, self.seed)?;
+        let true_centres_m = {
+            let world = sim.world.lock().expect("world lock");
+            world.objects.iter().map(|o| o.centre.to_array()).collect()
+        };
+        Ok(Prepared {
+            sim,
+            detector,
+            instances,
+            true_centres_m,
+        })
+    }
+
+    /// Answers `prompt` on fresh sim devices of the scene, telling `on_progress` what
+    /// happens.
+    pub fn answer(
+        &self,
+        prompt: &str,
+        config: &PipelineConfig,
+        on_progress: &dyn Fn(Progress),
+    ) -> Result<TwinAnswer> {
+        let catalog = FruitCatalog::builtin();
+        let Prepared {
+            mut sim,
+            detector,
+            instances,
+            true_centres_m,
+        } = self.prepare(&catalog)?;
+        let answer = answer_with(
+            prompt,
+            &catalog,
+            Devices {
+                camera: &mut sim.camera,
+                tactile: &mut sim.tactile,
+                arm: &mut sim.arm,
+            },
+            detector.as_ref(),
+            self.explainer,
+            config,
+            on_progress,
+        )?;
+        Ok(TwinAnswer {
+            answer,
+            true_centres_m,
+            intrinsics: sim.camera.intrinsics(),
+            camera_pose: sim.camera.pose(),
+            instances,
+        })
+    }
+
+    /// [`Twin::answer`], recording every frame and move into a session in `dir`.
+    pub fn answer_recorded(
+        &self,
+        prompt: &str,
+        config: &PipelineConfig,
+        dir: &Path,
+    ) -> Result<Answer> {
+        let catalog = FruitCatalog::builtin();
+        let mut prepared = self.prepare(&catalog)?;
+        let sim = &mut prepared.sim;
+        let devices = Devices {
             camera: &mut sim.camera,
             tactile: &mut sim.tactile,
             arm: &mut sim.arm,
-        },
-        detector.as_ref(),
+        };
+        let question = Question {
+            prompt,
+            catalog: &catalog,
+            detector: prepared.detector.as_ref(),
+            explainer: self.explainer,
+            config,
+        };
+        question.ask(devices, Some((dir, "sim")))
+    }
+}
+
+/// One question and what answers it, apart from the devices.
+pub struct Question<'q> {
+    pub prompt: &'q str,
+    pub catalog: &'q FruitCatalog,
+    pub detector: &'q dyn Detector,
+    pub explainer: &'q dyn Explainer,
+    pub config: &'q PipelineConfig,
+}
+
+impl Question<'_> {
+    /// Answers on `devices`; with `record` = (DIR, backend name), everything they deliver
+    /// and are asked to do is written into a new session in DIR.
+    pub fn ask<C: RgbdCamera, T: TactileSensor, A: Arm>(
+        &self,
+        devices: Devices<'_, C, T, A>,
+        record: Option<(&Path, &str)>,
+    ) -> Result<Answer> {
+        let Some((dir, backend)) = record else {
+            return answer_with(
+                self.prompt,
+                self.catalog,
+                devices,
+                self.detector,
+                self.explainer,
+                self.config,
+                &|_| {},
+            );
+        };
+        let recorder = SessionRecorder::create(dir).context("--record")?;
+        let answer = answer_with(
+            self.prompt,
+            self.catalog,
+            Devices {
+                camera: &mut recorder.camera(devices.camera),
+                tactile: &mut recorder.tactile(devices.tactile),
+                arm: &mut recorder.arm(devices.arm)?,
+            },
+            self.detector,
+            self.explainer,
+            self.config,
+            &|_| {},
+        )?;
+        let json = serde_json::to_value(&answer).context("serialising the answer")?;
+        recorder
+            .finish(backend, self.prompt, Some(json))
+            .context("--record")?;
+        Ok(answer)
+    }
+}
+
+/// One question through the pipeline on any devices, with the Hertz slope estimator.
+#[allow(clippy::too_many_arguments)]
+fn answer_with<C: RgbdCamera, T: TactileSensor, A: Arm>(
+    prompt: &str,
+    catalog: &FruitCatalog,
+    devices: Devices<'_, C, T, A>,
+    detector: &dyn Detector,
+    explainer: &dyn Explainer,
+    config: &PipelineConfig,
+    on_progress: &dyn Fn(Progress),
+) -> Result<Answer> {
+    Ok(pipeline::answer_with_progress(
+        prompt,
+        catalog,
+        devices,
+        detector,
         &HertzSlopeEstimator::default(),
         explainer,
         config,
-    )?;
-    Ok(TwinAnswer {
-        answer,
-        true_centres_m,
-        intrinsics: sim.camera.intrinsics(),
-        camera_pose: sim.camera.pose(),
-        instances,
-    })
+        on_progress,
+    )?)
+}
+
+/// Answers `prompt` from the recorded session in `dir`: its frames in the order they were
+/// taken, its moves checked against the pipeline's.
+pub fn answer_on_replay(
+    dir: &Path,
+    choice: &DetectorChoice,
+    explainer: &dyn Explainer,
+    prompt: &str,
+    config: &PipelineConfig,
+) -> Result<Answer> {
+    let catalog = FruitCatalog::builtin();
+    let (_, mut camera, mut tactile, mut arm) = open_session(dir).context("--session")?;
+    let detector = detector_without_truth(choice, &catalog)?;
+    let question = Question {
+        prompt,
+        catalog: &catalog,
+        detector: detector.as_ref(),
+        explainer,
+        config,
+    };
+    question.ask(
+        Devices {
+            camera: &mut camera,
+            tactile: &mut tactile,
+            arm: &mut arm,
+        },
+        None,
+    )
+}
+
+/// The detector for devices that know no ground truth (real ones, or a replay of them).
+fn detector_without_truth<'a>(
+    choice: &'a DetectorChoice,
+    catalog: &'a FruitCatalog,
+) -> Result<Box<dyn Detector + 'a>> {
+    if matches!(choice, DetectorChoice::PerceptionError(_)) {
+        bail!(
+            "--detector: the perception-error models need the twin's ground truth; use classical or yolo:FILE"
+        );
+    }
+    choice.detector(catalog, None, 0)
+}
+
+/// Answers `prompt` on the real devices `devices.toml` names: an xArm, a RealSense and a
+/// GelSight Mini.
+#[cfg(target_os = "linux")]
+fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> Result<Answer> {
+    let catalog = FruitCatalog::builtin();
+    let devices = DevicesConfig::load(file)?;
+    let choice = DetectorChoice::parse(&args.twin.detector)?;
+    let detector = detector_without_truth(&choice, &catalog)?;
+    let explainer = explainer(args.twin.explainer, args.twin.llm_config.as_ref())?;
+    // The sensors first, so that a missing camera never leaves the arm enabled.
+    let mut camera = devices.open_camera()?;
+    let mut tactile = devices.open_tactile()?;
+    let mut arm = devices.open_arm()?;
+    let question = Question {
+        prompt: &args.prompt,
+        catalog: &catalog,
+        detector: detector.as_ref(),
+        explainer: explainer.as_ref(),
+        config,
+    };
+    question.ask(
+        Devices {
+            camera: &mut camera,
+            tactile: &mut tactile,
+            arm: &mut arm,
+        },
+        args.record.as_deref().map(|d| (d, "hw")),
+    )
+}
+
+#[cfg(not(target_os = "linux"))]
+fn answer_on_hardware(_: &Path, _: &AskArgs, _: &PipelineConfig) -> Result<Answer> {
+    bail!("--backend hw: the cameras are read over V4L2, which needs Linux");
 }
 
 pub fn run(args: &AskArgs) -> Result<()> {
     let catalog = FruitCatalog::builtin();
-    // The prompt is checked before the scene is built so that a bad question fails fast.
+    // The prompt is checked before any device is opened so that a bad question fails fast.
     tactex_core::query::parse(&args.prompt, &catalog)?;
-    let path = args.scene.clone().unwrap_or_else(crate::default_scene);
-    let scene = Scene::load(&path, &catalog)?;
-    let choice = DetectorChoice::parse(&args.detector)?;
-    let renderer = scene_renderer(args.device)?;
-    let explainer = explainer(args.explainer, args.llm_config.as_ref())?;
     let config = PipelineConfig {
         measure_wall_time: !args.reproducible,
         ..PipelineConfig::default()
     };
-    let answer = answer_on_twin(
-        &scene,
-        args.seed,
-        &choice,
-        &renderer,
-        explainer.as_ref(),
-        &args.prompt,
-        &config,
-    )?
-    .answer;
+    if args.devices.is_some() && args.backend != Backend::Hw {
+        bail!("--devices: only with --backend hw");
+    }
+    let answer = match args.backend {
+        Backend::Hw => {
+            let Some(file) = &args.devices else {
+                bail!("--backend hw: needs --devices FILE (devices.toml: arm, camera, tactile)");
+            };
+            answer_on_hardware(file, args, &config)?
+        }
+        Backend::Replay => {
+            let Some(dir) = &args.session else {
+                bail!("--backend replay: needs --session DIR (a directory `--record` wrote)");
+            };
+            if args.record.is_some() {
+                bail!("--record: a replay is already a recording; record from --backend sim");
+            }
+            let opened = args.twin.open()?;
+            answer_on_replay(
+                dir,
+                &opened.detector,
+                opened.explainer.as_ref(),
+                &args.prompt,
+                &config,
+            )?
+        }
+        Backend::Sim => {
+            if args.session.is_some() {
+                bail!("--session: only with --backend replay");
+            }
+            let path = args.scene.clone().unwrap_or_else(crate::default_scene);
+            let scene = Scene::load(&path, &catalog)?;
+            let opened = args.twin.open()?;
+            let twin = Twin {
+                scene: &scene,
+                seed: args.seed,
+                detector: &opened.detector,
+                renderer: &opened.renderer,
+                explainer: opened.explainer.as_ref(),
+            };
+            match &args.record {
+                Some(dir) => twin.answer_recorded(&args.prompt, &config, dir)?,
+                None => twin.answer(&args.prompt, &config, &|_| {})?.answer,
+            }
+        }
+    };
     if args.json {
         println!(
             "{}",

@@ -15,7 +15,7 @@
 //! paper's ten fruit kinds (tier 2 through the eight that have ripeness stages), so that each
 //! kind is asked about equally often.
 
-use crate::ask::{TwinAnswer, answer_on_twin};
+use crate::ask::{Twin, TwinAnswer};
 use crate::detector_choice::DetectorChoice;
 use crate::eval_grounding::KINDS;
 use crate::output::{write_bytes_atomic, write_json_atomic};
@@ -578,15 +578,14 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
         .par_iter()
         .map(|&(s, d)| -> Result<RunScore> {
             let sc = &scenarios[s];
-            let twin = answer_on_twin(
-                &sc.scene,
-                sc.seed,
-                &detectors[d],
-                &renderer,
-                &TemplateExplainer,
-                &sc.prompt,
-                &config,
-            )
+            let twin = Twin {
+                scene: &sc.scene,
+                seed: sc.seed,
+                detector: &detectors[d],
+                renderer: &renderer,
+                explainer: &TemplateExplainer,
+            }
+            .answer(&sc.prompt, &config, &|_| {})
             .with_context(|| format!("tier {} run {}: {}", sc.tier, sc.run, args.detector[d]))?;
             bar.inc(1);
             Ok(score(sc, &args.detector[d], &twin))
@@ -705,6 +704,7 @@ mod tests {
                 explainer: "template".into(),
                 explain_notice: None,
                 timing: Vec::new(),
+                presses: Vec::new(),
             },
             true_centres_m: centres,
             instances,

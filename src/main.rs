@@ -1,6 +1,7 @@
 //! `tactex`: the TactEx twin command line. Wires the simulated devices (tactex-sim) into the
 //! backend-free pipeline (tactex-core).
 
+mod arm_cli;
 mod ask;
 mod ball_presses;
 mod bench_contact;
@@ -26,6 +27,7 @@ mod output;
 mod parse_prompt;
 mod plot;
 mod press;
+mod serve;
 
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
@@ -50,6 +52,12 @@ struct Cli {
 enum Command {
     /// Answer a question about the fruit on the table, e.g. "Which fruit is the softest?"
     Ask(ask::AskArgs),
+    /// The chat page: live camera view with detections, questions answered with progress,
+    /// tactile frames, hardness and ripeness of each touched fruit, latency per stage.
+    Serve(serve::ServeArgs),
+    /// A real uFactory xArm (or the vendor's simulator) over its TCP protocol: pose, move,
+    /// home.
+    Arm(arm_cli::ArmArgs),
     /// What the prompt parser reads from a question (intent, property, targets, filters).
     Parse(parse_prompt::ParseArgs),
     /// Press the gel into one object and report force, contact and indentation.
@@ -205,6 +213,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Ask(args) => ask::run(&args),
+        Command::Serve(args) => serve::run(&args),
+        Command::Arm(args) => arm_cli::run(&args),
         Command::Parse(args) => parse_prompt::run(&args),
         Command::Press(args) => press::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),

@@ -47,11 +47,16 @@ pub fn write_png16_atomic(path: &Path, width: u32, height: u32, data: Vec<u16>) 
     write_bytes_atomic(path, bytes.get_ref())
 }
 
-/// An 8-bit RGB PNG.
-pub fn write_png_atomic(path: &Path, image: &image::RgbImage) -> Result<()> {
+/// An 8-bit RGB PNG, encoded in memory.
+pub fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>> {
     let mut bytes = std::io::Cursor::new(Vec::new());
     image
         .write_to(&mut bytes, image::ImageFormat::Png)
         .context("encoding PNG")?;
-    write_bytes_atomic(path, bytes.get_ref())
+    Ok(bytes.into_inner())
+}
+
+/// An 8-bit RGB PNG.
+pub fn write_png_atomic(path: &Path, image: &image::RgbImage) -> Result<()> {
+    write_bytes_atomic(path, &png_bytes(image)?)
 }

@@ -99,6 +99,42 @@ pub struct ObjectReport {
     pub warnings: Vec<String>,
 }
 
+/// What a running question has got to, for a live view: the stage it entered, what the camera
+/// found, which object the arm is pressing, and each stage's time as it ends.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "event", rename_all = "snake_case")]
+pub enum Progress {
+    StageStarted {
+        stage: String,
+    },
+    Detected {
+        objects: Vec<Sighting>,
+    },
+    Pressing {
+        index: usize,
+        of: usize,
+        label: String,
+    },
+    Pressed {
+        index: usize,
+        label: String,
+        /// Press frames recorded; 0 when no contact was found.
+        frames: usize,
+        warning: Option<String>,
+    },
+    StageFinished(StageTiming),
+}
+
+/// One grounded object as the camera saw it, in the order the arm will press them.
+#[derive(Clone, Debug, Serialize)]
+pub struct Sighting {
+    pub label: String,
+    pub score: f64,
+    /// x0, y0, x1, y1 in colour-image pixels (inclusive).
+    pub bbox: [u32; 4],
+    pub position_m: [f64; 3],
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct Answer {
     pub query: Query,
@@ -112,6 +148,10 @@ pub struct Answer {
     /// Why a model's reply was not used, when the template stood in for it.
     pub explain_notice: Option<String>,
     pub timing: Vec<StageTiming>,
+    /// Each object's press (no-contact reference and press frames), in `objects`' order;
+    /// None where no contact was found. Left out of the JSON: images belong in image files.
+    #[serde(skip)]
+    pub presses: Vec<Option<PressSequence>>,
 }
 
 /// The devices one question runs on.
@@ -124,6 +164,7 @@ pub struct Devices<'a, C: RgbdCamera, T: TactileSensor, A: Arm> {
 struct Target {
     label: String,
     score: f64,
+    bbox: [u32; 4],
     centre: DVec3,
     surface: DVec3,
     touch: DVec3,
@@ -145,6 +186,30 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     explainer: &dyn Explainer,
     config: &PipelineConfig,
 ) -> Result<Answer, PipelineError> {
+    answer_with_progress(
+        prompt,
+        catalog,
+        devices,
+        detector,
+        estimator,
+        explainer,
+        config,
+        &|_| {},
+    )
+}
+
+/// [`answer`], telling `on_progress` what happens as it happens.
+#[allow(clippy::too_many_arguments)]
+pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
+    prompt: &str,
+    catalog: &FruitCatalog,
+    devices: Devices<'_, C, T, A>,
+    detector: &dyn Detector,
+    estimator: &dyn HardnessEstimator,
+    explainer: &dyn Explainer,
+    config: &PipelineConfig,
+    on_progress: &dyn Fn(Progress),
+) -> Result<Answer, PipelineError> {
     let Devices {
         camera,
         tactile,
@@ -152,22 +217,40 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     } = devices;
     let mut timing = Vec::new();
     let mut lap = |stage: &str, arm: &A, start: (Instant, Option<f64>)| {
-        timing.push(StageTiming {
+        let stage = StageTiming {
             stage: stage.into(),
             wall_ms: config
                 .measure_wall_time
                 .then(|| start.0.elapsed().as_secs_f64() * 1e3),
             sim_s: arm.sim_time_s().zip(start.1).map(|(now, then)| now - then),
-        });
+        };
+        on_progress(Progress::StageFinished(stage.clone()));
+        timing.push(stage);
     };
-    let start = |arm: &A| (Instant::now(), arm.sim_time_s());
+    let start = |stage: &str, arm: &A| {
+        on_progress(Progress::StageStarted {
+            stage: stage.into(),
+        });
+        (Instant::now(), arm.sim_time_s())
+    };
 
-    let t = start(arm);
+    let t = start("parse", arm);
     let query = query::parse(prompt, catalog)?;
     lap("parse", arm, t);
 
-    let t = start(arm);
+    let t = start("ground", arm);
     let targets = ground(&query, camera, detector, config)?;
+    on_progress(Progress::Detected {
+        objects: targets
+            .iter()
+            .map(|t| Sighting {
+                label: t.label.clone(),
+                score: t.score,
+                bbox: t.bbox,
+                position_m: t.centre.to_array(),
+            })
+            .collect(),
+    });
     lap("ground", arm, t);
     let not_found: Vec<String> = query
         .targets
@@ -176,14 +259,26 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
         .cloned()
         .collect();
 
-    let t = start(arm);
+    let t = start("press", arm);
     let mut presses = Vec::new();
-    for target in &targets {
-        presses.push(press(target, tactile, arm, config)?);
+    for (index, target) in targets.iter().enumerate() {
+        on_progress(Progress::Pressing {
+            index,
+            of: targets.len(),
+            label: target.label.clone(),
+        });
+        let pressed = press(target, tactile, arm, config)?;
+        on_progress(Progress::Pressed {
+            index,
+            label: target.label.clone(),
+            frames: pressed.as_ref().map_or(0, |p| p.sequence.frames.len()),
+            warning: pressed.as_ref().err().cloned(),
+        });
+        presses.push(pressed);
     }
     lap("press", arm, t);
 
-    let t = start(arm);
+    let t = start("hardness", arm);
     let mut objects = Vec::new();
     for (target, pressed) in targets.iter().zip(&presses) {
         let mut report = ObjectReport {
@@ -225,7 +320,7 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     }
     lap("hardness", arm, t);
 
-    let t = start(arm);
+    let t = start("explain", arm);
     let measured: Vec<Measured> = objects
         .iter()
         .map(|o| Measured {
@@ -257,6 +352,10 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
         explainer: explanation.explainer,
         explain_notice: explanation.notice,
         timing,
+        presses: presses
+            .into_iter()
+            .map(|p| p.ok().map(|p| p.sequence))
+            .collect(),
     })
 }
 
@@ -295,6 +394,7 @@ fn ground<C: RgbdCamera>(
             Some(Target {
                 label: d.label,
                 score: d.score,
+                bbox: d.bbox,
                 centre: at.centre,
                 surface: at.surface,
                 touch: at.touch,

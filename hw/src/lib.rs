@@ -1,6 +1,14 @@
 //! tactex-hw: the real-device backends behind tactex-core's traits (uFactory xArm over its
 //! TCP protocol, GelSight Mini and RealSense over V4L2, recorded-session replay).
 //!
-//! The walking skeleton runs on the simulated twin only; the devices land here with issue 8,
-//! and the `tactex` binary selects them with `--backend`. Until then this crate has no
-//! backend to offer and the binary says so rather than pretending.
+//! Here: the xArm client (`xarm`, with a fake controller for tests and bring-up) and
+//! recorded sessions (`session`: record any backend's devices, replay them). The V4L2
+//! cameras follow.
+
+pub mod devices_toml;
+pub mod gelsight_mini;
+pub mod realsense;
+pub mod session;
+#[cfg(target_os = "linux")]
+pub mod v4l2_capture;
+pub mod xarm;

@@ -1,0 +1,299 @@
+//! Replay: devices that give back a recorded session's frames in the order they were
+//! taken, and an arm that accepts exactly the recorded moves. A pipeline that asks for
+//! anything else (another prompt, another detector) has diverged from the recording, and
+//! the replay says so instead of inventing data.
+
+use super::format::{
+    ArmRecord, CameraRecord, FORMAT, MANIFEST, Manifest, SessionError, TactileRecord, partial_dir,
+};
+use super::record::depth_from_u16;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use tactex_core::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
+use tactex_core::frames::{RgbdFrame, TactileFrame};
+use tactex_core::geometry::{CameraIntrinsics, Pose};
+use tactex_core::tactile_spec::TactileSpec;
+
+/// How far a replayed move's target may lie from the recorded one: the depth stored in
+/// 0.1 mm steps moves touch points by less than this.
+const MOVE_TOLERANCE_M: f64 = 1e-3;
+
+/// The manifest and the three replay devices of the session in `dir`.
+pub fn open_session(
+    dir: &Path,
+) -> Result<(Manifest, ReplayCamera, ReplayTactile, ReplayArm), SessionError> {
+    if !dir.is_dir() {
+        let why = if partial_dir(dir).is_dir() {
+            "no such session (a .partial recording beside it did not finish)"
+        } else {
+            "no such session directory"
+        };
+        return Err(SessionError::file(dir, why));
+    }
+    let path = dir.join(MANIFEST);
+    let text = std::fs::read_to_string(&path).map_err(|e| SessionError::file(&path, e))?;
+    let manifest: Manifest =
+        serde_json::from_str(&text).map_err(|e| SessionError::file(&path, e))?;
+    let field = |field: &str, message: String| SessionError::Field {
+        path: path.clone(),
+        field: field.into(),
+        message,
+    };
+    if manifest.format != FORMAT {
+        return Err(field(
+            "format",
+            format!("'{}' is not {FORMAT}", manifest.format),
+        ));
+    }
+    if !(manifest.camera.depth_scale_m.is_finite() && manifest.camera.depth_scale_m > 0.0) {
+        return Err(field(
+            "camera.depth_scale_m",
+            "must be a positive number".into(),
+        ));
+    }
+    let files = manifest
+        .camera
+        .frames
+        .iter()
+        .flat_map(|f| [&f.color, &f.depth])
+        .chain(manifest.tactile.frames.iter().map(|f| &f.image));
+    for file in files {
+        let p = dir.join(file);
+        if Path::new(file).is_absolute() || file.contains("..") || !p.is_file() {
+            return Err(SessionError::file(&p, "listed in the manifest but missing"));
+        }
+    }
+    let name = |device: &str| format!("replay {device} ({})", dir.display());
+    let clock = RobotClock {
+        now_s: Arc::new(Mutex::new(manifest.arm.start_time_s)),
+        running: manifest.arm.start_time_s.is_some(),
+    };
+    Ok((
+        manifest.clone(),
+        ReplayCamera {
+            name: name("camera"),
+            dir: dir.to_path_buf(),
+            record: manifest.camera,
+            next: 0,
+            clock: clock.clone(),
+        },
+        ReplayTactile {
+            name: name("tactile"),
+            dir: dir.to_path_buf(),
+            record: manifest.tactile,
+            next: 0,
+            clock: clock.clone(),
+        },
+        ReplayArm {
+            name: name("arm"),
+            pose: manifest.arm.start_pose,
+            record: manifest.arm,
+            next: 0,
+            clock,
+        },
+    ))
+}
+
+/// The recorded robot clock, where the recorded backend had one of its own (the twin's
+/// simulated time): it stands at the time of the last frame or move given back, so a
+/// replay reports the recording's robot time per stage.
+#[derive(Clone)]
+struct RobotClock {
+    now_s: Arc<Mutex<Option<f64>>>,
+    running: bool,
+}
+
+impl RobotClock {
+    fn set(&self, t: Option<f64>) {
+        if self.running {
+            *self.now_s.lock().unwrap_or_else(|e| e.into_inner()) = t;
+        }
+    }
+    fn now(&self) -> Option<f64> {
+        *self.now_s.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+fn failure(device: &str, message: impl Into<String>) -> DeviceError {
+    DeviceError::Failure {
+        device: device.into(),
+        message: message.into(),
+    }
+}
+
+fn exhausted(device: &str, what: &str, n: usize) -> DeviceError {
+    failure(
+        device,
+        format!(
+            "the recording has {n} {what}; the pipeline asked for more, so this run diverged \
+             from the recorded one (another prompt or detector?)"
+        ),
+    )
+}
+
+pub struct ReplayCamera {
+    name: String,
+    dir: PathBuf,
+    record: CameraRecord,
+    next: usize,
+    clock: RobotClock,
+}
+
+impl RgbdCamera for ReplayCamera {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn intrinsics(&self) -> CameraIntrinsics {
+        self.record.intrinsics
+    }
+    fn pose(&self) -> Pose {
+        self.record.pose
+    }
+    fn capture(&mut self) -> Result<RgbdFrame, DeviceError> {
+        let Some(f) = self.record.frames.get(self.next) else {
+            return Err(exhausted(
+                &self.name,
+                "RGB-D frames",
+                self.record.frames.len(),
+            ));
+        };
+        self.next += 1;
+        let read = |file: &str| {
+            let path = self.dir.join(file);
+            tactex_core::image::open(&path)
+                .map_err(|e| failure(&self.name, format!("{}: {e}", path.display())))
+        };
+        let color = read(&f.color)?.to_rgb8();
+        let depth = read(&f.depth)?.to_luma16();
+        let k = &self.record.intrinsics;
+        for (file, size) in [
+            (&f.color, color.dimensions()),
+            (&f.depth, depth.dimensions()),
+        ] {
+            if size != (k.width, k.height) {
+                return Err(failure(
+                    &self.name,
+                    format!(
+                        "{file}: {}x{} px, the intrinsics say {}x{}",
+                        size.0, size.1, k.width, k.height
+                    ),
+                ));
+            }
+        }
+        self.clock.set(Some(f.timestamp_s));
+        Ok(RgbdFrame {
+            color,
+            depth_m: depth_from_u16(&depth, self.record.depth_scale_m),
+            timestamp_s: f.timestamp_s,
+        })
+    }
+}
+
+pub struct ReplayTactile {
+    name: String,
+    dir: PathBuf,
+    record: TactileRecord,
+    next: usize,
+    clock: RobotClock,
+}
+
+impl TactileSensor for ReplayTactile {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn spec(&self) -> &TactileSpec {
+        &self.record.spec
+    }
+    fn capture(&mut self) -> Result<TactileFrame, DeviceError> {
+        let Some(f) = self.record.frames.get(self.next) else {
+            return Err(exhausted(
+                &self.name,
+                "tactile frames",
+                self.record.frames.len(),
+            ));
+        };
+        self.next += 1;
+        let path = self.dir.join(&f.image);
+        let image = tactex_core::image::open(&path)
+            .map_err(|e| failure(&self.name, format!("{}: {e}", path.display())))?
+            .to_rgb8();
+        let spec = &self.record.spec;
+        if image.dimensions() != (spec.width_px, spec.height_px) {
+            return Err(failure(
+                &self.name,
+                format!(
+                    "{}: {}x{} px, the sensor gives {}x{}",
+                    f.image,
+                    image.width(),
+                    image.height(),
+                    spec.width_px,
+                    spec.height_px
+                ),
+            ));
+        }
+        self.clock.set(Some(f.timestamp_s));
+        Ok(TactileFrame {
+            image,
+            timestamp_s: f.timestamp_s,
+        })
+    }
+}
+
+pub struct ReplayArm {
+    name: String,
+    record: ArmRecord,
+    next: usize,
+    pose: Pose,
+    clock: RobotClock,
+}
+
+impl Arm for ReplayArm {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn pose(&self) -> Result<Pose, DeviceError> {
+        Ok(self.pose)
+    }
+    fn move_linear(&mut self, target: &Pose, speed_m_s: f64) -> Result<(), DeviceError> {
+        let n = self.next;
+        let Some(m) = self.record.moves.get(n) else {
+            return Err(exhausted(&self.name, "moves", self.record.moves.len()));
+        };
+        let off = (m.target.position - target.position).length();
+        if off > MOVE_TOLERANCE_M || m.target.rotation.angle_between(target.rotation) > 1e-3 {
+            let p = |v: tactex_core::glam::DVec3| format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z);
+            return Err(failure(
+                &self.name,
+                format!(
+                    "move {n} was recorded to {} m but is asked to {} m: this run diverged \
+                     from the recorded one",
+                    p(m.target.position),
+                    p(target.position)
+                ),
+            ));
+        }
+        if (m.speed_m_s - speed_m_s).abs() > 1e-9 * m.speed_m_s.abs().max(1.0) {
+            return Err(failure(
+                &self.name,
+                format!(
+                    "move {n} was recorded at {} m/s but is asked at {speed_m_s} m/s",
+                    m.speed_m_s
+                ),
+            ));
+        }
+        self.next += 1;
+        self.pose = m.reached;
+        self.clock.set(m.time_s);
+        match &m.error {
+            // The recorded device refused or failed this move; the replay does the same.
+            Some(e) => Err(failure(&self.name, format!("recorded: {e}"))),
+            None => Ok(()),
+        }
+    }
+    fn stop(&mut self) -> Result<(), DeviceError> {
+        Ok(())
+    }
+    fn sim_time_s(&self) -> Option<f64> {
+        self.clock.now()
+    }
+}

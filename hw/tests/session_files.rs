@@ -1,0 +1,168 @@
+//! Session files on their own: depth survives the 16-bit PNG within its 0.1 mm step, a
+//! recording that is not finished leaves nothing behind, and replayed devices give back
+//! exactly what was recorded and refuse what was not.
+
+use tactex_core::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
+use tactex_core::frames::{DepthImage, RgbdFrame, TactileFrame};
+use tactex_core::geometry::{CameraIntrinsics, Pose};
+use tactex_core::glam::DVec3;
+use tactex_core::image::{Luma, Rgb, RgbImage};
+use tactex_core::tactile_spec::TactileSpec;
+use tactex_hw::session::record::{depth_from_u16, depth_to_u16};
+use tactex_hw::session::{SessionRecorder, open_session};
+
+/// A camera whose depth ramps across the image, 0.3 to 0.9 m, with an invalid column.
+struct RampCamera {
+    k: CameraIntrinsics,
+    t: f64,
+}
+
+impl RgbdCamera for RampCamera {
+    fn name(&self) -> &str {
+        "ramp"
+    }
+    fn intrinsics(&self) -> CameraIntrinsics {
+        self.k
+    }
+    fn pose(&self) -> Pose {
+        Pose::IDENTITY
+    }
+    fn capture(&mut self) -> Result<RgbdFrame, DeviceError> {
+        self.t += 0.1;
+        let (w, h) = (self.k.width, self.k.height);
+        Ok(RgbdFrame {
+            color: RgbImage::from_fn(w, h, |x, y| Rgb([x as u8, y as u8, 7])),
+            depth_m: DepthImage::from_fn(w, h, |x, _| {
+                Luma([if x == 0 {
+                    0.0
+                } else {
+                    0.3 + 0.6 * x as f32 / w as f32
+                }])
+            }),
+            timestamp_s: self.t,
+        })
+    }
+}
+
+struct CountingTactile {
+    spec: TactileSpec,
+    n: u8,
+}
+
+impl TactileSensor for CountingTactile {
+    fn name(&self) -> &str {
+        "counting"
+    }
+    fn spec(&self) -> &TactileSpec {
+        &self.spec
+    }
+    fn capture(&mut self) -> Result<TactileFrame, DeviceError> {
+        self.n += 1;
+        let n = self.n;
+        Ok(TactileFrame {
+            image: RgbImage::from_pixel(self.spec.width_px, self.spec.height_px, Rgb([n, 0, 0])),
+            timestamp_s: f64::from(n),
+        })
+    }
+}
+
+struct PointArm {
+    pose: Pose,
+}
+
+impl Arm for PointArm {
+    fn name(&self) -> &str {
+        "point"
+    }
+    fn pose(&self) -> Result<Pose, DeviceError> {
+        Ok(self.pose)
+    }
+    fn move_linear(&mut self, target: &Pose, _speed_m_s: f64) -> Result<(), DeviceError> {
+        self.pose = *target;
+        Ok(())
+    }
+    fn stop(&mut self) -> Result<(), DeviceError> {
+        Ok(())
+    }
+}
+
+fn devices() -> (RampCamera, CountingTactile, PointArm) {
+    let mut k = CameraIntrinsics::default();
+    (k.width, k.height) = (64, 48);
+    (
+        RampCamera { k, t: 0.0 },
+        CountingTactile {
+            spec: TactileSpec::gelsight_mini(),
+            n: 0,
+        },
+        PointArm {
+            pose: Pose::tool_down(DVec3::new(0.0, 0.0, 0.3)),
+        },
+    )
+}
+
+#[test]
+fn depth_survives_the_png_within_half_a_step_and_invalid_stays_invalid() {
+    let (mut cam, ..) = devices();
+    let depth = cam.capture().unwrap().depth_m;
+    let back = depth_from_u16(&depth_to_u16(&depth), 1e-4);
+    for (a, b) in depth.pixels().zip(back.pixels()) {
+        assert!((a[0] - b[0]).abs() <= 0.5e-4 + 1e-7, "{} vs {}", a[0], b[0]);
+    }
+    assert_eq!(back.get_pixel(0, 0)[0], 0.0);
+}
+
+#[test]
+fn an_unfinished_recording_leaves_nothing_behind() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let (mut cam, ..) = devices();
+    {
+        let recorder = SessionRecorder::create(&dir).unwrap();
+        recorder.camera(&mut cam).capture().unwrap();
+        assert!(tmp.path().join("s.partial/camera/color-0000.png").is_file());
+    }
+    assert!(!dir.exists() && !tmp.path().join("s.partial").exists());
+}
+
+#[test]
+fn replayed_devices_give_back_what_was_recorded_and_refuse_the_rest() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let (mut cam, mut tac, mut arm) = devices();
+    let recorder = SessionRecorder::create(&dir).unwrap();
+    let (mut frames, mut touches) = (Vec::new(), Vec::new());
+    let goal = Pose::tool_down(DVec3::new(0.1, 0.0, 0.05));
+    {
+        let mut c = recorder.camera(&mut cam);
+        let mut t = recorder.tactile(&mut tac);
+        let mut a = recorder.arm(&mut arm).unwrap();
+        frames.push(c.capture().unwrap());
+        a.move_linear(&goal, 0.01).unwrap();
+        touches.push(t.capture().unwrap());
+        touches.push(t.capture().unwrap());
+    }
+    recorder.finish("test", "How hard is it?", None).unwrap();
+
+    let (manifest, mut c, mut t, mut a) = open_session(&dir).unwrap();
+    assert_eq!(manifest.backend, "test");
+    assert_eq!(manifest.tactile.frames[1].arm_pose, goal);
+    let f = c.capture().unwrap();
+    assert_eq!(f.color, frames[0].color);
+    assert_eq!(
+        f.depth_m, frames[0].depth_m,
+        "the recorder gave the stored depth"
+    );
+    let err = a
+        .move_linear(&Pose::tool_down(DVec3::new(0.2, 0.0, 0.05)), 0.01)
+        .unwrap_err();
+    assert!(err.to_string().contains("diverged"), "{err}");
+    a.move_linear(&goal, 0.01).unwrap();
+    assert_eq!(a.pose().unwrap(), goal);
+    for want in &touches {
+        assert_eq!(t.capture().unwrap().image, want.image);
+    }
+    let err = t.capture().unwrap_err();
+    assert!(err.to_string().contains("has 2 tactile frames"), "{err}");
+    assert!(c.capture().is_err());
+}
