@@ -196,9 +196,10 @@ fn markers_found_on_the_real_marker_frame_match_the_annotations() {
     }
     eprintln!("{within} of {total} annotated markers found within 1.5 px");
     assert_eq!(total, 99);
-    // 93 of 99 today; the six misses sit under the ridged indenter or carry a displacement
-    // the image does not show (one annotation is 6 px from any dot).
-    assert!(within >= 93, "{within} of {total}");
+    // 94 of 99 today (93 with plain silhouette means, before the circle through the hull
+    // restored dots that the ridge's highlights cut); of the five misses three annotations
+    // sit 2.6-6.6 px from a whole, unoccluded dot, and two dots are half hidden.
+    assert!(within >= 94, "{within} of {total}");
 }
 
 #[test]

@@ -3,7 +3,9 @@
 
 use image::{GrayImage, Luma, RgbImage};
 use imageproc::distance_transform::Norm;
+use imageproc::geometry::convex_hull;
 use imageproc::morphology::{Mask, close, grayscale_dilate, grayscale_erode};
+use imageproc::point::Point;
 use imageproc::region_labelling::{Connectivity, connected_components};
 
 /// Radius (px) of the closing that erases the dots to estimate the gel behind them: larger
@@ -33,25 +35,24 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
     let dark = close(&dark, Norm::LInf, 2);
     let labels = connected_components(&dark, Connectivity::Eight, Luma([0u8]));
     let n = labels.pixels().map(|p| p[0]).max().unwrap_or(0) as usize;
-    // Per blob: sums of x and y over its silhouette, and its pixel count. Uniform weights:
-    // shading inside a dot (specks, the glow of a contact) says nothing about its centre.
-    let mut acc = vec![(0.0f64, 0.0f64, 0usize); n + 1];
+    let mut blobs: Vec<Vec<Point<i32>>> = vec![Vec::new(); n + 1];
     for (x, y, l) in labels.enumerate_pixels() {
-        let id = l[0] as usize;
-        if id > 0 {
-            let a = &mut acc[id];
-            a.0 += x as f64;
-            a.1 += y as f64;
-            a.2 += 1;
+        if l[0] > 0 {
+            blobs[l[0] as usize].push(Point::new(x as i32, y as i32));
         }
     }
-    let mut out: Vec<(f64, f64)> = acc
-        .iter()
+    let mut out: Vec<(f64, f64)> = blobs
+        .into_iter()
         .skip(1)
         // Specks and smudges are not dots. A dot cut by the frame edge is kept: its centroid
         // is that of the visible part.
-        .filter(|a| (6..=600).contains(&a.2))
-        .map(|a| (a.0 / a.2 as f64, a.1 / a.2 as f64))
+        .filter(|b| (6..=600).contains(&b.len()))
+        .map(|b| {
+            let cut_by_frame = b
+                .iter()
+                .any(|p| p.x == 0 || p.y == 0 || p.x + 1 == w as i32 || p.y + 1 == h as i32);
+            dot_centre(&b, cut_by_frame)
+        })
         .collect();
     out.sort_by(|p, q| {
         (p.1.round(), p.0)
@@ -59,6 +60,93 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
             .unwrap_or(std::cmp::Ordering::Equal)
     });
     out
+}
+
+/// Centre of a dot from its silhouette. A bright ridge or glint that cuts a bite or a chord
+/// out of a dot (the highlights at a sharp indenter's edge) leaves the corners of the cut on
+/// the dot's outline, so the circle through the silhouette's convex hull vertices is the
+/// dot's; a plain pixel mean would be pulled away from the cut. Falls back to the hull's
+/// area centroid when the vertices do not make a plausible circle, and for a dot cut by the
+/// frame's edge (its centre is that of the visible part). Shading inside the dot plays no
+/// part.
+fn dot_centre(pixels: &[Point<i32>], cut_by_frame: bool) -> (f64, f64) {
+    let mean = (
+        pixels.iter().map(|p| p.x as f64).sum::<f64>() / pixels.len() as f64,
+        pixels.iter().map(|p| p.y as f64).sum::<f64>() / pixels.len() as f64,
+    );
+    let hull = convex_hull(pixels.to_vec());
+    // Shoelace area and centroid of the hull polygon.
+    let (mut area2, mut cx, mut cy) = (0.0, 0.0, 0.0);
+    for (i, a) in hull.iter().enumerate() {
+        let b = hull[(i + 1) % hull.len()];
+        let cross = (a.x * b.y - b.x * a.y) as f64;
+        area2 += cross;
+        cx += (a.x + b.x) as f64 * cross;
+        cy += (a.y + b.y) as f64 * cross;
+    }
+    // A line or a point (a one-pixel-wide blob) has no area: its pixel mean is its centre.
+    if area2.abs() < 1.0 {
+        return mean;
+    }
+    let centroid = (cx / (3.0 * area2), cy / (3.0 * area2));
+    if cut_by_frame {
+        return centroid;
+    }
+    let equivalent_radius = (area2.abs() / 2.0 / std::f64::consts::PI).sqrt();
+    match circle_through(&hull, centroid) {
+        // A cut removes at most about half a dot: its circle is at most ~1.5x the radius of
+        // a disc of the hull's area, and its centre lies within that circle.
+        Some((centre, r))
+            if r < 1.8 * equivalent_radius + 1.0
+                && (centre.0 - centroid.0).hypot(centre.1 - centroid.1) < r =>
+        {
+            centre
+        }
+        _ => centroid,
+    }
+}
+
+/// Least-squares circle (Kasa) through at least 6 points: its centre and radius. Solved
+/// about `origin` for conditioning.
+fn circle_through(points: &[Point<i32>], origin: (f64, f64)) -> Option<((f64, f64), f64)> {
+    if points.len() < 6 {
+        return None;
+    }
+    // x^2 + y^2 + D x + E y + F = 0, normal equations of the 3 unknowns.
+    let mut m = [[0.0f64; 3]; 3];
+    let mut v = [0.0f64; 3];
+    for p in points {
+        let (x, y) = (p.x as f64 - origin.0, p.y as f64 - origin.1);
+        let row = [x, y, 1.0];
+        let rhs = -(x * x + y * y);
+        for i in 0..3 {
+            for j in 0..3 {
+                m[i][j] += row[i] * row[j];
+            }
+            v[i] += row[i] * rhs;
+        }
+    }
+    let det = |m: &[[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(&m);
+    if d.abs() < 1e-9 {
+        return None;
+    }
+    // Cramer's rule.
+    let solve = |k: usize| {
+        let mut mk = m;
+        for (row, value) in mk.iter_mut().zip(v) {
+            row[k] = value;
+        }
+        det(&mk) / d
+    };
+    let (dd, ee, ff) = (solve(0), solve(1), solve(2));
+    let (a, b) = (-dd / 2.0, -ee / 2.0);
+    let r2 = a * a + b * b - ff;
+    (r2 > 0.0 && r2.is_finite()).then(|| ((a + origin.0, b + origin.1), r2.sqrt()))
 }
 
 /// The grid pitch: the median distance from each marker to its nearest neighbour. None with
@@ -135,6 +223,37 @@ mod tests {
                 Rgb([170, 150, 140])
             }
         })
+    }
+
+    #[test]
+    fn a_glint_cutting_into_a_dot_does_not_move_its_centre() {
+        // A dot of radius 6 at (30, 30) with a bright notch 5 px tall and 4 deep cut into its
+        // left side, as a ridge's highlight cuts into the real frames' dots.
+        let dark = |x: u32, y: u32| {
+            let (dx, dy) = (x as f64 - 30.0, y as f64 - 30.0);
+            dx.hypot(dy) <= 6.0 && !(dx < -2.5 && dy.abs() <= 2.0)
+        };
+        let img = RgbImage::from_fn(60, 60, |x, y| {
+            if dark(x, y) {
+                Rgb([30, 30, 30])
+            } else {
+                Rgb([170, 150, 140])
+            }
+        });
+        let pixels: Vec<(f64, f64)> = (0..60u32)
+            .flat_map(|y| (0..60u32).map(move |x| (x, y)))
+            .filter(|&(x, y)| dark(x, y))
+            .map(|(x, y)| (x as f64, y as f64))
+            .collect();
+        let mean_x = pixels.iter().map(|p| p.0).sum::<f64>() / pixels.len() as f64;
+        assert!(
+            mean_x - 30.0 > 0.6,
+            "the notch pulls a pixel mean: {mean_x}"
+        );
+        let found = detect_markers(&img);
+        assert_eq!(found.len(), 1);
+        let (x, y) = found[0];
+        assert!((x - 30.0).hypot(y - 30.0) < 0.3, "{x}, {y}");
     }
 
     #[test]
