@@ -15,8 +15,9 @@ use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::perception::detect::Detector;
 use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig, Progress};
 use tactex_core::scene::Scene;
+use tactex_core::tactile_spec::TactileSpec;
 use tactex_hw::devices_toml::DevicesConfig;
-use tactex_hw::session::{SessionRecorder, open_session};
+use tactex_hw::session::{SessionRecorder, TwinRecord, open_session};
 use tactex_sim::SimDevices;
 use tactex_sim::camera::InstanceImage;
 use tactex_sim::render_device::DeviceChoice;
@@ -53,6 +54,10 @@ pub struct AskArgs {
     /// --backend replay --session DIR).
     #[arg(long)]
     pub record: Option<PathBuf>,
+    /// The sim GelSight's gel modulus (MPa) instead of the stock 0.3: what a softer or
+    /// harder gel would see (--backend sim).
+    #[arg(long)]
+    pub gel_modulus_mpa: Option<f64>,
     /// The question.
     pub prompt: String,
 }
@@ -133,6 +138,8 @@ pub struct TwinAnswer {
 pub struct Twin<'a> {
     pub scene: &'a Scene,
     pub seed: u64,
+    /// The sim tactile sensor (the stock GelSight Mini unless a what-if asks otherwise).
+    pub sensor: &'a TactileSpec,
     pub detector: &'a DetectorChoice,
     pub renderer: &'a Arc<dyn SceneRenderer>,
     pub explainer: &'a dyn Explainer,
@@ -148,7 +155,7 @@ struct Prepared<'d> {
 
 impl<'a> Twin<'a> {
     fn prepare(&self, catalog: &'a FruitCatalog) -> Result<Prepared<'a>> {
-        let mut sim = SimDevices::from_scene(self.scene, self.seed)?;
+        let mut sim = SimDevices::with_sensor(self.scene, self.seed, self.sensor.clone())?;
         sim.camera.set_renderer(self.renderer.clone());
         let instances = sim.camera.clean()?.instances.clone();
         let labels: Vec<String> = self.scene.objects.iter().map(|o| o.label.clone()).collect();
@@ -230,8 +237,31 @@ impl<'a> Twin<'a> {
             explainer: self.explainer,
             config,
         };
-        question.ask(devices, Some((dir, "sim")))
+        let scene_toml = std::fs::read_to_string(&self.scene.path).with_context(|| {
+            format!("{}: cannot read the scene again", self.scene.path.display())
+        })?;
+        let scene_path = std::path::absolute(&self.scene.path).unwrap_or(self.scene.path.clone());
+        question.ask(
+            devices,
+            Some(Recording {
+                dir,
+                backend: "sim",
+                twin: Some(TwinRecord {
+                    scene_toml,
+                    scene_path: scene_path.display().to_string(),
+                    seed: self.seed,
+                }),
+            }),
+        )
     }
+}
+
+/// Where `Question::ask` records a session: a new directory, the backend's name, and the sim
+/// world when the backend is the twin.
+pub struct Recording<'r> {
+    pub dir: &'r Path,
+    pub backend: &'r str,
+    pub twin: Option<TwinRecord>,
 }
 
 /// One question and what answers it, apart from the devices.
@@ -244,14 +274,14 @@ pub struct Question<'q> {
 }
 
 impl Question<'_> {
-    /// Answers on `devices`; with `record` = (DIR, backend name), everything they deliver
-    /// and are asked to do is written into a new session in DIR.
+    /// Answers on `devices`; with `record`, everything they deliver and are asked to do is
+    /// written into a new session directory.
     pub fn ask<C: RgbdCamera, T: TactileSensor, A: Arm>(
         &self,
         devices: Devices<'_, C, T, A>,
-        record: Option<(&Path, &str)>,
+        record: Option<Recording<'_>>,
     ) -> Result<Answer> {
-        let Some((dir, backend)) = record else {
+        let Some(Recording { dir, backend, twin }) = record else {
             return answer_with(
                 self.prompt,
                 self.catalog,
@@ -263,6 +293,9 @@ impl Question<'_> {
             );
         };
         let recorder = SessionRecorder::create(dir).context("--record")?;
+        if let Some(twin) = twin {
+            recorder.twin(twin);
+        }
         let answer = answer_with(
             self.prompt,
             self.catalog,
@@ -375,7 +408,11 @@ fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> R
             tactile: &mut tactile,
             arm: &mut arm,
         },
-        args.record.as_deref().map(|d| (d, "hw")),
+        args.record.as_deref().map(|dir| Recording {
+            dir,
+            backend: "hw",
+            twin: None,
+        }),
     )
 }
 
@@ -395,6 +432,10 @@ pub fn run(args: &AskArgs) -> Result<()> {
     if args.devices.is_some() && args.backend != Backend::Hw {
         bail!("--devices: only with --backend hw");
     }
+    if args.gel_modulus_mpa.is_some() && args.backend != Backend::Sim {
+        bail!("--gel-modulus-mpa: only with --backend sim (a real gel is what it is)");
+    }
+    let sensor = sim_sensor(args.gel_modulus_mpa)?;
     let answer = match args.backend {
         Backend::Hw => {
             let Some(file) = &args.devices else {
@@ -428,6 +469,7 @@ pub fn run(args: &AskArgs) -> Result<()> {
             let twin = Twin {
                 scene: &scene,
                 seed: args.seed,
+                sensor: &sensor,
                 detector: &opened.detector,
                 renderer: &opened.renderer,
                 explainer: opened.explainer.as_ref(),
@@ -447,6 +489,19 @@ pub fn run(args: &AskArgs) -> Result<()> {
         print_answer(&answer);
     }
     Ok(())
+}
+
+/// The stock GelSight Mini, with its gel's modulus replaced when one is given.
+pub fn sim_sensor(gel_modulus_mpa: Option<f64>) -> Result<TactileSpec> {
+    let mut spec = TactileSpec::gelsight_mini();
+    if let Some(e) = gel_modulus_mpa {
+        // Beyond these the gel is no gel: a foam or a rubber outside the layer model's range.
+        if !(e.is_finite() && (0.01..=50.0).contains(&e)) {
+            bail!("--gel-modulus-mpa: {e} is outside 0.01..50 MPa");
+        }
+        spec.gel.modulus_mpa = e;
+    }
+    Ok(spec)
 }
 
 fn print_answer(a: &Answer) {

@@ -1,4 +1,5 @@
-//! `tactex compare`: sim-to-real on annotated ball presses. Each press is rebuilt in the twin
+//! `tactex compare`: sim-to-real on annotated ball presses (a recorded session's presses:
+//! `compare_session`). Each press is rebuilt in the twin
 //! (the ball at the annotated centre, pressed until the contact solver's contact radius is the
 //! annotated one, since the depth was not recorded), rendered through the calibration, and
 //! scored against the real frame: SSIM (grey, 7x7 uniform window, data range 255, as
@@ -6,8 +7,9 @@
 //! (a box of four contact radii around it), next to the score of the bare background.
 
 use crate::ball_presses::{self, Split};
+use crate::compare_session::SessionCompare;
 use crate::output::{write_json_atomic, write_png_atomic};
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::DVec2;
 use image::RgbImage;
@@ -26,12 +28,28 @@ use tactex_sim::gel_render::{
 #[derive(Args, Debug)]
 pub struct CompareArgs {
     /// Calibration file from `tactex calibrate`.
+    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    pub calib: Option<PathBuf>,
+    /// Folder of the real ball-press frames.
+    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    pub images: Option<PathBuf>,
+    /// CSV of the annotated contact circles.
+    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    pub annotations: Option<PathBuf>,
+    /// Instead of ball presses: a recorded session (`ask --record`), every press rebuilt in
+    /// the twin and scored recorded against rebuilt.
     #[arg(long)]
-    pub calib: PathBuf,
-    #[arg(long)]
-    pub images: PathBuf,
-    #[arg(long)]
-    pub annotations: PathBuf,
+    pub session: Option<PathBuf>,
+    /// With --session: the objects as they stood, for a session that carries no scene (one
+    /// recorded on real devices).
+    #[arg(long, conflicts_with_all = ["calib", "images", "annotations"])]
+    pub scene: Option<PathBuf>,
+    /// With --session: the twin's seed (default: the session's).
+    #[arg(long, conflicts_with_all = ["calib", "images", "annotations"])]
+    pub seed: Option<u64>,
+    /// With --session: the twin's gel modulus (MPa) instead of the stock 0.3.
+    #[arg(long, conflicts_with_all = ["calib", "images", "annotations"])]
+    pub gel_modulus_mpa: Option<f64>,
     /// Which presses to score: eval (every third, held out of calibration), calib, or all.
     #[arg(long, value_enum, default_value_t = Split::Eval)]
     pub split: Split,
@@ -197,7 +215,8 @@ fn rebuild(
     Ok((depth, solution.force_n, fields, warnings))
 }
 
-fn side_by_side(real: &RgbImage, rendered: &RgbImage) -> RgbImage {
+/// real | rendered | difference around mid-grey (4x), side by side.
+pub(crate) fn side_by_side(real: &RgbImage, rendered: &RgbImage) -> RgbImage {
     let (w, h) = real.dimensions();
     RgbImage::from_fn(3 * w, h, |x, y| {
         let (i, k) = (x % w, x / w);
@@ -216,17 +235,27 @@ fn side_by_side(real: &RgbImage, rendered: &RgbImage) -> RgbImage {
 }
 
 pub fn run(args: &CompareArgs) -> Result<()> {
-    let text = std::fs::read_to_string(&args.calib)
-        .with_context(|| format!("{}: cannot read", args.calib.display()))?;
+    let (Some(calib_path), Some(images), Some(annotations)) =
+        (&args.calib, &args.images, &args.annotations)
+    else {
+        let Some(session) = &args.session else {
+            bail!("compare: needs --calib, --images and --annotations, or --session DIR");
+        };
+        return crate::compare_session::run(&SessionCompare {
+            session,
+            scene: args.scene.as_deref(),
+            seed: args.seed,
+            gel_modulus_mpa: args.gel_modulus_mpa,
+            out: args.out.as_deref(),
+            json: args.json,
+        });
+    };
+    let text = std::fs::read_to_string(calib_path)
+        .with_context(|| format!("{}: cannot read", calib_path.display()))?;
     let calib = GelCalibration::from_json(&text)
-        .with_context(|| format!("{}: not a usable calibration", args.calib.display()))?;
+        .with_context(|| format!("{}: not a usable calibration", calib_path.display()))?;
     let optics = calib.to_optics()?;
-    let presses = ball_presses::load(
-        &args.images,
-        &args.annotations,
-        args.split,
-        (calib.width, calib.height),
-    )?;
+    let presses = ball_presses::load(images, annotations, args.split, (calib.width, calib.height))?;
     let choice = open_renderer(args.device)?;
     if let Some(note) = &choice.note {
         eprintln!("note: {note}");
@@ -277,7 +306,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         });
     }
     let report = CompareReport {
-        calibration: args.calib.display().to_string(),
+        calibration: calib_path.display().to_string(),
         split: format!("{:?}", args.split).to_lowercase(),
         fidelity: args.fidelity.name().into(),
         device: renderer.name(),

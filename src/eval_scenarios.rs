@@ -33,6 +33,7 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::explain::TemplateExplainer;
 use tactex_core::pipeline::{Answer, PipelineConfig};
 use tactex_core::scene::Scene;
+use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_random::{Variation, random_scene};
 
@@ -581,6 +582,7 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
             let twin = Twin {
                 scene: &sc.scene,
                 seed: sc.seed,
+                sensor: &TactileSpec::gelsight_mini(),
                 detector: &detectors[d],
                 renderer: &renderer,
                 explainer: &TemplateExplainer,

@@ -10,6 +10,7 @@ mod bench_render;
 mod bench_scene;
 mod calibrate;
 mod compare;
+mod compare_session;
 mod datagen_scenes;
 mod datagen_tactile;
 mod detect_image;
@@ -65,7 +66,8 @@ enum Command {
     /// Fit a GelSight shading table from annotated presses of a ball of known radius.
     Calibrate(calibrate::CalibrateArgs),
     /// Render annotated real presses through a calibration and score them against the real
-    /// frames (SSIM, mean absolute intensity error).
+    /// frames (SSIM, mean absolute intensity error); or, with --session, rebuild a recorded
+    /// session's presses in the twin (SSIM, marker displacement error, hardness agreement).
     Compare(compare::CompareArgs),
     /// Marker centroids on a tactile frame, and displacements against a reference frame.
     Markers(markers::MarkersArgs),
@@ -208,9 +210,23 @@ fn ensure_runtime_dir() {
     }
 }
 
+/// A closed stdout (`tactex ask ... | head -1`) ends the program quietly, as it does any Unix
+/// filter, instead of println! panicking on the broken pipe. Not for `serve`: a browser
+/// that goes away must not end the server.
+fn quiet_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in main, before any thread exists; restores the default.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
     ensure_runtime_dir();
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::Serve(_)) {
+        quiet_on_closed_pipe();
+    }
     let result = match cli.command {
         Command::Ask(args) => ask::run(&args),
         Command::Serve(args) => serve::run(&args),

@@ -154,3 +154,104 @@ fn broken_or_missing_sessions_and_misused_flags_are_one_line_errors() {
     let out = tactex(&["ask", "--session", dir.to_str().unwrap(), p]);
     assert!(one_line_error(&out).contains("--backend replay"));
 }
+
+fn compare_session(dir: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["compare", "--json", "--session", dir.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    tactex(&args)
+}
+
+fn press_frames(report: &Value) -> Vec<&Value> {
+    report["presses"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|p| p["frames"].as_array().unwrap()[1..].iter())
+        .collect()
+}
+
+#[test]
+fn compare_session_rebuilds_a_sim_recording_exactly() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("banana");
+    record(&dir, "How hard is the banana?");
+    let report: Value = serde_json::from_slice(ok(&compare_session(&dir, &[]))).unwrap();
+    let presses = report["presses"].as_array().unwrap();
+    assert_eq!(presses.len(), 1, "{report:#}");
+    assert_eq!(presses[0]["object"], "banana");
+    let frames = press_frames(&report);
+    assert_eq!(frames.len(), 8, "the pipeline's 8 press frames");
+    // Same scene, pose, seed and frame order: the twin gives back the very frames.
+    for f in &frames {
+        assert_eq!(f["ssim"].as_f64().unwrap(), 1.0, "{f}");
+        assert_eq!(f["marker_error_px"].as_f64().unwrap(), 0.0, "{f}");
+    }
+    assert!(
+        frames.last().unwrap()["recorded_marker_px"]
+            .as_f64()
+            .unwrap()
+            > 1.0
+    );
+    assert_eq!(report["all_frames_mean_ssim"].as_f64().unwrap(), 1.0);
+    assert_eq!(report["max_shore_a_difference"].as_f64().unwrap(), 0.0);
+    assert_eq!(
+        presses[0]["hardness"]["modulus_ratio"].as_f64().unwrap(),
+        1.0
+    );
+
+    // A session without its scene (as a real one) needs --scene, and says so.
+    let manifest = dir.join("manifest.json");
+    let mut m: Value = serde_json::from_slice(&std::fs::read(&manifest).unwrap()).unwrap();
+    m.as_object_mut().unwrap().remove("twin");
+    m["backend"] = "hw".into();
+    std::fs::write(&manifest, serde_json::to_vec_pretty(&m).unwrap()).unwrap();
+    let stderr = one_line_error(&compare_session(&dir, &[]));
+    assert!(stderr.contains("manifest.json: twin"), "{stderr}");
+    assert!(stderr.contains("--scene"), "{stderr}");
+    let report: Value =
+        serde_json::from_slice(ok(&compare_session(&dir, &["--scene", "scenes/demo.toml"])))
+            .unwrap();
+    assert_eq!(report["mean_ssim"].as_f64().unwrap(), 1.0);
+
+    let stderr = one_line_error(&compare_session(&tmp.path().join("none"), &[]));
+    assert!(stderr.contains("no such session directory"), "{stderr}");
+}
+
+#[test]
+fn compare_session_sees_a_recording_made_with_a_softer_gel() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("soft-gel");
+    let prompt = "How hard is the banana?";
+    ok(&tactex(&[
+        "ask",
+        "--reproducible",
+        "--gel-modulus-mpa",
+        "0.15",
+        "--record",
+        dir.to_str().unwrap(),
+        prompt,
+    ]));
+    let report: Value = serde_json::from_slice(ok(&compare_session(&dir, &[]))).unwrap();
+    assert_eq!(report["recorded_gel_modulus_mpa"].as_f64().unwrap(), 0.15);
+    assert_eq!(report["twin_gel_modulus_mpa"].as_f64().unwrap(), 0.3);
+    let frames = press_frames(&report);
+    assert!(!frames.is_empty(), "{report:#}");
+    // The softer gel takes more of the travel: a deeper imprint than the twin's.
+    let min_ssim = report["min_ssim"].as_f64().unwrap();
+    assert!(min_ssim < 0.99, "{min_ssim}");
+    let marker_error = report["mean_marker_error_px"].as_f64().unwrap();
+    assert!(marker_error > 0.2, "{marker_error}");
+    // Read with the twin's 0.3 MPa gel, the recorded press puts the object's compliance
+    // share on a gel twice as stiff as the one that took it: Hertz's split
+    // (1/E*_gel) / (1/E*_gel + 1/E*_object), equal in both, gives the object twice the
+    // modulus (0.3 / 0.15).
+    let h = &report["presses"][0]["hardness"];
+    let ratio = h["modulus_ratio"].as_f64().unwrap();
+    assert!((ratio - 2.0).abs() < 0.1, "{h}");
+    assert!(h["shore_a_difference"].as_f64().unwrap() > 0.0, "{h}");
+
+    // The same twin with the recording's gel rebuilds it exactly.
+    let report: Value =
+        serde_json::from_slice(ok(&compare_session(&dir, &["--gel-modulus-mpa", "0.15"]))).unwrap();
+    assert_eq!(report["mean_ssim"].as_f64().unwrap(), 1.0);
+}

@@ -5,6 +5,7 @@ use crate::catalog::FruitCatalog;
 use crate::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
 use crate::estimate::{Evidence, HardnessEstimator, PressSequence};
 use crate::explain::{self, Explainer, Facts, Measured, location_words};
+use crate::frames::TactileFrame;
 use crate::geometry::Pose;
 use crate::hardness::HardnessReport;
 use crate::perception::centroid::median_depth;
@@ -442,6 +443,38 @@ fn apply_position(query: &Query, targets: Vec<Target>) -> Vec<Target> {
         .collect()
 }
 
+/// The press's contact test on one frame against the no-contact reference.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactReading {
+    pub contact: bool,
+    pub ssim: f64,
+    /// Mean displacement of the markers that moved (px).
+    pub marker_px: f64,
+}
+
+/// Contact when the frame's SSIM to the reference is at most `config.contact_ssim` and the
+/// markers that moved did so by more than `config.contact_marker_px` on average (markers
+/// tracked within 0.45 of the grid pitch).
+pub fn contact_test(
+    reference: &TactileFrame,
+    reference_markers: &[(f64, f64)],
+    frame: &TactileFrame,
+    pitch_px: f64,
+    config: &PipelineConfig,
+) -> ContactReading {
+    let ssim = ssim_rgb(&frame.image, &reference.image).unwrap_or(1.0);
+    let marker_px = mean_moved_displacement(&track(
+        reference_markers,
+        &detect_markers(&frame.image),
+        0.45 * pitch_px,
+    ));
+    ContactReading {
+        contact: ssim <= config.contact_ssim && marker_px > config.contact_marker_px,
+        ssim,
+        marker_px,
+    }
+}
+
 /// Above the target, descend until the contact test fires, record the press frames, retract.
 /// A press that finds no contact is a warning for that object, not a failure of the question.
 fn press<T: TactileSensor, A: Arm>(
@@ -466,14 +499,9 @@ fn press<T: TactileSensor, A: Arm>(
     for i in 1..=max_steps {
         arm.move_linear(&above(start_z - i as f64 * step_m), config.press_speed_m_s)?;
         let frame = tactile.capture()?;
-        let ssim = ssim_rgb(&frame.image, &reference.image).unwrap_or(1.0);
-        let moved = mean_moved_displacement(&track(
-            &reference_markers,
-            &detect_markers(&frame.image),
-            0.45 * pitch_px,
-        ));
-        if ssim <= config.contact_ssim && moved > config.contact_marker_px {
-            found = Some((i, frame, ssim, moved));
+        let test = contact_test(&reference, &reference_markers, &frame, pitch_px, config);
+        if test.contact {
+            found = Some((i, frame, test.ssim, test.marker_px));
             break;
         }
     }

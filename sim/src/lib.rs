@@ -35,8 +35,17 @@ pub struct SimDevices {
 
 impl SimDevices {
     pub fn from_scene(scene: &Scene, seed: u64) -> Result<Self, world::WorldError> {
+        Self::with_sensor(scene, seed, TactileSpec::gelsight_mini())
+    }
+
+    /// The devices with another tactile sensor than the stock GelSight Mini (a softer gel,
+    /// another marker grid): what-if runs, and sessions recorded with such a sensor.
+    pub fn with_sensor(
+        scene: &Scene,
+        seed: u64,
+        spec: TactileSpec,
+    ) -> Result<Self, world::WorldError> {
         let shared = world::SimWorld::from_scene(scene)?.shared();
-        let spec = TactileSpec::gelsight_mini();
         Ok(Self {
             camera: camera::SimCamera::new(shared.clone(), seed),
             tactile: gelsight::SimGelSight::new(shared.clone(), spec.clone(), seed),

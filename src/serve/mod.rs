@@ -27,6 +27,7 @@ use tactex_core::devices::RgbdCamera;
 use tactex_core::explain::Explainer;
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
+use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::SimDevices;
 use tactex_sim::camera::SimCamera;
 use tactex_sim::scene_render::SceneRenderer;
@@ -293,6 +294,7 @@ fn answer_question(s: &Served, run: &QueryRun, prompt: &str) {
     let twin = Twin {
         scene: &s.scene,
         seed: s.seed,
+        sensor: &TactileSpec::gelsight_mini(),
         detector: &s.detector,
         renderer: &s.renderer,
         explainer: s.explainer.as_ref(),

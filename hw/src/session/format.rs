@@ -52,6 +52,22 @@ pub struct Manifest {
     pub arm: ArmRecord,
     /// The answer given while recording (the `ask --json` object), when there was one.
     pub answer: Option<serde_json::Value>,
+    /// What the twin needs to rebuild the recorded presses (`tactex compare --session`):
+    /// written by the sim backend; a real session gets its objects from `--scene` instead.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub twin: Option<TwinRecord>,
+}
+
+/// The sim world a session was recorded in.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwinRecord {
+    /// The scene file's text as it was read: objects, their poses and hardness, camera, table.
+    pub scene_toml: String,
+    /// Where it was read from; relative mesh paths in it resolve against its folder.
+    pub scene_path: String,
+    /// The seed of the sim devices (sensor noise).
+    pub seed: u64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -14,12 +14,14 @@
 //! tactile sensor's description, each frame's timestamp, and every arm move (target,
 //! speed, the pose reached, the robot clock after it). A recording is written into
 //! `DIR.partial` and renamed to `DIR` only when it finished, so a directory that exists is
-//! whole.
+//! whole. A session recorded on the twin also holds its scene and seed, from which
+//! `tactex compare --session` rebuilds every press.
 
 pub mod format;
+pub mod presses;
 pub mod record;
 pub mod replay;
 
-pub use format::{Manifest, SessionError};
+pub use format::{Manifest, SessionError, TwinRecord};
 pub use record::{RecordingArm, RecordingCamera, RecordingTactile, SessionRecorder};
 pub use replay::{ReplayArm, ReplayCamera, ReplayTactile, open_session};

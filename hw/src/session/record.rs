@@ -3,7 +3,7 @@
 
 use super::format::{
     ArmRecord, CameraRecord, DEPTH_SCALE_M, FORMAT, MANIFEST, Manifest, MoveRecord, RgbdRecord,
-    SessionError, TactileFrameRecord, TactileRecord, partial_dir,
+    SessionError, TactileFrameRecord, TactileRecord, TwinRecord, partial_dir,
 };
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -20,6 +20,7 @@ struct Log {
     tactile: Option<TactileRecord>,
     arm: Option<ArmRecord>,
     arm_pose: Pose,
+    twin: Option<TwinRecord>,
     finished: bool,
 }
 
@@ -84,6 +85,7 @@ impl SessionRecorder {
                 tactile: None,
                 arm: None,
                 arm_pose: Pose::IDENTITY,
+                twin: None,
                 finished: false,
             })),
         })
@@ -132,6 +134,11 @@ impl SessionRecorder {
         })
     }
 
+    /// Notes the sim world being recorded, so that the twin can rebuild its presses.
+    pub fn twin(&self, twin: TwinRecord) {
+        lock(&self.log).twin = Some(twin);
+    }
+
     /// Writes the manifest and moves the session to its directory.
     pub fn finish(
         self,
@@ -153,6 +160,7 @@ impl SessionRecorder {
                 .ok_or_else(|| missing("tactile sensor"))?,
             arm: log.arm.clone().ok_or_else(|| missing("arm"))?,
             answer,
+            twin: log.twin.clone(),
         };
         let path = log.partial.join(MANIFEST);
         let text =
