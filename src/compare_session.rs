@@ -189,18 +189,30 @@ fn pair_markers(
         .collect()
 }
 
+/// The session's tactile frames beside their rebuilds, and the SSIM of each pair.
+#[derive(Clone, Copy)]
+struct FramePairs<'a> {
+    manifest: &'a Manifest,
+    recorded: &'a [TactileFrame],
+    rebuilt: &'a [TactileFrame],
+    ssim: &'a [f64],
+}
+
 /// Compares one press: `run` indexes the session's frames at one spot, highest first.
-#[allow(clippy::too_many_arguments)]
 fn compare_press(
     index: usize,
     run: &[usize],
-    manifest: &Manifest,
-    recorded: &[TactileFrame],
-    rebuilt: &[TactileFrame],
+    pairs: &FramePairs,
     spec: &TactileSpec,
     sim: &SimDevices,
     scene: &Scene,
 ) -> PressReport {
+    let FramePairs {
+        manifest,
+        recorded,
+        rebuilt,
+        ssim: frame_ssim,
+    } = *pairs;
     let config = PipelineConfig::default();
     let estimator = HertzSlopeEstimator::default();
     let pitch_px = spec.markers.pitch_mm / spec.mm_per_px;
@@ -209,7 +221,7 @@ fn compare_press(
     let (rec_ref, sim_ref) = (&recorded[reference], &rebuilt[reference]);
     let rec_markers = detect_markers(&rec_ref.image);
     let sim_markers = detect_markers(&sim_ref.image);
-    let pairs = pair_markers(&rec_markers, &sim_markers, pitch_px);
+    let marker_pairs = pair_markers(&rec_markers, &sim_markers, pitch_px);
     let contact = run[1..]
         .iter()
         .position(|&i| contact_test(rec_ref, &rec_markers, &recorded[i], pitch_px, &config).contact)
@@ -224,12 +236,11 @@ fn compare_press(
     let z = |i: usize| manifest.tactile.frames[i].arm_pose.position.z;
     let contact_z = press_frames.first().map_or(z(reference), |&i| z(i));
     let compare_frame = |i: usize, with_markers: bool| -> FrameComparison {
-        let ssim = ssim_rgb(&recorded[i].image, &rebuilt[i].image).unwrap_or(f64::NAN);
         let (mut error, mut scale, mut n) = (0.0, 0.0, 0usize);
         if with_markers {
             let d_rec = displacements(&rec_markers, &recorded[i].image, pitch_px);
             let d_sim = displacements(&sim_markers, &rebuilt[i].image, pitch_px);
-            for &(r, s) in &pairs {
+            for &(r, s) in &marker_pairs {
                 if let (Some(a), Some(b)) = (d_rec[r], d_sim[s]) {
                     error += (a.0 - b.0).hypot(a.1 - b.1);
                     scale += a.0.hypot(a.1);
@@ -240,7 +251,7 @@ fn compare_press(
         FrameComparison {
             image: manifest.tactile.frames[i].image.clone(),
             travel_mm: (contact_z - z(i)) * 1e3,
-            ssim,
+            ssim: frame_ssim[i],
             marker_error_px: (n > 0).then(|| error / n as f64),
             recorded_marker_px: (n > 0).then(|| scale / n as f64),
             markers_compared: n,
@@ -371,11 +382,22 @@ pub fn run(args: &SessionCompare) -> Result<()> {
         .with_context(|| format!("{scene_name}: the twin cannot stand it up"))?;
     let rebuilt = rebuild_frames(&mut sim, &manifest)?;
 
+    let all: Vec<f64> = recorded
+        .iter()
+        .zip(&rebuilt)
+        .map(|(a, b)| ssim_rgb(&a.image, &b.image).unwrap_or(f64::NAN))
+        .collect();
+    let pairs = FramePairs {
+        manifest: &manifest,
+        recorded: &recorded,
+        rebuilt: &rebuilt,
+        ssim: &all,
+    };
     let presses: Vec<PressReport> = press_runs(&manifest.tactile.frames)
         .iter()
         .filter(|run| run.len() >= 2)
         .enumerate()
-        .map(|(k, run)| compare_press(k, run, &manifest, &recorded, &rebuilt, &spec, &sim, &scene))
+        .map(|(k, run)| compare_press(k, run, &pairs, &spec, &sim, &scene))
         .collect();
     let press_ssims: Vec<f64> = presses
         .iter()
@@ -384,11 +406,6 @@ pub fn run(args: &SessionCompare) -> Result<()> {
     let errors: Vec<f64> = presses
         .iter()
         .flat_map(|p| p.frames.iter().filter_map(|f| f.marker_error_px))
-        .collect();
-    let all: Vec<f64> = recorded
-        .iter()
-        .zip(&rebuilt)
-        .map(|(a, b)| ssim_rgb(&a.image, &b.image).unwrap_or(f64::NAN))
         .collect();
     let report = SessionComparison {
         session: args.session.display().to_string(),

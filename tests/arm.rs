@@ -1,5 +1,7 @@
 //! `tactex arm` against the fake xArm controller (tactex-hw) running in this test process.
 
+mod cli;
+use cli::one_line_error;
 use serde_json::Value;
 use std::process::{Command, Output};
 use tactex_hw::xarm::fake_controller::FakeController;
@@ -10,14 +12,6 @@ fn tactex_arm(f: &FakeController, args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("runs tactex")
-}
-
-fn one_line_error(out: &Output) -> String {
-    assert_eq!(out.status.code(), Some(1));
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
-    assert!(out.stdout.is_empty());
-    stderr
 }
 
 #[test]

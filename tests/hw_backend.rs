@@ -2,6 +2,8 @@
 //! and field, a missing camera is named and the arm is not enabled, and misused flags are
 //! one-line errors.
 
+mod cli;
+use cli::one_line_error;
 use std::process::{Command, Output};
 use tactex_hw::xarm::fake_controller::FakeController;
 
@@ -13,14 +15,6 @@ fn ask(args: &[&str]) -> Output {
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .expect("runs tactex")
-}
-
-fn one_line_error(out: &Output) -> String {
-    assert_eq!(out.status.code(), Some(1));
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
-    assert!(out.stdout.is_empty());
-    stderr
 }
 
 fn devices_toml(addr: &str, extra: &str) -> String {

@@ -2,17 +2,11 @@
 //! from the recording gives the same answer, hardness and robot time; a replay that asks
 //! for other moves, and broken sessions, are one-line errors.
 
+mod cli;
+use cli::{one_line_error, tactex};
 use serde_json::Value;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn tactex(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tactex"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("runs tactex")
-}
+use std::process::Output;
 
 fn ok(out: &Output) -> &[u8] {
     assert!(
@@ -21,19 +15,6 @@ fn ok(out: &Output) -> &[u8] {
         String::from_utf8_lossy(&out.stderr)
     );
     &out.stdout
-}
-
-fn one_line_error(out: &Output) -> String {
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&out.stdout)
-    );
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
-    assert!(out.stdout.is_empty());
-    stderr
 }
 
 fn record(dir: &Path, prompt: &str) -> Vec<u8> {
