@@ -384,7 +384,7 @@ fn detector_without_truth<'a>(
 
 /// Answers `prompt` on the real devices `devices.toml` names: an xArm, a RealSense and a
 /// GelSight Mini.
-#[cfg(target_os = "linux")]
+#[cfg(all(target_os = "linux", feature = "v4l2"))]
 fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> Result<Answer> {
     let catalog = FruitCatalog::builtin();
     let devices = DevicesConfig::load(file)?;
@@ -416,9 +416,14 @@ fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> R
     )
 }
 
-#[cfg(not(target_os = "linux"))]
-fn answer_on_hardware(_: &Path, _: &AskArgs, _: &PipelineConfig) -> Result<Answer> {
-    bail!("--backend hw: the cameras are read over V4L2, which needs Linux");
+#[cfg(not(all(target_os = "linux", feature = "v4l2")))]
+fn answer_on_hardware(file: &Path, _: &AskArgs, _: &PipelineConfig) -> Result<Answer> {
+    // The file is still checked, so a bad devices.toml is named before the missing feature.
+    DevicesConfig::load(file)?;
+    bail!(
+        "--backend hw: this tactex was built without V4L2, which reads the cameras; \
+         on Linux rebuild with `cargo build --release --features v4l2` (needs libclang-dev)"
+    );
 }
 
 pub fn run(args: &AskArgs) -> Result<()> {

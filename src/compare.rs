@@ -4,10 +4,13 @@
 //! annotated one, since the depth was not recorded), rendered through the calibration, and
 //! scored against the real frame: SSIM (grey, 7x7 uniform window, data range 255, as
 //! scikit-image) and mean absolute intensity error, over the whole frame and over the contact
-//! (a box of four contact radii around it), next to the score of the bare background.
+//! (a box of four contact radii around it), next to the score of the bare background. The
+//! contact circle is estimated on the real frame and on the rendered one and scored against
+//! the marked circle.
 
 use crate::ball_presses::{self, Split};
 use crate::compare_session::SessionCompare;
+use crate::contact_circle_score::{CircleScore, CircleSummary, score_circle, summarise};
 use crate::output::{write_json_atomic, write_png_atomic};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -85,6 +88,10 @@ pub struct PressComparison {
     pub rendered: Scores,
     /// The bare no-contact frame scored the same way: what rendering the press adds.
     pub background_only: Scores,
+    /// The contact circle estimated on the real frame (against the calibration's no-contact
+    /// frame) and on the rendered one (against the rendered no-contact frame).
+    pub circle_real: Option<CircleScore>,
+    pub circle_rendered: Option<CircleScore>,
     pub warnings: Vec<String>,
 }
 
@@ -97,6 +104,8 @@ pub struct CompareReport {
     pub presses: Vec<PressComparison>,
     pub mean: Scores,
     pub background_only_mean: Scores,
+    pub circle_real: CircleSummary,
+    pub circle_rendered: CircleSummary,
 }
 
 /// Mean absolute difference over all channels (grey levels).
@@ -284,6 +293,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     });
     let mut images = renderer.render_batch(&optics, &frames)?;
     let background = images.pop().expect("the flat frame was rendered last");
+    let real_background = calib.background()?;
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create", dir.display()))?;
@@ -302,6 +312,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             force_n: *force,
             rendered: scores(real, rendered, press),
             background_only: scores(real, &background, press),
+            circle_real: score_circle(real, &real_background, press),
+            circle_rendered: score_circle(rendered, &background, press),
             warnings: warnings.clone(),
         });
     }
@@ -312,6 +324,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         device: renderer.name(),
         mean: mean(out.iter().map(|p| p.rendered)),
         background_only_mean: mean(out.iter().map(|p| p.background_only)),
+        circle_real: summarise(out.iter().map(|p| &p.circle_real)),
+        circle_rendered: summarise(out.iter().map(|p| &p.circle_rendered)),
         presses: out,
     };
     if let Some(dir) = &args.out {
@@ -377,5 +391,18 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         report.fidelity,
         report.device
     );
+    for (frames, c) in [
+        ("real", &report.circle_real),
+        ("rendered", &report.circle_rendered),
+    ] {
+        println!(
+            "contact circle on the {frames} frames vs the marked one: found {}/{}, centre error median {:.1} px, radius error median {:+.1} px, mean |error| {:.1} px",
+            c.found,
+            c.presses,
+            c.centre_error_median_px,
+            c.radius_error_median_px,
+            c.radius_error_mean_abs_px
+        );
+    }
     Ok(())
 }

@@ -11,6 +11,7 @@ mod bench_scene;
 mod calibrate;
 mod compare;
 mod compare_session;
+mod contact_circle_score;
 mod datagen_scenes;
 mod datagen_tactile;
 mod detect_image;

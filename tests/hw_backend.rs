@@ -49,10 +49,13 @@ fn a_missing_camera_is_named_and_the_arm_is_left_alone() {
         "--devices",
         file.to_str().unwrap(),
     ]));
-    assert!(
-        stderr.contains("realsense colour: /dev/video-tactex-none: no such video device"),
-        "{stderr}"
-    );
+    // Built without the V4L2 feature there are no cameras to open: that is said instead.
+    let says = if cfg!(feature = "v4l2") {
+        "realsense colour: /dev/video-tactex-none: no such video device"
+    } else {
+        "built without V4L2"
+    };
+    assert!(stderr.contains(says), "{stderr}");
     assert!(f.with(|s| s.requests.is_empty()), "the arm was not touched");
 }
 

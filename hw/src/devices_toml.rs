@@ -142,7 +142,7 @@ impl DevicesConfig {
         ))
     }
 
-    #[cfg(target_os = "linux")]
+    #[cfg(all(target_os = "linux", feature = "v4l2"))]
     pub fn open_camera(&self) -> Result<crate::realsense::RealSense, DevicesError> {
         let c = &self.camera;
         let pose = self.camera_pose().expect("checked in load");
@@ -155,7 +155,7 @@ impl DevicesConfig {
         )?)
     }
 
-    #[cfg(target_os = "linux")]
+    #[cfg(all(target_os = "linux", feature = "v4l2"))]
     pub fn open_tactile(&self) -> Result<crate::gelsight_mini::GelSightMini, DevicesError> {
         Ok(crate::gelsight_mini::GelSightMini::open(
             &self.tactile.device,

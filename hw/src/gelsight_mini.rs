@@ -89,7 +89,7 @@ pub fn resize_bilinear_like_opencv(src: &RgbImage, width: u32, height: u32) -> R
 }
 
 /// A GelSight Mini on V4L2, behind core's `TactileSensor`.
-#[cfg(target_os = "linux")]
+#[cfg(all(target_os = "linux", feature = "v4l2"))]
 pub struct GelSightMini {
     capture: crate::v4l2_capture::V4l2Capture,
     spec: tactex_core::tactile_spec::TactileSpec,
@@ -97,7 +97,7 @@ pub struct GelSightMini {
     opened: std::time::Instant,
 }
 
-#[cfg(target_os = "linux")]
+#[cfg(all(target_os = "linux", feature = "v4l2"))]
 impl GelSightMini {
     /// Opens the sensor by path or name ("GelSight Mini") at its native MJPG stream.
     pub fn open(spec: &str) -> Result<GelSightMini, tactex_core::devices::DeviceError> {
@@ -119,7 +119,7 @@ impl GelSightMini {
     }
 }
 
-#[cfg(target_os = "linux")]
+#[cfg(all(target_os = "linux", feature = "v4l2"))]
 impl tactex_core::devices::TactileSensor for GelSightMini {
     fn name(&self) -> &str {
         &self.name

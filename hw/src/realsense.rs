@@ -78,7 +78,7 @@ pub fn rgb_from_yuyv(bytes: &[u8], width: u32, height: u32) -> Result<RgbImage, 
 /// The two streams are read one after the other, not hardware-synchronised; on a D405
 /// colour and depth come from the same imager, so they are aligned pixel for pixel. Other
 /// models need librealsense's alignment, which this backend does not do.
-#[cfg(target_os = "linux")]
+#[cfg(all(target_os = "linux", feature = "v4l2"))]
 pub struct RealSense {
     color: crate::v4l2_capture::V4l2Capture,
     depth: crate::v4l2_capture::V4l2Capture,
@@ -89,7 +89,7 @@ pub struct RealSense {
     opened: std::time::Instant,
 }
 
-#[cfg(target_os = "linux")]
+#[cfg(all(target_os = "linux", feature = "v4l2"))]
 impl RealSense {
     pub fn open(
         color: &str,
@@ -136,7 +136,7 @@ impl RealSense {
     }
 }
 
-#[cfg(target_os = "linux")]
+#[cfg(all(target_os = "linux", feature = "v4l2"))]
 impl tactex_core::devices::RgbdCamera for RealSense {
     fn name(&self) -> &str {
         &self.name

@@ -1,6 +1,6 @@
 //! The V4L2 devices on a machine without them: opening by a path that does not exist or a
 //! name no device has is a one-line error naming the device, not a panic.
-#![cfg(target_os = "linux")]
+#![cfg(all(target_os = "linux", feature = "v4l2"))]
 
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_hw::gelsight_mini::GelSightMini;

@@ -1,10 +1,11 @@
 //! Perception on device frames: RGB-D grounding (detection, mask refinement, depth median,
-//! centroids) and tactile helpers (SSIM, markers, surface slopes). All of it works on real
+//! centroids) and tactile helpers (SSIM, markers, surface slopes, the contact circle). All of it works on real
 //! frames as well as on the twin's.
 
 pub mod centroid;
 pub mod colour_name;
 pub mod contact;
+pub mod contact_circle;
 pub mod depth;
 pub mod detect;
 pub mod grounding;
