@@ -12,6 +12,7 @@ mod calibrate;
 mod compare;
 mod compare_session;
 mod contact_circle_score;
+mod contact_cli;
 mod datagen_scenes;
 mod datagen_tactile;
 mod detect_image;
@@ -72,6 +73,9 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Marker centroids on a tactile frame, and displacements against a reference frame.
     Markers(markers::MarkersArgs),
+    /// Contact or not against a no-contact frame (the paper's SSIM criterion), and the
+    /// contact circle and region.
+    Contact(contact_cli::ContactArgs),
     /// A YOLOv8-seg ONNX model on one colour image: boxes, scores, masks, an overlay PNG.
     Detect(detect_image::DetectArgs),
     /// Evaluations on the twin.
@@ -237,6 +241,7 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Markers(args) => markers::run(&args),
+        Command::Contact(args) => contact_cli::run(&args),
         Command::Detect(args) => detect_image::run(&args),
         Command::Eval {
             command: EvalCommand::Grounding(args),

@@ -13,7 +13,9 @@ use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::elastic::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
 };
-use tactex_sim::gel_render::{DeviceChoice, PressFrame, SensorOptics, image_fields, open_renderer};
+use tactex_sim::gel_render::{
+    DeviceChoice, GelImageFields, PressFrame, SensorOptics, image_fields, open_renderer,
+};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum Shape {
@@ -68,8 +70,8 @@ pub struct PressArgs {
     /// Gel Young's modulus (MPa); GelSight Mini ~0.15-0.45.
     #[arg(long)]
     gel_modulus_mpa: Option<f64>,
-    /// Write the gel displacement and pressure maps (16-bit PNG + JSON sidecar) and the
-    /// rendered GelSight Mini frame (tactile.png) here.
+    /// Write the gel displacement and pressure maps (16-bit PNG + JSON sidecar), the
+    /// rendered GelSight Mini frame (tactile.png) and a no-contact frame (reference.png) here.
     #[arg(long)]
     out: Option<PathBuf>,
     /// Device that renders tactile.png: auto (a hardware GPU if there is one, else the
@@ -286,17 +288,26 @@ pub fn run(args: &PressArgs) -> Result<()> {
         write_maps(dir, &mut solver, &solution, &pad, &report)?;
         let optics = SensorOptics::for_spec(&spec);
         let fields = image_fields(&mut solver, &solution, &gel, &optics);
-        let frame = renderer
-            .render_batch(
-                &optics,
-                &[PressFrame {
+        let flat = GelImageFields::flat(optics.width, optics.height);
+        // The no-contact frame draws its own camera noise, as a real one taken before the
+        // press would.
+        let mut frames = renderer.render_batch(
+            &optics,
+            &[
+                PressFrame {
                     fields: &fields,
                     seed: args.seed,
-                }],
-            )?
-            .pop()
-            .expect("one frame rendered");
+                },
+                PressFrame {
+                    fields: &flat,
+                    seed: args.seed.wrapping_add(1),
+                },
+            ],
+        )?;
+        let reference = frames.pop().expect("two frames rendered");
+        let frame = frames.pop().expect("two frames rendered");
         write_png_atomic(&dir.join("tactile.png"), &frame)?;
+        write_png_atomic(&dir.join("reference.png"), &reference)?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

@@ -106,6 +106,52 @@ fn press_writes_maps_with_their_scale() {
 }
 
 #[test]
+fn the_contact_circle_seen_in_a_rendered_press_is_the_solvers() {
+    // The twin's frame (markers, noise) read back by `tactex contact` against the no-contact
+    // frame `press --out` writes: the contact radius the solver found, from the image alone.
+    for (radius_mm, hardness, depth_mm) in [("5", "40A", "1"), ("3", "70A", "0.5")] {
+        let dir = tempfile::tempdir().unwrap();
+        let v = json(&tactex(&[
+            "press",
+            "--shape",
+            "sphere",
+            "--radius-mm",
+            radius_mm,
+            "--hardness",
+            hardness,
+            "--depth-mm",
+            depth_mm,
+            "--device",
+            "cpu",
+            "--json",
+            "--out",
+            dir.path().to_str().unwrap(),
+        ]));
+        let seen = json(&tactex(&[
+            "contact",
+            dir.path().join("tactile.png").to_str().unwrap(),
+            "--reference",
+            dir.path().join("reference.png").to_str().unwrap(),
+            "--mm-per-px",
+            "0.0634",
+            "--json",
+        ]));
+        assert_eq!(seen["evidence"]["contact"], true, "{seen}");
+        let solver = v["contact_radius_mm"].as_f64().unwrap();
+        let image = seen["contact_radius_mm"].as_f64().unwrap();
+        // Measured 2.493 vs 2.544 mm and 1.315 vs 1.340 mm: 2% short, about a pixel.
+        assert!(
+            (image / solver - 1.0).abs() < 0.04,
+            "{radius_mm} mm {hardness}: {image:.3} mm seen, {solver:.3} mm solved"
+        );
+        // The pad is centred over the sphere: the imprint is in the frame's middle.
+        let c = &seen["circle"]["centre_px"];
+        let (x, y) = (c[0].as_f64().unwrap(), c[1].as_f64().unwrap());
+        assert!((x - 160.0).hypot(y - 120.0) < 2.5, "{c}");
+    }
+}
+
+#[test]
 fn bad_press_input_is_one_clear_line_and_a_failure() {
     let dir = tempfile::tempdir().unwrap();
     let empty = dir.path().join("empty.obj");

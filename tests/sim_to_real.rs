@@ -197,6 +197,62 @@ fn contact_circles_estimated_on_real_ball_presses_match_the_marked_ones() {
 }
 
 #[test]
+fn contact_command_finds_the_marked_circle_and_no_contact_on_the_background() {
+    let f = fixtures();
+    let background = f.join("background.png");
+    let out = tactex(&[
+        "contact",
+        f.join("ball-presses/0014.png").to_str().unwrap(),
+        "--reference",
+        background.to_str().unwrap(),
+        "--mm-per-px",
+        MM_PER_PX,
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["evidence"]["contact"], true);
+    // Marked: centre (125, 191) + 1/2, radius 39 px (1.99 mm).
+    let c = &r["circle"];
+    let (x, y) = (
+        c["centre_px"][0].as_f64().unwrap(),
+        c["centre_px"][1].as_f64().unwrap(),
+    );
+    assert!((x - 125.5).hypot(y - 191.5) < 5.0, "{c}");
+    assert!((c["radius_px"].as_f64().unwrap() - 39.0).abs() < 3.0, "{c}");
+    let mm = r["contact_radius_mm"].as_f64().unwrap();
+    assert!((mm - 39.0 * 0.0510725).abs() < 0.16, "{mm} mm");
+
+    let out = tactex(&[
+        "contact",
+        background.to_str().unwrap(),
+        "--reference",
+        background.to_str().unwrap(),
+        "--json",
+    ]);
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["evidence"]["contact"], false);
+    assert!(r.get("circle").is_none(), "{r}");
+
+    // A reference of another size is named in one line.
+    let marker_frame = f.join("markers/press.png");
+    let out = tactex(&[
+        "contact",
+        background.to_str().unwrap(),
+        "--reference",
+        marker_frame.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("markers/press.png"), "{err}");
+}
+
+#[test]
 fn markers_found_on_the_real_marker_frame_match_the_annotations() {
     let f = fixtures().join("markers");
     let out = tactex(&["markers", f.join("press.png").to_str().unwrap(), "--json"]);
