@@ -3,6 +3,7 @@
 //! within 0.45 of the grid pitch, estimated from the reference's own spacing).
 
 use crate::ball_presses::load_rgb;
+use crate::output::write_png_atomic;
 use anyhow::{Result, bail};
 use clap::Args;
 use serde::Serialize;
@@ -18,9 +19,132 @@ pub struct MarkersArgs {
     /// A no-contact frame of the same sensor: report each of its markers' displacement.
     #[arg(long)]
     pub reference: Option<PathBuf>,
+    /// Annotated markers to score the detections against: CSV with a header and columns
+    /// Mx,My,dx,dy (FOTS's format: rest position and displacement in whole pixels, truncated,
+    /// so the marker is taken at M + d + 1/2).
+    #[arg(long)]
+    pub annotations: Option<PathBuf>,
+    /// With --annotations: write the frame, 3x, with annotated (red) and found (green)
+    /// markers and the misses ringed in yellow.
+    #[arg(long, requires = "annotations")]
+    pub overlay: Option<PathBuf>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+/// An annotation is found when a detection lies within this distance.
+const FOUND_WITHIN_PX: f64 = 1.5;
+
+#[derive(Serialize)]
+struct AnnotationScore {
+    annotations: String,
+    count: usize,
+    /// Annotated markers with a detection within 1.5 px.
+    found: usize,
+    /// The others: where annotated, and how far the nearest detection is.
+    misses: Vec<Miss>,
+}
+
+#[derive(Serialize)]
+struct Miss {
+    x_px: f64,
+    y_px: f64,
+    nearest_px: f64,
+}
+
+fn read_marker_annotations(path: &std::path::Path) -> Result<Vec<(f64, f64)>> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate().skip(1) {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|c| c.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| {
+                anyhow::anyhow!(
+                    "{}: line {}: not four numbers Mx,My,dx,dy",
+                    path.display(),
+                    i + 1
+                )
+            })?;
+        let [mx, my, dx, dy] = v[..] else {
+            bail!(
+                "{}: line {}: not four numbers Mx,My,dx,dy",
+                path.display(),
+                i + 1
+            );
+        };
+        out.push((mx + dx + 0.5, my + dy + 0.5));
+    }
+    if out.is_empty() {
+        bail!("{}: no annotated markers", path.display());
+    }
+    Ok(out)
+}
+
+fn score_annotations(path: &std::path::Path, found: &[(f64, f64)]) -> Result<AnnotationScore> {
+    let annotated = read_marker_annotations(path)?;
+    let misses: Vec<Miss> = annotated
+        .iter()
+        .map(|&(x, y)| Miss {
+            x_px: x,
+            y_px: y,
+            nearest_px: found
+                .iter()
+                .map(|p| (p.0 - x).hypot(p.1 - y))
+                .fold(f64::INFINITY, f64::min),
+        })
+        .filter(|m| m.nearest_px > FOUND_WITHIN_PX)
+        .collect();
+    Ok(AnnotationScore {
+        annotations: path.display().to_string(),
+        count: annotated.len(),
+        found: annotated.len() - misses.len(),
+        misses,
+    })
+}
+
+fn draw_overlay(
+    image: &image::RgbImage,
+    found: &[(f64, f64)],
+    annotated: &[(f64, f64)],
+    misses: &[Miss],
+) -> image::RgbImage {
+    use imageproc::drawing::{draw_cross_mut, draw_hollow_circle_mut};
+    const S: u32 = 3;
+    let mut canvas = image::imageops::resize(
+        image,
+        image.width() * S,
+        image.height() * S,
+        image::imageops::FilterType::Nearest,
+    );
+    // Detections (and the annotations as scored) put pixel x's centre at x: on the canvas
+    // it is at S x + S/2.
+    let at = |x: f64, y: f64| {
+        let s = S as f64;
+        ((s * x + s / 2.0) as i32, (s * y + s / 2.0) as i32)
+    };
+    for &(x, y) in annotated {
+        draw_hollow_circle_mut(&mut canvas, at(x, y), 4, image::Rgb([255, 0, 0]));
+    }
+    for &(x, y) in found {
+        let (cx, cy) = at(x, y);
+        draw_cross_mut(&mut canvas, image::Rgb([0, 255, 0]), cx, cy);
+    }
+    for m in misses {
+        draw_hollow_circle_mut(
+            &mut canvas,
+            at(m.x_px, m.y_px),
+            14,
+            image::Rgb([255, 255, 0]),
+        );
+    }
+    canvas
 }
 
 #[derive(Serialize)]
@@ -45,6 +169,8 @@ struct MarkersReport {
     displacements: Option<Vec<Displacement>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     mean_moved_px: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    annotated: Option<AnnotationScore>,
 }
 
 pub fn run(args: &MarkersArgs) -> Result<()> {
@@ -58,7 +184,19 @@ pub fn run(args: &MarkersArgs) -> Result<()> {
         pitch_px: None,
         displacements: None,
         mean_moved_px: None,
+        annotated: None,
     };
+    if let Some(path) = &args.annotations {
+        let score = score_annotations(path, &found)?;
+        if let Some(out) = &args.overlay {
+            let annotated = read_marker_annotations(path)?;
+            write_png_atomic(
+                out,
+                &draw_overlay(&image, &found, &annotated, &score.misses),
+            )?;
+        }
+        report.annotated = Some(score);
+    }
     if let Some(path) = &args.reference {
         let reference = load_rgb(path)?;
         if reference.dimensions() != image.dimensions() {
@@ -94,6 +232,18 @@ pub fn run(args: &MarkersArgs) -> Result<()> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
+    }
+    if let Some(a) = &report.annotated {
+        println!(
+            "{}: {} of {} annotated markers found within {FOUND_WITHIN_PX} px",
+            a.annotations, a.found, a.count
+        );
+        for m in &a.misses {
+            println!(
+                "  missed ({:.1}, {:.1}): nearest detection {:.2} px away",
+                m.x_px, m.y_px, m.nearest_px
+            );
+        }
     }
     match &report.displacements {
         None => {

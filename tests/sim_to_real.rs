@@ -290,6 +290,28 @@ fn markers_found_on_the_real_marker_frame_match_the_annotations() {
     // restored dots that the ridge's highlights cut); of the five misses three annotations
     // sit 2.6-6.6 px from a whole, unoccluded dot, and two dots are half hidden.
     assert!(within >= 94, "{within} of {total}");
+
+    // The command scores the same annotations the same way, and draws them.
+    let dir = tempfile::tempdir().unwrap();
+    let overlay = dir.path().join("overlay.png");
+    let out = tactex(&[
+        "markers",
+        f.join("press.png").to_str().unwrap(),
+        "--annotations",
+        f.join("press.csv").to_str().unwrap(),
+        "--overlay",
+        overlay.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["annotated"]["count"], 99);
+    assert_eq!(report["annotated"]["found"], within as u64);
+    assert_eq!(image::open(&overlay).unwrap().width(), 3 * 320);
 }
 
 #[test]
