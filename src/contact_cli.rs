@@ -2,6 +2,7 @@
 //! paper's contact criterion against a no-contact frame, and the contact circle and region.
 
 use crate::ball_presses::load_rgb;
+use crate::press::positive;
 use anyhow::{Result, bail};
 use clap::Args;
 use serde::Serialize;
@@ -17,18 +18,11 @@ pub struct ContactArgs {
     #[arg(long)]
     pub reference: PathBuf,
     /// Millimetres per pixel, to give the circle in mm too (GelSight Mini at 320x240: 0.0634).
-    #[arg(long, value_parser = positive_mm_per_px)]
+    #[arg(long)]
     pub mm_per_px: Option<f64>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
-}
-
-fn positive_mm_per_px(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("'{s}' is not a positive number of mm per pixel")),
-    }
 }
 
 #[derive(Serialize)]
@@ -46,6 +40,10 @@ struct ContactReport {
 }
 
 pub fn run(args: &ContactArgs) -> Result<()> {
+    let mm_per_px = args
+        .mm_per_px
+        .map(|v| positive("mm-per-px", v))
+        .transpose()?;
     let image = load_rgb(&args.image)?;
     let reference = load_rgb(&args.reference)?;
     if reference.dimensions() != image.dimensions() {
@@ -68,10 +66,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         .contact
         .then(|| estimate_contact_circle(&image, &reference))
         .flatten();
-    let scale = |c: &ContactCircle| {
-        args.mm_per_px
-            .map(|s| (c.radius_px * s, c.region_area_px2 * s * s))
-    };
+    let scale = |c: &ContactCircle| mm_per_px.map(|s| (c.radius_px * s, c.region_area_px2 * s * s));
     let mm = circle.as_ref().and_then(scale);
     let report = ContactReport {
         image: args.image.display().to_string(),

@@ -87,8 +87,11 @@ fn read_marker_annotations(path: &std::path::Path) -> Result<Vec<(f64, f64)>> {
     Ok(out)
 }
 
-fn score_annotations(path: &std::path::Path, found: &[(f64, f64)]) -> Result<AnnotationScore> {
-    let annotated = read_marker_annotations(path)?;
+fn score_annotations(
+    path: &std::path::Path,
+    annotated: &[(f64, f64)],
+    found: &[(f64, f64)],
+) -> AnnotationScore {
     let misses: Vec<Miss> = annotated
         .iter()
         .map(|&(x, y)| Miss {
@@ -101,12 +104,12 @@ fn score_annotations(path: &std::path::Path, found: &[(f64, f64)]) -> Result<Ann
         })
         .filter(|m| m.nearest_px > FOUND_WITHIN_PX)
         .collect();
-    Ok(AnnotationScore {
+    AnnotationScore {
         annotations: path.display().to_string(),
         count: annotated.len(),
         found: annotated.len() - misses.len(),
         misses,
-    })
+    }
 }
 
 fn draw_overlay(
@@ -187,9 +190,9 @@ pub fn run(args: &MarkersArgs) -> Result<()> {
         annotated: None,
     };
     if let Some(path) = &args.annotations {
-        let score = score_annotations(path, &found)?;
+        let annotated = read_marker_annotations(path)?;
+        let score = score_annotations(path, &annotated, &found);
         if let Some(out) = &args.overlay {
-            let annotated = read_marker_annotations(path)?;
             write_png_atomic(
                 out,
                 &draw_overlay(&image, &found, &annotated, &score.misses),

@@ -18,6 +18,8 @@
 //! absolute (about 5% of a 40 px radius), 25 of 31 centres within 5 px
 //! (`tests/sim_to_real.rs`; `tactex compare` reports it per image).
 
+use super::circle_fit::fit_circle;
+use super::slopes::is_dark;
 use image::{ImageBuffer, Luma, RgbImage};
 use imageproc::filter::{filter3x3, gaussian_blur_f32};
 use serde::Serialize;
@@ -77,7 +79,7 @@ pub fn estimate_contact_circle(frame: &RgbImage, reference: &RgbImage) -> Option
     Some(ContactCircle {
         centre_px: centre,
         radius_px: radius,
-        region_area_px2: polygon_area(&edge, centre),
+        region_area_px2: polygon_area(&edge),
         edge_px: edge,
         rms_residual_px: rms,
     })
@@ -89,10 +91,9 @@ pub fn estimate_contact_circle(frame: &RgbImage, reference: &RgbImage) -> Option
 /// (a deep press saturates red over thousands of pixels around the imprint on the FOTS frames).
 fn colour_change(frame: &RgbImage, reference: &RgbImage) -> [FloatImage; 3] {
     let (w, h) = frame.dimensions();
-    let dark = |p: &image::Rgb<u8>| p.0.iter().map(|&c| c as u32).sum::<u32>() < 3 * 70;
     let weight = FloatImage::from_fn(w, h, |x, y| {
         let (p, r) = (frame.get_pixel(x, y), reference.get_pixel(x, y));
-        let shaded = !(dark(p) || dark(r));
+        let shaded = !(is_dark(p) || is_dark(r));
         Luma([if shaded { 1.0 } else { 0.0 }])
     });
     let weight_blur = gaussian_blur_f32(&weight, CHANGE_SIGMA_PX);
@@ -242,7 +243,11 @@ type Circle = ([f64; 2], f64, Vec<[f64; 2]>);
 /// The circle through `points`, refitted once without those further from it than twice the
 /// median distance (rays that peaked on a glint or a fold rather than the edge).
 fn fit_without_outliers(points: &[[f64; 2]]) -> Option<Circle> {
-    let (centre, radius) = kasa_circle(points)?;
+    // At least a fifth of the rays: fewer do not outline a contact.
+    if points.len() < RAYS / 5 {
+        return None;
+    }
+    let (centre, radius) = fit_circle(points)?;
     let distance = |p: &[f64; 2]| ((p[0] - centre[0]).hypot(p[1] - centre[1]) - radius).abs();
     let mut residuals: Vec<f64> = points.iter().map(distance).collect();
     residuals.sort_by(f64::total_cmp);
@@ -252,55 +257,19 @@ fn fit_without_outliers(points: &[[f64; 2]]) -> Option<Circle> {
         .filter(|p| distance(p) <= limit)
         .copied()
         .collect();
-    let (centre, radius) = kasa_circle(&kept)?;
+    if kept.len() < RAYS / 5 {
+        return None;
+    }
+    let (centre, radius) = fit_circle(&kept)?;
     Some((centre, radius, kept))
 }
 
-/// Kasa's least-squares circle, x^2 + y^2 + D x + E y + F = 0, solved about the points' mean
-/// for conditioning; at least 12 points (a fifth of the rays at 90).
-fn kasa_circle(points: &[[f64; 2]]) -> Option<([f64; 2], f64)> {
-    if points.len() < 12 {
-        return None;
-    }
-    let n = points.len() as f64;
-    let mx = points.iter().map(|p| p[0]).sum::<f64>() / n;
-    let my = points.iter().map(|p| p[1]).sum::<f64>() / n;
-    let (mut sxx, mut sxy, mut syy, mut sxz, mut syz) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for p in points {
-        let (x, y) = (p[0] - mx, p[1] - my);
-        let z = x * x + y * y;
-        sxx += x * x;
-        sxy += x * y;
-        syy += y * y;
-        sxz += x * z;
-        syz += y * z;
-    }
-    // With centred coordinates the normal equations decouple F: D, E from a 2x2 system.
-    let det = sxx * syy - sxy * sxy;
-    if det.abs() < 1e-9 {
-        return None;
-    }
-    let a = (sxz * syy - syz * sxy) / (2.0 * det);
-    let b = (syz * sxx - sxz * sxy) / (2.0 * det);
-    let mean_z = points
-        .iter()
-        .map(|p| (p[0] - mx).powi(2) + (p[1] - my).powi(2))
-        .sum::<f64>()
-        / n;
-    let r2 = a * a + b * b + mean_z;
-    (r2.is_finite() && r2 > 0.0).then(|| ([a + mx, b + my], r2.sqrt()))
-}
-
-/// Area of the outline, its points taken in angle order about `centre` (shoelace).
-fn polygon_area(points: &[[f64; 2]], centre: [f64; 2]) -> f64 {
-    let mut sorted = points.to_vec();
-    sorted.sort_by(|a, b| {
-        let angle = |p: &[f64; 2]| (p[1] - centre[1]).atan2(p[0] - centre[0]);
-        angle(a).total_cmp(&angle(b))
-    });
-    let twice: f64 = (0..sorted.len())
+/// Area of the outline (shoelace). Its points come in ray order, so in angle order about
+/// the last ray origin, about which the outline is star-shaped.
+fn polygon_area(points: &[[f64; 2]]) -> f64 {
+    let twice: f64 = (0..points.len())
         .map(|i| {
-            let (p, q) = (sorted[i], sorted[(i + 1) % sorted.len()]);
+            let (p, q) = (points[i], points[(i + 1) % points.len()]);
             p[0] * q[1] - q[0] * p[1]
         })
         .sum();

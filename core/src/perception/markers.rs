@@ -1,6 +1,7 @@
 //! Marker dots on a tactile image: detection (dark blobs against the local background),
 //! tracking against a reference frame, and the displacement statistic of the contact test.
 
+use super::circle_fit::fit_circle;
 use image::{GrayImage, Luma, RgbImage};
 use imageproc::distance_transform::Norm;
 use imageproc::geometry::convex_hull;
@@ -93,60 +94,21 @@ fn dot_centre(pixels: &[Point<i32>], cut_by_frame: bool) -> (f64, f64) {
         return centroid;
     }
     let equivalent_radius = (area2.abs() / 2.0 / std::f64::consts::PI).sqrt();
-    match circle_through(&hull, centroid) {
+    let vertices: Vec<[f64; 2]> = hull.iter().map(|p| [p.x as f64, p.y as f64]).collect();
+    // Six vertices at least: fewer do not pin a dot's outline.
+    let circle = (vertices.len() >= 6)
+        .then(|| fit_circle(&vertices))
+        .flatten();
+    match circle {
         // A cut removes at most about half a dot: its circle is at most ~1.5x the radius of
         // a disc of the hull's area, and its centre lies within that circle.
-        Some((centre, r))
-            if r < 1.8 * equivalent_radius + 1.0
-                && (centre.0 - centroid.0).hypot(centre.1 - centroid.1) < r =>
+        Some(([x, y], r))
+            if r < 1.8 * equivalent_radius + 1.0 && (x - centroid.0).hypot(y - centroid.1) < r =>
         {
-            centre
+            (x, y)
         }
         _ => centroid,
     }
-}
-
-/// Least-squares circle (Kasa) through at least 6 points: its centre and radius. Solved
-/// about `origin` for conditioning.
-fn circle_through(points: &[Point<i32>], origin: (f64, f64)) -> Option<((f64, f64), f64)> {
-    if points.len() < 6 {
-        return None;
-    }
-    // x^2 + y^2 + D x + E y + F = 0, normal equations of the 3 unknowns.
-    let mut m = [[0.0f64; 3]; 3];
-    let mut v = [0.0f64; 3];
-    for p in points {
-        let (x, y) = (p.x as f64 - origin.0, p.y as f64 - origin.1);
-        let row = [x, y, 1.0];
-        let rhs = -(x * x + y * y);
-        for i in 0..3 {
-            for j in 0..3 {
-                m[i][j] += row[i] * row[j];
-            }
-            v[i] += row[i] * rhs;
-        }
-    }
-    let det = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(&m);
-    if d.abs() < 1e-9 {
-        return None;
-    }
-    // Cramer's rule.
-    let solve = |k: usize| {
-        let mut mk = m;
-        for (row, value) in mk.iter_mut().zip(v) {
-            row[k] = value;
-        }
-        det(&mk) / d
-    };
-    let (dd, ee, ff) = (solve(0), solve(1), solve(2));
-    let (a, b) = (-dd / 2.0, -ee / 2.0);
-    let r2 = a * a + b * b - ff;
-    (r2 > 0.0 && r2.is_finite()).then(|| ((a + origin.0, b + origin.1), r2.sqrt()))
 }
 
 /// The grid pitch: the median distance from each marker to its nearest neighbour. None with

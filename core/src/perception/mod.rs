@@ -3,6 +3,7 @@
 //! frames as well as on the twin's.
 
 pub mod centroid;
+pub mod circle_fit;
 pub mod colour_name;
 pub mod contact;
 pub mod contact_circle;

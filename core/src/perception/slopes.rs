@@ -15,7 +15,8 @@ pub struct SlopeField {
     pub valid: Vec<bool>,
 }
 
-fn is_dark(p: &image::Rgb<u8>) -> bool {
+/// A marker dot's pixel: it carries no shading.
+pub(crate) fn is_dark(p: &image::Rgb<u8>) -> bool {
     (p[0] as u32 + p[1] as u32 + p[2] as u32) < 3 * 70
 }
 
