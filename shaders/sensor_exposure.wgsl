@@ -13,19 +13,43 @@ fn pcg(v: u32) -> u32 {
     return (word >> 22u) ^ word;
 }
 
-fn unit(h: u32) -> f32 {
-    return (f32(h >> 8u) + 1.0) / 16777216.0;
+// The 24-bit count behind a uniform draw: 1..=2^24, exact in f32.
+fn count(h: u32) -> f32 {
+    return f32((h >> 8u) + 1u);
+}
+
+// ln(n / 2^24), n = count(h) = m 2^e, m in [1, 2): ln m = 2 atanh((m - 1)/(m + 1)) by its
+// series, the CPU path's polynomial (no built-in log, whose precision the device chooses).
+fn ln_unit(h: u32) -> f32 {
+    let bits = bitcast<u32>(count(h));
+    let e = f32(i32(bits >> 23u) - 127 - 24);
+    let m = bitcast<f32>((bits & 0x007fffffu) | 0x3f800000u);
+    let t = (m - 1.0) / (m + 1.0);
+    let t2 = t * t;
+    let series = 1.0 + t2 * (1.0 / 3.0 + t2 * (1.0 / 5.0 + t2 * (1.0 / 7.0 + t2 * (1.0 / 9.0))));
+    return e * 0.69314718055994530942 + 2.0 * t * series;
+}
+
+// (cos, sin) of 2 pi u from the half angle a = pi u - pi/2 in (-pi/2, pi/2], as on the CPU.
+fn cis_unit(h: u32) -> vec2<f32> {
+    let a = 3.14159265358979323846 * (count(h) * (1.0 / 16777216.0) - 0.5);
+    let a2 = a * a;
+    let s = a * (1.0 + a2 * (-1.0 / 6.0 + a2 * (1.0 / 120.0
+        + a2 * (-1.0 / 5040.0 + a2 * (1.0 / 362880.0 - a2 / 39916800.0)))));
+    let c = 1.0 + a2 * (-0.5 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0
+        + a2 * (1.0 / 40320.0 + a2 * (-1.0 / 3628800.0 + a2 / 479001600.0)))));
+    return vec2<f32>(s * s - c * c, -2.0 * s * c);
 }
 
 // Three standard normal draws for (frame seed, pixel) by Box-Muller: the first pair gives red
 // and green (cosine and sine), the second blue.
 fn gaussian3(seed: u32, pixel: u32) -> vec3<f32> {
     let key = pcg(seed ^ pcg(pixel));
-    let r1 = sqrt(-2.0 * log(unit(pcg(key))));
-    let t1 = 6.28318530717958647692 * unit(pcg(key ^ 0x9e3779b9u));
-    let r2 = sqrt(-2.0 * log(unit(pcg(key ^ 0x85ebca6bu))));
-    let t2 = 6.28318530717958647692 * unit(pcg(key ^ 0xc2b2ae35u));
-    return vec3<f32>(r1 * cos(t1), r1 * sin(t1), r2 * cos(t2));
+    let r1 = sqrt(-2.0 * ln_unit(pcg(key)));
+    let a1 = cis_unit(pcg(key ^ 0x9e3779b9u));
+    let r2 = sqrt(-2.0 * ln_unit(pcg(key ^ 0x85ebca6bu)));
+    let a2 = cis_unit(pcg(key ^ 0xc2b2ae35u));
+    return vec3<f32>(r1 * a1.x, r1 * a1.y, r2 * a2.x);
 }
 
 @compute @workgroup_size(8, 8, 1)

@@ -167,7 +167,7 @@ impl SensorOptics {
                 ),
             ));
         }
-        if self.background.iter().flatten().any(|v| !v.is_finite()) {
+        if !all_finite(self.background.as_flattened()) {
             return Err(invalid("optics.background", "must be finite"));
         }
         let finite_nonneg = |v: f32| v.is_finite() && v >= 0.0;
@@ -233,13 +233,21 @@ impl SensorOptics {
                     ),
                 ));
             }
-            let finite = |v: &Vec<f32>| v.iter().all(|x| x.is_finite());
-            if !(finite(&f.normal_mm) && finite(&f.lateral_x_mm) && finite(&f.lateral_y_mm)) {
+            if !(all_finite(&f.normal_mm)
+                && all_finite(&f.lateral_x_mm)
+                && all_finite(&f.lateral_y_mm))
+            {
                 return Err(invalid(&format!("frames[{k}]"), "fields must be finite"));
             }
         }
         Ok(())
     }
+}
+
+/// Whether every value is finite, without stopping at the first that is not: a plain
+/// reduction vectorises, and the check runs on every frame's three fields.
+fn all_finite(values: &[f32]) -> bool {
+    values.iter().fold(true, |ok, v| ok & v.is_finite())
 }
 
 /// The uniform block every shader stage reads (`RenderParams` in shaders/common.wgsl).
