@@ -14,7 +14,9 @@
 //! at k = 0 and decay exponentially, so plain quadrature converges; the corrections are
 //! tabulated in r and averaged over a cell with 2 x 2 Gauss points.
 
+use rayon::prelude::*;
 use std::f64::consts::PI;
+use std::sync::{Arc, Mutex};
 use tactex_core::layer_compliance::{lateral_ratio, normal_compliance_ratio};
 
 /// The half-space radial-to-normal displacement ratio T_inf (negative: inward).
@@ -52,38 +54,39 @@ pub fn love_lateral_x(x: f64, y: f64, a: f64) -> f64 {
     (h(x + a, y + a) - h(x - a, y + a) - h(x + a, y - a) + h(x - a, y - a)) / PI
 }
 
-/// Tabulated layer corrections C_w and C_u for one thickness and Poisson ratio.
-#[derive(Clone, Debug)]
-pub struct LayerCorrection {
-    pub thickness_mm: f64,
-    pub poisson: f64,
-    dr: f64,
+/// C_w and C_u of a layer of unit thickness, at radii rho = m / SAMPLES_PER_THICKNESS.
+/// Every quantity in the integrals scales with the thickness h (k h, r / h, b = h), so
+/// C(r; h) = c(r / h) / h: one table serves every thickness of a given Poisson's ratio.
+#[derive(Debug)]
+struct UnitLayer {
     normal: Vec<f64>,
     lateral: Vec<f64>,
 }
 
-impl LayerCorrection {
-    /// Tables out to `r_max_mm`.
-    pub fn new(thickness_mm: f64, poisson: f64, r_max_mm: f64) -> Self {
-        let h = thickness_mm;
-        let b = h;
+const SAMPLES_PER_THICKNESS: f64 = 48.0;
+
+impl UnitLayer {
+    /// Tables out to `extent` thicknesses: a few hundred radii, each a quadrature over
+    /// ~800 wavenumbers of two Bessel functions (tens of ms, so radii run in parallel).
+    fn new(poisson: f64, extent: f64) -> Self {
         let t_inf = half_space_lateral_ratio(poisson);
-        let dr = h / 48.0;
-        let n_r = (r_max_mm / dr).ceil() as usize + 2;
+        let dr = 1.0 / SAMPLES_PER_THICKNESS;
+        let n_r = (extent / dr).ceil() as usize + 2;
         let r_max = dr * n_r as f64;
         // Resolve both the integrand (scale 1/h) and the Bessel oscillation (period 2 pi / r).
-        let k_max = 40.0 / h;
-        let dk = (0.05 / h).min(2.0 * PI / (12.0 * r_max));
+        let k_max = 40.0;
+        let dk = 0.05f64.min(2.0 * PI / (12.0 * r_max));
         let n_k = ((k_max / dk).ceil() as usize).div_ceil(2) * 2;
         let dk = k_max / n_k as f64;
         let ks: Vec<f64> = (0..=n_k).map(|q| q as f64 * dk).collect();
+        // The integrands with their e^{-k} (b = h = 1) terms, zero at k = 0.
         let g_w: Vec<f64> = ks
             .iter()
             .map(|&k| {
                 if k == 0.0 {
                     0.0
                 } else {
-                    normal_compliance_ratio(k * h, poisson) - 1.0 + (-k * b).exp()
+                    normal_compliance_ratio(k, poisson) - 1.0 + (-k).exp()
                 }
             })
             .collect();
@@ -93,8 +96,8 @@ impl LayerCorrection {
                 if k == 0.0 {
                     0.0
                 } else {
-                    lateral_ratio(k * h, poisson) * normal_compliance_ratio(k * h, poisson) - t_inf
-                        + t_inf * (-k * b).exp()
+                    lateral_ratio(k, poisson) * normal_compliance_ratio(k, poisson) - t_inf
+                        + t_inf * (-k).exp()
                 }
             })
             .collect();
@@ -108,34 +111,67 @@ impl LayerCorrection {
                 2.0 * dk / 3.0
             }
         };
-        let mut normal = Vec::with_capacity(n_r + 1);
-        let mut lateral = Vec::with_capacity(n_r + 1);
-        for m in 0..=n_r {
-            let r = m as f64 * dr;
-            let (mut cw, mut cu) = (0.0, 0.0);
-            for (q, &k) in ks.iter().enumerate() {
-                let w = weight(q);
-                cw += w * g_w[q] * libm::j0(k * r);
-                cu += w * g_u[q] * libm::j1(k * r);
-            }
-            let root = (b * b + r * r).sqrt();
-            cw -= 1.0 / root;
-            // int e^{-kb} J1(kr) dk = (1 - b / sqrt(b^2 + r^2)) / r = r / (root (root + b)).
-            cu -= t_inf * r / (root * (root + b));
-            normal.push(cw);
-            lateral.push(cu);
+        let (normal, lateral) = (0..=n_r)
+            .into_par_iter()
+            .map(|m| {
+                let r = m as f64 * dr;
+                let (mut cw, mut cu) = (0.0, 0.0);
+                for (q, &k) in ks.iter().enumerate() {
+                    let w = weight(q);
+                    cw += w * g_w[q] * libm::j0(k * r);
+                    cu += w * g_u[q] * libm::j1(k * r);
+                }
+                let root = (1.0 + r * r).sqrt();
+                cw -= 1.0 / root;
+                // int e^{-kb} J1(kr) dk = (1 - b / sqrt(b^2 + r^2)) / r = r / (root (root + b)).
+                cu -= t_inf * r / (root * (root + 1.0));
+                (cw, cu)
+            })
+            .unzip();
+        UnitLayer { normal, lateral }
+    }
+
+    /// The table for (Poisson's ratio, at least `extent` thicknesses), built once per process:
+    /// extents are rounded up to a power of two so that nearby thicknesses share one.
+    fn shared(poisson: f64, extent: f64) -> Arc<UnitLayer> {
+        static TABLES: Mutex<Vec<((u64, u64), Arc<UnitLayer>)>> = Mutex::new(Vec::new());
+        let extent = extent.max(1.0).log2().ceil().exp2();
+        let key = (poisson.to_bits(), extent.to_bits());
+        // A poisoned lock only means another thread panicked mid-build; the list is intact.
+        let mut tables = TABLES.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, t)) = tables.iter().find(|(k, _)| *k == key) {
+            return t.clone();
         }
+        // Bound the cache for long randomised runs (Poisson's ratio drawn per sample).
+        if tables.len() >= 32 {
+            tables.clear();
+        }
+        let table = Arc::new(UnitLayer::new(poisson, extent));
+        tables.push((key, table.clone()));
+        table
+    }
+}
+
+/// Tabulated layer corrections C_w and C_u for one thickness and Poisson ratio.
+#[derive(Clone, Debug)]
+pub struct LayerCorrection {
+    pub thickness_mm: f64,
+    pub poisson: f64,
+    unit: Arc<UnitLayer>,
+}
+
+impl LayerCorrection {
+    /// Tables out to `r_max_mm`.
+    pub fn new(thickness_mm: f64, poisson: f64, r_max_mm: f64) -> Self {
         Self {
             thickness_mm,
             poisson,
-            dr,
-            normal,
-            lateral,
+            unit: UnitLayer::shared(poisson, r_max_mm / thickness_mm),
         }
     }
 
-    fn lookup(table: &[f64], dr: f64, r: f64) -> f64 {
-        let x = r / dr;
+    fn lookup(table: &[f64], rho: f64) -> f64 {
+        let x = rho * SAMPLES_PER_THICKNESS;
         let i = (x.floor() as usize).min(table.len() - 2);
         let f = (x - i as f64).min(1.0);
         table[i] * (1.0 - f) + table[i + 1] * f
@@ -143,9 +179,10 @@ impl LayerCorrection {
 
     /// (C_w, C_u) at radius r (mm).
     pub fn at(&self, r: f64) -> (f64, f64) {
+        let (h, rho) = (self.thickness_mm, r / self.thickness_mm);
         (
-            Self::lookup(&self.normal, self.dr, r),
-            Self::lookup(&self.lateral, self.dr, r),
+            Self::lookup(&self.unit.normal, rho) / h,
+            Self::lookup(&self.unit.lateral, rho) / h,
         )
     }
 }
@@ -230,5 +267,32 @@ mod tests {
         // Thin near-incompressible layers are much stiffer than the half-space under a
         // load: the correction is negative at the origin.
         assert!(layer.at(0.0).0 < 0.0);
+    }
+
+    #[test]
+    fn one_unit_table_gives_each_thickness_its_own_corrections() {
+        // C_w(r; h) = int (K(kh) - 1 + e^{-kh}) J0(kr) dk - 1 / sqrt(h^2 + r^2), here by a
+        // plain trapezoid on its own fine grid in k, for thicknesses not used by the table.
+        for (h, nu) in [(1.7, 0.49), (4.3, 0.49), (3.1, 0.3)] {
+            let layer = LayerCorrection::new(h, nu, 20.0);
+            for r in [0.0, 0.8, 3.0, 9.5] {
+                let dk = 0.002 / h;
+                let direct: f64 = (1..(60.0 / h / dk) as usize)
+                    .map(|q| {
+                        let k = q as f64 * dk;
+                        (normal_compliance_ratio(k * h, nu) - 1.0 + (-k * h).exp())
+                            * libm::j0(k * r)
+                            * dk
+                    })
+                    .sum::<f64>()
+                    - 1.0 / h.hypot(r);
+                let (cw, _) = layer.at(r);
+                // Corrections are of order 1/h; the table interpolates linearly in r.
+                assert!(
+                    (cw - direct).abs() < 2e-3 / h,
+                    "h {h}, nu {nu}, r {r}: {cw} vs {direct}"
+                );
+            }
+        }
     }
 }

@@ -166,14 +166,12 @@ pub struct ContactSolution {
     object: Elastic,
 }
 
-/// Solves contacts, caching FFT plans, kernel spectra and layer tables between calls (a
-/// press sequence reuses them all).
+/// Solves contacts, caching FFT plans and kernel spectra between calls (a press sequence
+/// reuses them; the layer tables behind the kernels are shared by the whole process).
 #[derive(Default)]
 pub struct ContactSolver {
     pub settings: polonsky_keer::Settings,
     kernels: HashMap<KernelKey, GridKernels>,
-    /// Layer tables keyed by (thickness, Poisson's ratio, extent).
-    layers: Vec<((f64, f64, f64), LayerCorrection)>,
 }
 
 fn finite_in(field: &str, v: f64, lo: f64, hi: f64) -> Result<(), ContactError> {
@@ -287,30 +285,15 @@ impl ContactSolver {
     /// sampling depends on its extent: a table grown for an earlier, larger press must not
     /// serve a later one, or a press would depend on what the solver solved before it (and
     /// parallel data generation on thread scheduling).
-    fn layer_table(&mut self, thickness_mm: f64, poisson: f64, r_max_mm: f64) -> usize {
-        let extent_mm = r_max_mm.max(4.0).log2().ceil().exp2();
-        let key = (thickness_mm, poisson, extent_mm);
-        if let Some(k) = self.layers.iter().position(|(k, _)| *k == key) {
-            return k;
-        }
-        // Tables are small (a few hundred samples); bound the cache for long randomised runs.
-        if self.layers.len() >= 64 {
-            self.layers.clear();
-        }
-        self.layers
-            .push((key, LayerCorrection::new(thickness_mm, poisson, extent_mm)));
-        self.layers.len() - 1
-    }
-
     fn kernels(&mut self, grid: &Grid, gel: &GelSpec, layer: bool) -> &mut GridKernels {
         let thickness = layer.then_some(gel.thickness_mm);
         let key = KernelKey::new(grid, gel.poisson, thickness);
         if !self.kernels.contains_key(&key) {
             let table = layer.then(|| {
                 let diagonal = grid.cell_mm * (grid.nx as f64).hypot(grid.ny as f64) + grid.cell_mm;
-                self.layer_table(gel.thickness_mm, gel.poisson, diagonal)
+                LayerCorrection::new(gel.thickness_mm, gel.poisson, diagonal)
             });
-            let built = GridKernels::new(grid, gel.poisson, table.map(|k| &self.layers[k].1));
+            let built = GridKernels::new(grid, gel.poisson, table.as_ref());
             // Keep the cache bounded: a press sequence needs one or two grids.
             if self.kernels.len() >= 8 {
                 self.kernels.clear();
