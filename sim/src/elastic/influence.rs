@@ -65,6 +65,9 @@ struct UnitLayer {
 
 const SAMPLES_PER_THICKNESS: f64 = 48.0;
 
+/// A unit table's key: the bits of (Poisson's ratio, extent in thicknesses).
+type TableKey = (u64, u64);
+
 impl UnitLayer {
     /// Tables out to `extent` thicknesses: a few hundred radii, each a quadrature over
     /// ~800 wavenumbers of two Bessel functions (tens of ms, so radii run in parallel).
@@ -134,7 +137,7 @@ impl UnitLayer {
     /// The table for (Poisson's ratio, at least `extent` thicknesses), built once per process:
     /// extents are rounded up to a power of two so that nearby thicknesses share one.
     fn shared(poisson: f64, extent: f64) -> Arc<UnitLayer> {
-        static TABLES: Mutex<Vec<((u64, u64), Arc<UnitLayer>)>> = Mutex::new(Vec::new());
+        static TABLES: Mutex<Vec<(TableKey, Arc<UnitLayer>)>> = Mutex::new(Vec::new());
         let extent = extent.max(1.0).log2().ceil().exp2();
         let key = (poisson.to_bits(), extent.to_bits());
         // A poisoned lock only means another thread panicked mid-build; the list is intact.
