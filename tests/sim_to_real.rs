@@ -22,6 +22,16 @@ fn tactex(args: &[&str]) -> std::process::Output {
         .expect("runs tactex")
 }
 
+/// The JSON a successful run printed (its stderr shown if it failed).
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
+
 fn rgb(path: &Path) -> RgbImage {
     image::open(path).unwrap().to_rgb8()
 }
@@ -68,12 +78,7 @@ fn calibrated_renderer_matches_held_out_real_presses() {
         "cpu",
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let report = json(&out);
     let n = report["presses"].as_array().unwrap().len();
     // Fixture annotations hold 9 presses; every third (3) is held out of the calibration.
     assert_eq!(n, 3);
@@ -209,12 +214,7 @@ fn contact_command_finds_the_marked_circle_and_no_contact_on_the_background() {
         MM_PER_PX,
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = json(&out);
     assert_eq!(r["evidence"]["contact"], true);
     // Marked: centre (125, 191) + 1/2, radius 39 px (1.99 mm).
     let c = &r["circle"];
@@ -234,7 +234,7 @@ fn contact_command_finds_the_marked_circle_and_no_contact_on_the_background() {
         background.to_str().unwrap(),
         "--json",
     ]);
-    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = json(&out);
     assert_eq!(r["evidence"]["contact"], false);
     assert!(r.get("circle").is_none(), "{r}");
 
@@ -256,12 +256,7 @@ fn contact_command_finds_the_marked_circle_and_no_contact_on_the_background() {
 fn markers_found_on_the_real_marker_frame_match_the_annotations() {
     let f = fixtures().join("markers");
     let out = tactex(&["markers", f.join("press.png").to_str().unwrap(), "--json"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let report = json(&out);
     let found: Vec<(f64, f64)> = report["markers"]
         .as_array()
         .unwrap()
@@ -303,12 +298,7 @@ fn markers_found_on_the_real_marker_frame_match_the_annotations() {
         overlay.to_str().unwrap(),
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let report = json(&out);
     assert_eq!(report["annotated"]["count"], 99);
     assert_eq!(report["annotated"]["found"], within as u64);
     assert_eq!(image::open(&overlay).unwrap().width(), 3 * 320);

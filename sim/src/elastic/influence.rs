@@ -135,7 +135,10 @@ impl UnitLayer {
     }
 
     /// The table for (Poisson's ratio, at least `extent` thicknesses), built once per process:
-    /// extents are rounded up to a power of two so that nearby thicknesses share one.
+    /// extents are rounded up to a power of two so that nearby thicknesses share one, and
+    /// looked up by that extent exactly (never a larger table), because the sampling depends
+    /// on the extent: otherwise a press would depend on what the process solved before it
+    /// (and parallel data generation on thread scheduling).
     fn shared(poisson: f64, extent: f64) -> Arc<UnitLayer> {
         static TABLES: Mutex<Vec<(TableKey, Arc<UnitLayer>)>> = Mutex::new(Vec::new());
         let extent = extent.max(1.0).log2().ceil().exp2();

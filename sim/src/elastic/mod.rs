@@ -280,11 +280,7 @@ impl ContactSolver {
         Self::default()
     }
 
-    /// The layer table reaching `r_max_mm`. Its extent is rounded up to a power of two
-    /// (at least 4 mm) and tables are looked up by that extent exactly, because the table's
-    /// sampling depends on its extent: a table grown for an earlier, larger press must not
-    /// serve a later one, or a press would depend on what the solver solved before it (and
-    /// parallel data generation on thread scheduling).
+    /// The kernel spectra of `grid` for the half-space or (`layer`) the bonded layer.
     fn kernels(&mut self, grid: &Grid, gel: &GelSpec, layer: bool) -> &mut GridKernels {
         let thickness = layer.then_some(gel.thickness_mm);
         let key = KernelKey::new(grid, gel.poisson, thickness);
