@@ -1,6 +1,7 @@
 //! `tactex bench contact`: the speed/accuracy ladder of the contact solver. For each
 //! fidelity level and solver cell, the median time per press frame (an 8-frame press,
-//! warm-started) and its error against the finest `layer` solution and against Hertz.
+//! warm-started) and its error against the finest `layer` solution and against Hertz; and
+//! for the default grid, what the conjugate gradient's stopping tolerance buys.
 
 use crate::output::{write_bytes_atomic, write_json_atomic};
 use crate::plot;
@@ -34,7 +35,14 @@ pub struct ContactBenchArgs {
     /// Finest cell (mm): the reference `layer` solution.
     #[arg(long, default_value_t = 0.05)]
     reference_cell_mm: f64,
+    /// Stopping tolerances to time besides the default, for `layer` on the first cell.
+    #[arg(long, value_delimiter = ',', default_value = "1e-3,1e-4,1e-5,1e-8")]
+    tolerances: Vec<f64>,
 }
+
+/// Tolerance of the reference and of the converged solves rows are compared with: far below
+/// anything a row asks for, so that what they measure is the row's own stopping error.
+const CONVERGED_TOLERANCE: f64 = 1e-11;
 
 /// The pressed object: a 10 mm sphere of 1 MPa (a ripe-fruit modulus) on the Mini's gel.
 const RADIUS_MM: f64 = 10.0;
@@ -54,6 +62,8 @@ pub struct BenchRow {
     pub domain: &'static str,
     /// Each frame started from the previous one, or cold.
     pub start: &'static str,
+    /// The conjugate gradient stops when the pressure changes by less than this (relative).
+    pub tolerance: f64,
     pub ms_per_frame: f64,
     pub iterations_per_frame: f64,
     pub force_err_vs_reference_pct: f64,
@@ -62,6 +72,19 @@ pub struct BenchRow {
     pub force_err_vs_hertz_pct: f64,
     pub radius_err_vs_hertz_pct: f64,
     pub rms_gel_um_vs_hertz: f64,
+    /// The same press on the same grid solved to `CONVERGED_TOLERANCE`: the error of
+    /// stopping early, apart from the grid's.
+    pub rms_gel_um_vs_converged: f64,
+}
+
+/// One timed configuration.
+#[derive(Clone, Copy)]
+struct Config {
+    fidelity: Fidelity,
+    cell: Option<f64>,
+    whole_pad: bool,
+    warm: bool,
+    tolerance: f64,
 }
 
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
@@ -164,19 +187,48 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             ),
         });
     }
-    // (fidelity, cell, whole pad, warm start)
-    let mut configs: Vec<(Fidelity, Option<f64>, bool, bool)> = Vec::new();
+    for t in &args.tolerances {
+        anyhow::ensure!(
+            t.is_finite() && *t > 0.0 && *t < 1.0,
+            "--tolerances: {t} is not a tolerance in (0, 1)"
+        );
+    }
+    let default_tolerance = ContactSolver::new().settings.tolerance;
+    let config = |fidelity, cell, whole_pad, warm, tolerance| Config {
+        fidelity,
+        cell,
+        whole_pad,
+        warm,
+        tolerance,
+    };
+    let mut configs = Vec::new();
     for fidelity in Fidelity::ALL {
         for cell in &cells {
-            configs.push((fidelity, *cell, false, true));
+            configs.push(config(fidelity, *cell, false, true, default_tolerance));
         }
     }
     // What modelling only the touched region saves: the same solve over the whole pad.
     for cell in &cells {
-        configs.push((Fidelity::Layer, *cell, true, true));
+        configs.push(config(
+            Fidelity::Layer,
+            *cell,
+            true,
+            true,
+            default_tolerance,
+        ));
     }
     // What the warm start saves: each frame solved cold.
-    configs.push((Fidelity::Layer, cells[0], false, false));
+    configs.push(config(
+        Fidelity::Layer,
+        cells[0],
+        false,
+        false,
+        default_tolerance,
+    ));
+    // What the stopping tolerance trades.
+    for t in &args.tolerances {
+        configs.push(config(Fidelity::Layer, cells[0], false, true, *t));
+    }
 
     let bar = ProgressBar::new(configs.len() as u64 + 1);
     bar.set_style(
@@ -186,6 +238,7 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
     );
     bar.set_message("reference layer solve");
     let mut solver = ContactSolver::new();
+    solver.settings.tolerance = CONVERGED_TOLERANCE;
     let reference = solver.press_sequence(
         &setup.problem(Some(args.reference_cell_mm)),
         Fidelity::Layer,
@@ -194,9 +247,16 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
     bar.inc(1);
 
     let mut rows = Vec::new();
-    for (fidelity, cell, whole_pad, warm) in configs {
+    for Config {
+        fidelity,
+        cell,
+        whole_pad,
+        warm,
+        tolerance,
+    } in configs
+    {
         let label = format!(
-            "{fidelity} {}{}{}",
+            "{fidelity} {}{}{} tol {tolerance:.0e}",
             cell.map_or("auto".into(), |c| format!("{c} mm")),
             if whole_pad { " (pad)" } else { "" },
             if warm { "" } else { " (cold)" }
@@ -209,11 +269,9 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             let cell_mm = grid.map_or(0.1, |g| g.cell_mm);
             grid = Some(Grid::covering(&setup.pad, cell_mm));
         }
-        let mut times = Vec::with_capacity(args.reps);
-        let mut frames: Vec<ContactSolution> = Vec::new();
-        for _ in 0..args.reps {
-            frames.clear();
-            let start = Instant::now();
+        let press = |solver: &mut ContactSolver, tolerance: f64| {
+            solver.settings.tolerance = tolerance;
+            let mut frames: Vec<ContactSolution> = Vec::new();
             for &depth in &setup.depths {
                 let frame = ContactProblem {
                     approach_mm: depth,
@@ -223,6 +281,14 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
                 let s = solver.solve_on(&frame, fidelity, grid, previous)?;
                 frames.push(s);
             }
+            anyhow::Ok(frames)
+        };
+        let converged = press(&mut solver, CONVERGED_TOLERANCE)?;
+        let mut times = Vec::with_capacity(args.reps);
+        let mut frames: Vec<ContactSolution> = Vec::new();
+        for _ in 0..args.reps {
+            let start = Instant::now();
+            frames = press(&mut solver, tolerance)?;
             times.push(start.elapsed().as_secs_f64() * 1e3 / setup.depths.len() as f64);
         }
         let n = frames.len() as f64;
@@ -233,6 +299,7 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             grid: grid.map_or("-".into(), |g| format!("{}x{}", g.nx, g.ny)),
             domain: if whole_pad { "pad" } else { "contact" },
             start: if warm { "warm" } else { "cold" },
+            tolerance,
             ms_per_frame: median(times),
             iterations_per_frame: frames.iter().map(|f| f.iterations as f64).sum::<f64>() / n,
             force_err_vs_reference_pct: 0.0,
@@ -241,8 +308,14 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             force_err_vs_hertz_pct: 0.0,
             radius_err_vs_hertz_pct: 0.0,
             rms_gel_um_vs_hertz: 0.0,
+            rms_gel_um_vs_converged: 0.0,
         };
-        for ((s, r), &depth) in frames.iter().zip(&reference).zip(&setup.depths) {
+        for (((s, r), c), &depth) in frames
+            .iter()
+            .zip(&reference)
+            .zip(&converged)
+            .zip(&setup.depths)
+        {
             let h = hertz_at(depth);
             row.force_err_vs_reference_pct += 100.0 * (s.force_n / r.force_n - 1.0).abs() / n;
             row.radius_err_vs_reference_pct +=
@@ -255,6 +328,7 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             row.rms_gel_um_vs_hertz += rms_um(&fields, r, |p| {
                 Some(share * h.total_displacement_mm(p.length()))
             }) / n;
+            row.rms_gel_um_vs_converged += rms_um(&s.gel, c, |_| None) / n;
         }
         rows.push(row);
         bar.inc(1);
@@ -275,7 +349,11 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
                 } else {
                     r.fidelity.clone()
                 },
-                label: r.cell.clone(),
+                label: if r.tolerance == default_tolerance {
+                    r.cell.clone()
+                } else {
+                    format!("{} tol {:.0e}", r.cell, r.tolerance)
+                },
                 x: r.ms_per_frame,
                 y: r.force_err_vs_reference_pct,
             })
@@ -298,17 +376,18 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
 
 fn csv(rows: &[BenchRow]) -> String {
     let mut out = String::from(
-        "fidelity,cell,cell_mm,grid,domain,start,ms_per_frame,iterations_per_frame,force_err_vs_reference_pct,radius_err_vs_reference_pct,rms_gel_um_vs_reference,force_err_vs_hertz_pct,radius_err_vs_hertz_pct,rms_gel_um_vs_hertz\n",
+        "fidelity,cell,cell_mm,grid,domain,start,tolerance,ms_per_frame,iterations_per_frame,force_err_vs_reference_pct,radius_err_vs_reference_pct,rms_gel_um_vs_reference,force_err_vs_hertz_pct,radius_err_vs_hertz_pct,rms_gel_um_vs_hertz,rms_gel_um_vs_converged\n",
     );
     for r in rows {
         out += &format!(
-            "{},{},{:.5},{},{},{},{:.4},{:.1},{:.4},{:.4},{:.3},{:.4},{:.4},{:.3}\n",
+            "{},{},{:.5},{},{},{},{:e},{:.4},{:.1},{:.4},{:.4},{:.3},{:.4},{:.4},{:.3},{:.6}\n",
             r.fidelity,
             r.cell,
             r.cell_mm,
             r.grid,
             r.domain,
             r.start,
+            r.tolerance,
             r.ms_per_frame,
             r.iterations_per_frame,
             r.force_err_vs_reference_pct,
@@ -316,7 +395,8 @@ fn csv(rows: &[BenchRow]) -> String {
             r.rms_gel_um_vs_reference,
             r.force_err_vs_hertz_pct,
             r.radius_err_vs_hertz_pct,
-            r.rms_gel_um_vs_hertz
+            r.rms_gel_um_vs_hertz,
+            r.rms_gel_um_vs_converged
         );
     }
     out
@@ -324,7 +404,7 @@ fn csv(rows: &[BenchRow]) -> String {
 
 fn markdown(rows: &[BenchRow]) -> String {
     let mut out = String::from(
-        "| fidelity | cell | grid | domain | start | ms/frame | iter/frame | force err vs ref | radius err vs ref | RMS gel vs ref | force err vs Hertz | radius err vs Hertz | RMS gel vs Hertz |\n|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| fidelity | cell | grid | domain | start | tolerance | ms/frame | iter/frame | force err vs ref | radius err vs ref | RMS gel vs ref | force err vs Hertz | radius err vs Hertz | RMS gel vs Hertz | RMS gel vs converged |\n|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         let cell = if r.cell == "auto" {
@@ -333,11 +413,12 @@ fn markdown(rows: &[BenchRow]) -> String {
             format!("{} mm", r.cell)
         };
         out += &format!(
-            "| {} | {cell} | {} | {} | {} | {:.3} | {:.1} | {:.2}% | {:.2}% | {:.1} µm | {:.2}% | {:.2}% | {:.1} µm |\n",
+            "| {} | {cell} | {} | {} | {} | {:.0e} | {:.3} | {:.1} | {:.2}% | {:.2}% | {:.1} µm | {:.2}% | {:.2}% | {:.1} µm | {:.2} nm |\n",
             r.fidelity,
             r.grid,
             r.domain,
             r.start,
+            r.tolerance,
             r.ms_per_frame,
             r.iterations_per_frame,
             r.force_err_vs_reference_pct,
@@ -345,7 +426,8 @@ fn markdown(rows: &[BenchRow]) -> String {
             r.rms_gel_um_vs_reference,
             r.force_err_vs_hertz_pct,
             r.radius_err_vs_hertz_pct,
-            r.rms_gel_um_vs_hertz
+            r.rms_gel_um_vs_hertz,
+            1e3 * r.rms_gel_um_vs_converged
         );
     }
     out

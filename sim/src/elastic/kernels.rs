@@ -14,6 +14,20 @@ pub struct GridKernels {
     /// Layer minus half-space, when the gel is a bonded layer.
     pub layer_normal: Option<Spectrum>,
     pub layer_lateral: Option<[Spectrum; 2]>,
+    /// The spectra weighted by the last pair of compliances asked for: every frame of a
+    /// press asks for the same pair, and weighting them anew cost as much as a convolution.
+    weighted: Option<Weighted>,
+}
+
+/// The influence spectra times one pair of compliances (1/MPa).
+pub struct Weighted {
+    key: (u64, u64),
+    /// Gap closure per unit pressure, gel and object together: what the solve inverts.
+    pub total_normal: Spectrum,
+    pub gel_normal: Spectrum,
+    pub gel_lateral: [Spectrum; 2],
+    /// The object's own indentation; None for a rigid object.
+    pub object_normal: Option<Spectrum>,
 }
 
 /// Identifies a `GridKernels`: grid shape, cell and material (bits of the f64s).
@@ -95,7 +109,40 @@ impl GridKernels {
             half_space_lateral,
             layer_normal,
             layer_lateral,
+            weighted: None,
         }
+    }
+
+    /// The spectra for gel compliance `gel_c` and object compliance `object_c`, with the
+    /// FFT plans to apply them.
+    pub fn weighted(&mut self, gel_c: f64, object_c: f64) -> (&mut Convolver, &Weighted) {
+        let key = (gel_c.to_bits(), object_c.to_bits());
+        if self.weighted.as_ref().is_none_or(|w| w.key != key) {
+            let layer = |base: &Spectrum, correction: Option<&Spectrum>| match correction {
+                Some(c) => combine(&[(gel_c, base), (gel_c, c)]),
+                None => combine(&[(gel_c, base)]),
+            };
+            let mut total = vec![(gel_c + object_c, &self.half_space_normal)];
+            if let Some(l) = &self.layer_normal {
+                total.push((gel_c, l));
+            }
+            let lateral = self.layer_lateral.as_ref();
+            self.weighted = Some(Weighted {
+                key,
+                total_normal: combine(&total),
+                gel_normal: layer(&self.half_space_normal, self.layer_normal.as_ref()),
+                gel_lateral: [
+                    layer(&self.half_space_lateral[0], lateral.map(|l| &l[0])),
+                    layer(&self.half_space_lateral[1], lateral.map(|l| &l[1])),
+                ],
+                object_normal: (object_c > 0.0)
+                    .then(|| combine(&[(object_c, &self.half_space_normal)])),
+            });
+        }
+        (
+            &mut self.conv,
+            self.weighted.as_ref().expect("weighted above"),
+        )
     }
 }
 

@@ -27,7 +27,7 @@ pub use surface::ObjectSurface;
 
 use glam::DVec2;
 use influence::{LayerCorrection, half_space_lateral_ratio};
-use kernels::{GridKernels, KernelKey, combine};
+use kernels::{GridKernels, KernelKey};
 use std::collections::HashMap;
 use std::fmt;
 use std::str::FromStr;
@@ -623,11 +623,6 @@ impl ContactSolver {
         let object_c = problem.object.compliance();
         let settings = self.settings;
         let k = self.kernels(&grid, &problem.gel, layer);
-        let mut terms = vec![(gel_c + object_c, &k.half_space_normal)];
-        if let Some(l) = &k.layer_normal {
-            terms.push((gel_c, l));
-        }
-        let total = combine(&terms);
         // Cold start: the overlap over one cell's self-compliance, spread over the cells
         // across, so that the contact set starts as a superset and shrinks.
         let self_c = (gel_c + object_c)
@@ -651,9 +646,10 @@ impl ContactSolver {
             }
             _ => cold.collect(),
         };
+        let (conv, weighted) = k.weighted(gel_c, object_c);
         let outcome = polonsky_keer::solve(
-            &mut k.conv,
-            &total,
+            conv,
+            &weighted.total_normal,
             separation,
             problem.approach_mm,
             start,
@@ -686,7 +682,7 @@ impl ContactSolver {
         if on_rim {
             warnings.push("the contact reached the edge of the solver grid".into());
         }
-        let (gel, object_max) = kernel_fields(k, &grid, &p, gel_c, object_c);
+        let (gel, object_max) = kernel_fields(k, &grid, &p, gel_c, object_c, true);
         let mut s = self.base(problem, fidelity, grid, p, gel, FieldModel::Kernel);
         s.object_max_indentation_mm = object_max;
         s.iterations = outcome.iterations;
@@ -734,7 +730,8 @@ impl ContactSolver {
                 .compliance();
                 let layer = solution.fidelity == Fidelity::Layer;
                 let k = self.kernels(&grid, &solution.gel_spec, layer);
-                kernel_fields(k, &grid, &pressure, gel_c, solution.object.compliance()).0
+                let object_c = solution.object.compliance();
+                kernel_fields(k, &grid, &pressure, gel_c, object_c, false).0
             }
         }
     }
@@ -769,40 +766,30 @@ fn hertz_fields(
     }
 }
 
-/// Gel normal and lateral fields (and the object's largest indentation) from a pressure
-/// field by convolution with the kernels.
+/// Gel normal and lateral fields from a pressure field by convolution with the kernels,
+/// and (when `object_depth`) the object's largest indentation.
 fn kernel_fields(
     k: &mut GridKernels,
     grid: &Grid,
     pressure: &[f64],
     gel_c: f64,
     object_c: f64,
+    object_depth: bool,
 ) -> (GelFields, f64) {
     let n = grid.len();
-    let spectrum = k.conv.spectrum(pressure);
-    let mut gel_normal = combine(&[(gel_c, &k.half_space_normal)]);
-    let mut lateral = [
-        combine(&[(gel_c, &k.half_space_lateral[0])]),
-        combine(&[(gel_c, &k.half_space_lateral[1])]),
-    ];
-    if let (Some(ln), Some(ll)) = (&k.layer_normal, &k.layer_lateral) {
-        gel_normal = combine(&[(1.0, &gel_normal), (gel_c, ln)]);
-        lateral = [
-            combine(&[(1.0, &lateral[0]), (gel_c, &ll[0])]),
-            combine(&[(1.0, &lateral[1]), (gel_c, &ll[1])]),
-        ];
-    }
+    let (conv, w) = k.weighted(gel_c, object_c);
+    let spectrum = conv.spectrum(pressure);
     let (mut normal, mut lx, mut ly) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    k.conv.apply(&spectrum, &gel_normal, &mut normal);
-    k.conv.apply(&spectrum, &lateral[0], &mut lx);
-    k.conv.apply(&spectrum, &lateral[1], &mut ly);
-    let object_max = if object_c > 0.0 {
-        let mut object = vec![0.0; n];
-        let object_kernel = combine(&[(object_c, &k.half_space_normal)]);
-        k.conv.apply(&spectrum, &object_kernel, &mut object);
-        object.into_iter().fold(0.0, f64::max)
-    } else {
-        0.0
+    conv.apply(&spectrum, &w.gel_normal, &mut normal);
+    conv.apply(&spectrum, &w.gel_lateral[0], &mut lx);
+    conv.apply(&spectrum, &w.gel_lateral[1], &mut ly);
+    let object_max = match &w.object_normal {
+        Some(kernel) if object_depth => {
+            let mut object = vec![0.0; n];
+            conv.apply(&spectrum, kernel, &mut object);
+            object.into_iter().fold(0.0, f64::max)
+        }
+        _ => 0.0,
     };
     (
         GelFields {

@@ -14,9 +14,12 @@ pub struct Settings {
 }
 
 impl Default for Settings {
+    /// 1e-6: on the benched press it moves the gel surface by ~1 nm and the force by 3e-7
+    /// relative (`tactex bench contact`, RMS gel vs converged), a thousandth of the default
+    /// grid's own error, in two thirds of the steps that 1e-8 takes.
     fn default() -> Self {
         Self {
-            tolerance: 1e-8,
+            tolerance: 1e-6,
             max_iterations: 2000,
         }
     }
@@ -57,9 +60,12 @@ pub fn solve(
     let mut conjugate = false;
     let mut iterations = 0;
     let mut converged = false;
+    // u = K p, kept up to date: after a step that only moved cells already in contact
+    // (no cell clipped to zero, none entered) it is u - tau K t, which saves one of the
+    // iteration's two convolutions; otherwise it is convolved afresh.
+    conv.convolve(&p, kernel, &mut u);
     while iterations < settings.max_iterations {
         iterations += 1;
-        conv.convolve(&p, kernel, &mut u);
         let mut g_sum = 0.0;
         for i in 0..n {
             gap[i] = if active[i] {
@@ -91,13 +97,16 @@ pub fn solve(
         let tau = if den > 0.0 { num / den } else { 0.0 };
         let (mut change, mut total) = (0.0, 0.0);
         let mut overlap = false;
+        let mut clipped = false;
         for i in 0..n {
             if !active[i] {
                 continue;
             }
             let old = p[i];
             let mut new = if old > 0.0 {
-                (old - tau * t[i]).max(0.0)
+                let moved = old - tau * t[i];
+                clipped |= moved < 0.0;
+                moved.max(0.0)
             } else {
                 0.0
             };
@@ -116,8 +125,15 @@ pub fn solve(
             converged = true;
             break;
         }
+        if overlap || clipped {
+            conv.convolve(&p, kernel, &mut u);
+        } else {
+            for (u, r) in u.iter_mut().zip(&r) {
+                *u -= tau * r;
+            }
+        }
     }
-    // Final contact conditions.
+    // Final contact conditions, from a fresh convolution.
     conv.convolve(&p, kernel, &mut u);
     let (mut violation, mut count) = (0.0, 0usize);
     for i in 0..n {
@@ -142,5 +158,82 @@ pub fn solve(
         iterations,
         residual,
         converged,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::elastic::convolution::wrapped_kernel;
+    use crate::elastic::influence::love_normal;
+
+    /// A rigid sphere of radius 5 mm pressed 0.2 mm into a half-space of unit compliance on
+    /// a 24x24 grid of 0.25 mm cells: the contact set grows, clips and settles, so the
+    /// solve takes both the incremental and the fresh displacement updates.
+    fn sphere_press(settings: Settings) -> (Vec<f64>, Vec<f64>, Outcome) {
+        let (n, cell, radius, approach) = (24usize, 0.25, 5.0, 0.2);
+        let centre = (n as f64 - 1.0) / 2.0;
+        let separation: Vec<f64> = (0..n * n)
+            .map(|k| {
+                let (x, y) = ((k % n) as f64 - centre, (k / n) as f64 - centre);
+                let r2 = (x * x + y * y) * cell * cell;
+                radius - (radius * radius - r2).sqrt() - approach
+            })
+            .collect();
+        let coefficient =
+            |di: i64, dj: i64| love_normal(di as f64 * cell, dj as f64 * cell, cell / 2.0);
+        let mut conv = Convolver::new(n, n);
+        let kernel = conv.padded_spectrum(&wrapped_kernel(n, n, coefficient));
+        let start = separation.iter().map(|s| (-s).max(0.0)).collect();
+        let outcome = solve(&mut conv, &kernel, &separation, approach, start, settings);
+        // The displacement by direct summation, independent of the FFT and of the
+        // solver's running update.
+        let displacement = (0..n * n)
+            .map(|k| {
+                let (i, j) = ((k % n) as i64, (k / n) as i64);
+                (0..n * n)
+                    .map(|q| {
+                        let (p, r) = ((q % n) as i64, (q / n) as i64);
+                        outcome.pressure[q] * coefficient(i - p, j - r)
+                    })
+                    .sum()
+            })
+            .collect();
+        (separation, displacement, outcome)
+    }
+
+    #[test]
+    fn the_solution_meets_the_contact_conditions_by_direct_summation() {
+        let settings = Settings::default();
+        let (separation, displacement, outcome) = sphere_press(settings);
+        assert!(outcome.converged, "{} iterations", outcome.iterations);
+        let approach = 0.2;
+        let mut in_contact = 0;
+        for ((s, u), p) in separation.iter().zip(&displacement).zip(&outcome.pressure) {
+            let gap = u + s;
+            assert!(*p >= 0.0);
+            if *p > 0.0 {
+                in_contact += 1;
+                assert!(gap.abs() < 1e-4 * approach, "gap {gap} under pressure {p}");
+            } else {
+                assert!(gap > -1e-4 * approach, "overlap {gap} where free");
+            }
+        }
+        assert!(in_contact > 20, "{in_contact} cells in contact");
+    }
+
+    #[test]
+    fn a_looser_tolerance_stops_sooner_near_the_tight_answer() {
+        let tight = sphere_press(Settings {
+            tolerance: 1e-11,
+            ..Settings::default()
+        })
+        .2;
+        let loose = sphere_press(Settings::default()).2;
+        assert!(tight.converged && loose.converged);
+        assert!(loose.iterations < tight.iterations);
+        let force = |p: &[f64]| p.iter().sum::<f64>();
+        let (ft, fl) = (force(&tight.pressure), force(&loose.pressure));
+        assert!((fl / ft - 1.0).abs() < 1e-5, "force {fl} vs {ft}");
     }
 }
