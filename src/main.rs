@@ -40,6 +40,12 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::scene::Scene;
 use tactex_sim::SimDevices;
 
+// Frames, fields and FFT scratch are allocated and freed by the hundred per press; glibc
+// returns blocks this size to the kernel on every free and faults them back in, which cost
+// a third of the gel-fields stage (measured with `bench render`).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 #[derive(Parser)]
 #[command(
     name = "tactex",
