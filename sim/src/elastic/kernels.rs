@@ -3,7 +3,8 @@
 
 use super::convolution::{Convolver, Spectrum, wrapped_kernel};
 use super::grid::Grid;
-use super::influence::{CellResponse, LayerCorrection, cell_response};
+use super::influence::{CellResponse, LayerCorrection, half_space_cells, layer_cell_correction};
+use rayon::prelude::*;
 use rustfft::num_complex::Complex;
 
 /// The spectra for one grid shape and cell, one Poisson ratio, and optionally one layer.
@@ -53,30 +54,25 @@ impl KernelKey {
 }
 
 /// Evaluates the responses for all offsets once, using their symmetry: normal even in both
-/// axes, lateral x odd in x and even in y, lateral y the reverse.
+/// axes, lateral x odd in x and even in y, lateral y the reverse. The layer's part is what
+/// it adds to the half-space's.
 fn responses(
     grid: &Grid,
     poisson: f64,
     layer: Option<&LayerCorrection>,
 ) -> (Vec<CellResponse>, Vec<CellResponse>) {
     let (nx, ny, cell) = (grid.nx, grid.ny, grid.cell_mm);
-    let mut half_space = Vec::with_capacity(nx * ny);
-    let mut with_layer = Vec::with_capacity(if layer.is_some() { nx * ny } else { 0 });
-    for dj in 0..ny {
-        for di in 0..nx {
-            let (x, y) = (di as f64 * cell, dj as f64 * cell);
-            let h = cell_response(x, y, cell, poisson, None);
-            half_space.push(h);
-            if let Some(layer) = layer {
-                let l = cell_response(x, y, cell, poisson, Some(layer));
-                with_layer.push(CellResponse {
-                    normal: l.normal - h.normal,
-                    lateral_x: l.lateral_x - h.lateral_x,
-                    lateral_y: l.lateral_y - h.lateral_y,
-                });
-            }
-        }
-    }
+    let half_space = half_space_cells(nx, ny, cell, poisson);
+    let with_layer = match layer {
+        Some(layer) => (0..nx * ny)
+            .into_par_iter()
+            .map(|k| {
+                let (x, y) = ((k % nx) as f64 * cell, (k / nx) as f64 * cell);
+                layer_cell_correction(x, y, cell, layer)
+            })
+            .collect(),
+        None => Vec::new(),
+    };
     (half_space, with_layer)
 }
 
