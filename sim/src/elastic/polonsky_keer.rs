@@ -34,6 +34,116 @@ pub struct Outcome {
     pub converged: bool,
 }
 
+const LANES: usize = 4;
+
+// The passes over the grid below are a third of the solve beside its FFTs. Each sums in
+// four interleaved running sums, a fixed order (the same bytes every run) that the
+// compiler can vectorise, and is compiled for AVX2 too, picked at run time: without FMA
+// contraction (Rust never contracts) both builds give the same bits.
+
+/// gap = u + separation everywhere; returns the sum of gap^2 over the cells in contact.
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+fn gaps(u: &[f64], separation: &[f64], p: &[f64], gap: &mut [f64]) -> f64 {
+    let mut lanes = [0.0; LANES];
+    let mut lane = |l: usize, g: &mut f64, u: f64, s: f64, p: f64| {
+        *g = u + s;
+        lanes[l] += if p > 0.0 { *g * *g } else { 0.0 };
+    };
+    let (gc, gr) = gap.as_chunks_mut::<LANES>();
+    let (uc, ur) = u.as_chunks::<LANES>();
+    let (sc, sr) = separation.as_chunks::<LANES>();
+    let (pc, pr) = p.as_chunks::<LANES>();
+    for (((g, u), s), p) in gc.iter_mut().zip(uc).zip(sc).zip(pc) {
+        for l in 0..LANES {
+            lane(l, &mut g[l], u[l], s[l], p[l]);
+        }
+    }
+    for (l, (((g, u), s), p)) in gr.iter_mut().zip(ur).zip(sr).zip(pr).enumerate() {
+        lane(l, g, *u, *s, *p);
+    }
+    lanes.iter().sum()
+}
+
+/// The conjugate direction t = gap + ratio t on the contact, zero off it.
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+fn directions(gap: &[f64], p: &[f64], ratio: f64, t: &mut [f64]) {
+    for ((t, g), p) in t.iter_mut().zip(gap).zip(p) {
+        *t = if *p > 0.0 { g + ratio * *t } else { 0.0 };
+    }
+}
+
+/// (sum of gap t, sum of r t) over the contact: the step length's numerator and
+/// denominator (t is zero off the contact, where the gap may be infinite).
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+fn step_sums(gap: &[f64], t: &[f64], r: &[f64], p: &[f64]) -> (f64, f64) {
+    let (mut num, mut den) = ([0.0; LANES], [0.0; LANES]);
+    let mut lane = |l: usize, g: f64, t: f64, r: f64, p: f64| {
+        num[l] += if p > 0.0 { g * t } else { 0.0 };
+        den[l] += r * t;
+    };
+    let (gc, gr) = gap.as_chunks::<LANES>();
+    let (tc, tr) = t.as_chunks::<LANES>();
+    let (rc, rr) = r.as_chunks::<LANES>();
+    let (pc, pr) = p.as_chunks::<LANES>();
+    for (((g, t), r), p) in gc.iter().zip(tc).zip(rc).zip(pc) {
+        for l in 0..LANES {
+            lane(l, g[l], t[l], r[l], p[l]);
+        }
+    }
+    for (l, (((g, t), r), p)) in gr.iter().zip(tr).zip(rr).zip(pr).enumerate() {
+        lane(l, *g, *t, *r, *p);
+    }
+    (num.iter().sum(), den.iter().sum())
+}
+
+/// What one step did to the pressure.
+struct Stepped {
+    change: f64,
+    total: f64,
+    /// A cell in contact was clipped to zero.
+    clipped: bool,
+    /// A cell out of contact overlapped the object and entered.
+    entered: bool,
+}
+
+/// p = max(p - tau t, 0), then cells out of contact that overlap the object enter with
+/// -gap * `entry`.
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+fn step(p: &mut [f64], t: &[f64], gap: &[f64], tau: f64, entry: f64) -> Stepped {
+    let (mut change, mut total) = ([0.0; LANES], [0.0; LANES]);
+    let (mut clipped, mut entered) = ([false; LANES], [false; LANES]);
+    let mut lane = |l: usize, p: &mut f64, t: f64, gap: f64| {
+        let old = *p;
+        // Off the contact t = 0, so this leaves such cells at zero.
+        let moved = old - tau * t;
+        clipped[l] |= moved < 0.0;
+        let kept = moved.max(0.0);
+        let enters = kept == 0.0 && gap < 0.0;
+        entered[l] |= enters;
+        let new = if enters { -gap * entry } else { kept };
+        *p = new;
+        change[l] += (new - old).abs();
+        total[l] += new;
+    };
+    let (pc, pr) = p.as_chunks_mut::<LANES>();
+    let (tc, tr) = t.as_chunks::<LANES>();
+    let (gc, gr) = gap.as_chunks::<LANES>();
+    for ((p, t), g) in pc.iter_mut().zip(tc).zip(gc) {
+        for l in 0..LANES {
+            lane(l, &mut p[l], t[l], g[l]);
+        }
+    }
+    for (l, ((p, t), g)) in pr.iter_mut().zip(tr).zip(gr).enumerate() {
+        lane(l, p, *t, *g);
+    }
+    Stepped {
+        change: change.iter().sum(),
+        total: total.iter().sum(),
+        clipped: clipped.iter().any(|c| *c),
+        entered: entered.iter().any(|e| *e),
+    }
+}
+
 /// Solves for the pressure given `separation` = h0 - delta per cell (infinite where the
 /// object is absent), the total compliance kernel, and a starting pressure.
 pub fn solve(
@@ -46,6 +156,12 @@ pub fn solve(
 ) -> Outcome {
     let n = separation.len();
     let active: Vec<bool> = separation.iter().map(|s| s.is_finite()).collect();
+    // Outside the object the separation is +inf, so the gap is too and such a cell can
+    // never enter: the loops below need no mask of their own.
+    let separation: Vec<f64> = separation
+        .iter()
+        .map(|s| if s.is_finite() { *s } else { f64::INFINITY })
+        .collect();
     let mut p = start;
     for (p, a) in p.iter_mut().zip(&active) {
         if !a || !p.is_finite() || *p < 0.0 {
@@ -66,66 +182,23 @@ pub fn solve(
     conv.convolve(&p, kernel, &mut u);
     while iterations < settings.max_iterations {
         iterations += 1;
-        let mut g_sum = 0.0;
-        for i in 0..n {
-            gap[i] = if active[i] {
-                u[i] + separation[i]
-            } else {
-                f64::INFINITY
-            };
-            if p[i] > 0.0 {
-                g_sum += gap[i] * gap[i];
-            }
-        }
+        let g_sum = gaps(&u, &separation, &p, &mut gap);
         let ratio = if conjugate { g_sum / g_old } else { 0.0 };
-        for i in 0..n {
-            t[i] = if p[i] > 0.0 {
-                gap[i] + ratio * t[i]
-            } else {
-                0.0
-            };
-        }
+        directions(&gap, &p, ratio, &mut t);
         g_old = g_sum;
         conv.convolve(&t, kernel, &mut r);
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..n {
-            if p[i] > 0.0 {
-                num += gap[i] * t[i];
-                den += r[i] * t[i];
-            }
-        }
+        let (num, den) = step_sums(&gap, &t, &r, &p);
         let tau = if den > 0.0 { num / den } else { 0.0 };
-        let (mut change, mut total) = (0.0, 0.0);
-        let mut overlap = false;
-        let mut clipped = false;
-        for i in 0..n {
-            if !active[i] {
-                continue;
-            }
-            let old = p[i];
-            let mut new = if old > 0.0 {
-                let moved = old - tau * t[i];
-                clipped |= moved < 0.0;
-                moved.max(0.0)
-            } else {
-                0.0
-            };
-            // Cells out of contact that overlap the object enter it (before any cell is in
-            // contact there is no step length yet: the overlap itself seeds them).
-            if new == 0.0 && gap[i] < 0.0 {
-                new = -gap[i] * if tau > 0.0 { tau } else { 1.0 };
-                overlap = true;
-            }
-            p[i] = new;
-            change += (new - old).abs();
-            total += new;
-        }
-        conjugate = !overlap;
-        if total == 0.0 || change <= settings.tolerance * total {
+        // Before any cell is in contact there is no step length yet: the overlap itself
+        // seeds the contact.
+        let entry = if tau > 0.0 { tau } else { 1.0 };
+        let stepped = step(&mut p, &t, &gap, tau, entry);
+        conjugate = !stepped.entered;
+        if stepped.total == 0.0 || stepped.change <= settings.tolerance * stepped.total {
             converged = true;
             break;
         }
-        if overlap || clipped {
+        if stepped.entered || stepped.clipped {
             conv.convolve(&p, kernel, &mut u);
         } else {
             for (u, r) in u.iter_mut().zip(&r) {
