@@ -64,6 +64,10 @@ pub struct PressArgs {
     /// Solver cell (mm); default from the contact's size.
     #[arg(long)]
     grid_mm: Option<f64>,
+    /// The contact solve stops when one step changes the pressure by less than this
+    /// (relative); `bench contact` measures what looser values trade.
+    #[arg(long, default_value_t = 1e-6)]
+    tolerance: f64,
     /// Gel thickness (mm); GelSight Mini ~4.
     #[arg(long)]
     gel_thickness_mm: Option<f64>,
@@ -209,6 +213,9 @@ pub fn run(args: &PressArgs) -> Result<()> {
     if let Some(cell) = args.grid_mm {
         positive("grid-mm", cell)?;
     }
+    if !(args.tolerance.is_finite() && args.tolerance > 0.0 && args.tolerance < 1.0) {
+        bail!("--tolerance: must be in (0, 1), got {}", args.tolerance);
+    }
     if !(args.object_poisson.is_finite() && (0.0..=0.5).contains(&args.object_poisson)) {
         bail!(
             "--object-poisson: must be in [0, 0.5], got {}",
@@ -254,6 +261,7 @@ pub fn run(args: &PressArgs) -> Result<()> {
         cell_mm: args.grid_mm,
     };
     let mut solver = ContactSolver::new();
+    solver.settings.tolerance = args.tolerance;
     let solution = solver.solve(&problem, fidelity)?;
     let shown = tactex_core::hardness::HardnessReport::from(hardness);
     let report = PressReport {

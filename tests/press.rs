@@ -239,6 +239,10 @@ fn bad_press_input_is_one_clear_line_and_a_failure() {
             vec!["--shape", "sphere", "--modulus-mpa", "0", "--depth-mm", "1"],
             "modulus-mpa",
         ),
+        (
+            vec!["--shape", "sphere", "--depth-mm", "1", "--tolerance", "0"],
+            "tolerance",
+        ),
     ];
     for (args, named) in cases {
         let mut all = vec!["press"];

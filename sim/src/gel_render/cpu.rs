@@ -233,6 +233,9 @@ impl GelRenderer for CpuRenderer {
         frames: &[PressFrame],
     ) -> Result<Vec<RgbImage>, RenderError> {
         optics.check_frames(frames)?;
-        Ok(frames.par_iter().map(|f| self.render_one(optics, f)).collect())
+        Ok(frames
+            .par_iter()
+            .map(|f| self.render_one(optics, f))
+            .collect())
     }
 }
