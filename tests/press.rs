@@ -1,23 +1,10 @@
 //! `tactex press` and `tactex bench contact` from the command line: the JSON contract, the
 //! maps on disk, and clear one-line errors for bad input.
 
+mod cli;
+
+use cli::{json, tactex};
 use std::process::Command;
-
-fn tactex(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_tactex"))
-        .args(args)
-        .output()
-        .expect("tactex runs")
-}
-
-fn json(out: &std::process::Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
-}
 
 #[test]
 fn press_reports_the_documented_fields_and_softer_means_less_force() {

@@ -4,7 +4,9 @@
 
 use image::RgbImage;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+mod cli;
+
+use cli::{json, tactex};
 use tactex_core::ball_calibration::read_annotations;
 use tactex_core::perception::centroid::median;
 use tactex_core::perception::contact::{ContactRule, contact_evidence};
@@ -12,24 +14,6 @@ use tactex_core::perception::contact_circle::estimate_contact_circle;
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fots")
-}
-
-fn tactex(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_tactex"))
-        .args(args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("runs tactex")
-}
-
-/// The JSON a successful run printed (its stderr shown if it failed).
-fn json(out: &std::process::Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
 }
 
 fn rgb(path: &Path) -> RgbImage {

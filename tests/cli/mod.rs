@@ -4,13 +4,25 @@
 
 use std::process::{Command, Output};
 
-/// `tactex ARGS` run from the repository root.
+/// `tactex ARGS` run from the repository root (with a runtime dir, so that the Vulkan
+/// loader keeps stderr clean where a command looks for a GPU).
 pub fn tactex(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_tactex"))
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .output()
         .expect("runs tactex")
+}
+
+/// The JSON a successful run printed (its stderr shown if it failed).
+pub fn json(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
 }
 
 /// The failure's stderr, after checking it is one line, the exit code is 1 and nothing was
