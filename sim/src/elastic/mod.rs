@@ -21,6 +21,7 @@ pub mod influence;
 pub mod kernels;
 pub mod polonsky_keer;
 pub mod surface;
+mod warm_start;
 
 pub use grid::{Grid, Rect};
 pub use surface::ObjectSurface;
@@ -635,14 +636,10 @@ impl ContactSolver {
                 0.0
             }
         });
-        // Warm start: the previous frame of a press, scaled by the Hertz force law
-        // F ~ delta^1.5, where it pressed; the cold guess where it did not.
+        // Warm start: the previous frame of a press grown the way a Hertz contact grows.
         let start: Vec<f64> = match warm {
             Some(w) if w.grid == grid && w.approach_mm > 0.0 => {
-                let scale = (problem.approach_mm / w.approach_mm).powf(1.5);
-                cold.zip(&w.pressure_mpa)
-                    .map(|(c, p)| if *p > 0.0 { p * scale } else { c })
-                    .collect()
+                warm_start::hertz_grown(&grid, &w.pressure_mpa, problem.approach_mm / w.approach_mm)
             }
             _ => cold.collect(),
         };
