@@ -1,7 +1,8 @@
 //! `tactex bench contact`: the speed/accuracy ladder of the contact solver. For each
 //! fidelity level and solver cell, the median time per press frame (an 8-frame press,
 //! warm-started) and its error against the finest `layer` solution and against Hertz; and
-//! for the default grid, what the conjugate gradient's stopping tolerance buys.
+//! for the default grid, what the conjugate gradient's stopping tolerance and its
+//! preconditioner buy.
 
 use crate::output::{write_bytes_atomic, write_json_atomic};
 use crate::plot;
@@ -62,6 +63,8 @@ pub struct BenchRow {
     pub domain: &'static str,
     /// Each frame started from the previous one, or cold.
     pub start: &'static str,
+    /// The conjugate gradient preconditioned ("pre") or plain.
+    pub cg: &'static str,
     /// The conjugate gradient stops when the pressure changes by less than this (relative).
     pub tolerance: f64,
     pub ms_per_frame: f64,
@@ -85,6 +88,7 @@ struct Config {
     whole_pad: bool,
     warm: bool,
     tolerance: f64,
+    preconditioned: bool,
 }
 
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
@@ -200,6 +204,7 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
         whole_pad,
         warm,
         tolerance,
+        preconditioned: true,
     };
     let mut configs = Vec::new();
     for fidelity in Fidelity::ALL {
@@ -229,6 +234,13 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
     for t in &args.tolerances {
         configs.push(config(Fidelity::Layer, cells[0], false, true, *t));
     }
+    // What the preconditioner saves: the plain conjugate gradient.
+    for fidelity in [Fidelity::Halfspace, Fidelity::Layer] {
+        configs.push(Config {
+            preconditioned: false,
+            ..config(fidelity, cells[0], false, true, default_tolerance)
+        });
+    }
 
     let bar = ProgressBar::new(configs.len() as u64 + 1);
     bar.set_style(
@@ -253,13 +265,15 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
         whole_pad,
         warm,
         tolerance,
+        preconditioned,
     } in configs
     {
         let label = format!(
-            "{fidelity} {}{}{} tol {tolerance:.0e}",
+            "{fidelity} {}{}{}{} tol {tolerance:.0e}",
             cell.map_or("auto".into(), |c| format!("{c} mm")),
             if whole_pad { " (pad)" } else { "" },
-            if warm { "" } else { " (cold)" }
+            if warm { "" } else { " (cold)" },
+            if preconditioned { "" } else { " (plain)" }
         );
         bar.set_message(label);
         let problem = setup.problem(cell);
@@ -269,6 +283,7 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             let cell_mm = grid.map_or(0.1, |g| g.cell_mm);
             grid = Some(Grid::covering(&setup.pad, cell_mm));
         }
+        solver.settings.preconditioned = preconditioned;
         let press = |solver: &mut ContactSolver, tolerance: f64| {
             solver.settings.tolerance = tolerance;
             let mut frames: Vec<ContactSolution> = Vec::new();
@@ -299,6 +314,7 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             grid: grid.map_or("-".into(), |g| format!("{}x{}", g.nx, g.ny)),
             domain: if whole_pad { "pad" } else { "contact" },
             start: if warm { "warm" } else { "cold" },
+            cg: if preconditioned { "pre" } else { "plain" },
             tolerance,
             ms_per_frame: median(times),
             iterations_per_frame: frames.iter().map(|f| f.iterations as f64).sum::<f64>() / n,
@@ -349,10 +365,10 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
                 } else {
                     r.fidelity.clone()
                 },
-                label: if r.tolerance == default_tolerance {
-                    r.cell.clone()
-                } else {
-                    format!("{} tol {:.0e}", r.cell, r.tolerance)
+                label: match (r.tolerance == default_tolerance, r.cg) {
+                    (true, "pre") => r.cell.clone(),
+                    (true, cg) => format!("{} {cg} CG", r.cell),
+                    (false, _) => format!("{} tol {:.0e}", r.cell, r.tolerance),
                 },
                 x: r.ms_per_frame,
                 y: r.force_err_vs_reference_pct,
@@ -376,17 +392,18 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
 
 fn csv(rows: &[BenchRow]) -> String {
     let mut out = String::from(
-        "fidelity,cell,cell_mm,grid,domain,start,tolerance,ms_per_frame,iterations_per_frame,force_err_vs_reference_pct,radius_err_vs_reference_pct,rms_gel_um_vs_reference,force_err_vs_hertz_pct,radius_err_vs_hertz_pct,rms_gel_um_vs_hertz,rms_gel_um_vs_converged\n",
+        "fidelity,cell,cell_mm,grid,domain,start,cg,tolerance,ms_per_frame,iterations_per_frame,force_err_vs_reference_pct,radius_err_vs_reference_pct,rms_gel_um_vs_reference,force_err_vs_hertz_pct,radius_err_vs_hertz_pct,rms_gel_um_vs_hertz,rms_gel_um_vs_converged\n",
     );
     for r in rows {
         out += &format!(
-            "{},{},{:.5},{},{},{},{:e},{:.4},{:.1},{:.4},{:.4},{:.3},{:.4},{:.4},{:.3},{:.6}\n",
+            "{},{},{:.5},{},{},{},{},{:e},{:.4},{:.1},{:.4},{:.4},{:.3},{:.4},{:.4},{:.3},{:.6}\n",
             r.fidelity,
             r.cell,
             r.cell_mm,
             r.grid,
             r.domain,
             r.start,
+            r.cg,
             r.tolerance,
             r.ms_per_frame,
             r.iterations_per_frame,
@@ -404,7 +421,7 @@ fn csv(rows: &[BenchRow]) -> String {
 
 fn markdown(rows: &[BenchRow]) -> String {
     let mut out = String::from(
-        "| fidelity | cell | grid | domain | start | tolerance | ms/frame | iter/frame | force err vs ref | radius err vs ref | RMS gel vs ref | force err vs Hertz | radius err vs Hertz | RMS gel vs Hertz | RMS gel vs converged |\n|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| fidelity | cell | grid | domain | start | CG | tolerance | ms/frame | iter/frame | force err vs ref | radius err vs ref | RMS gel vs ref | force err vs Hertz | radius err vs Hertz | RMS gel vs Hertz | RMS gel vs converged |\n|---|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         let cell = if r.cell == "auto" {
@@ -413,11 +430,12 @@ fn markdown(rows: &[BenchRow]) -> String {
             format!("{} mm", r.cell)
         };
         out += &format!(
-            "| {} | {cell} | {} | {} | {} | {:.0e} | {:.3} | {:.1} | {:.2}% | {:.2}% | {:.1} µm | {:.2}% | {:.2}% | {:.1} µm | {:.2} nm |\n",
+            "| {} | {cell} | {} | {} | {} | {} | {:.0e} | {:.3} | {:.1} | {:.2}% | {:.2}% | {:.1} µm | {:.2}% | {:.2}% | {:.1} µm | {:.2} nm |\n",
             r.fidelity,
             r.grid,
             r.domain,
             r.start,
+            r.cg,
             r.tolerance,
             r.ms_per_frame,
             r.iterations_per_frame,

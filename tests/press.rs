@@ -265,9 +265,9 @@ fn contact_bench_writes_its_table_and_plot() {
         dir.path().to_str().unwrap(),
     ]));
     let rows = v.as_array().unwrap();
-    // Four levels and two pad-wide rows at each of two cells, one cold-start row and one
-    // looser tolerance.
-    assert_eq!(rows.len(), 4 * 2 + 2 + 1 + 1);
+    // Four levels and two pad-wide rows at each of two cells, one cold-start row, one
+    // looser tolerance and two plain (unpreconditioned) conjugate gradients.
+    assert_eq!(rows.len(), 4 * 2 + 2 + 1 + 1 + 2);
     for name in [
         "contact_bench.csv",
         "contact_bench.md",
@@ -286,22 +286,27 @@ fn contact_bench_writes_its_table_and_plot() {
     assert!(err("layer") < 2.0 && err("rigid") > 5.0);
     // Stopping the conjugate gradient sooner takes fewer steps and leaves the gel further
     // from the converged solution, though still far within the grid's own error.
-    let layer = |tolerance: f64| {
+    let layer = |tolerance: f64, cg: &str| {
         rows.iter()
             .find(|r| {
                 r["fidelity"] == "layer"
                     && r["cell"] == "auto"
                     && r["domain"] == "contact"
                     && r["start"] == "warm"
+                    && r["cg"] == cg
                     && r["tolerance"] == tolerance
             })
             .unwrap()
     };
     let f = |r: &serde_json::Value, key: &str| r[key].as_f64().unwrap();
-    let (default, loose) = (layer(1e-6), layer(1e-3));
+    let (default, loose) = (layer(1e-6, "pre"), layer(1e-3, "pre"));
     assert!(f(loose, "iterations_per_frame") < f(default, "iterations_per_frame"));
     assert!(f(loose, "rms_gel_um_vs_converged") > f(default, "rms_gel_um_vs_converged"));
     assert!(f(loose, "rms_gel_um_vs_converged") < f(default, "rms_gel_um_vs_reference"));
+    // The preconditioner takes fewer steps to the same answer.
+    let plain = layer(1e-6, "plain");
+    assert!(f(default, "iterations_per_frame") < f(plain, "iterations_per_frame"));
+    assert!(f(plain, "rms_gel_um_vs_converged") < f(default, "rms_gel_um_vs_reference"));
 }
 
 #[test]

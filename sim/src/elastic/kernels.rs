@@ -4,6 +4,7 @@
 use super::convolution::{Convolver, Spectrum, wrapped_kernel};
 use super::grid::Grid;
 use super::influence::{CellResponse, LayerCorrection, half_space_cells, layer_cell_correction};
+use super::polonsky_keer;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex;
 
@@ -25,6 +26,8 @@ pub struct Weighted {
     key: (u64, u64),
     /// Gap closure per unit pressure, gel and object together: what the solve inverts.
     pub total_normal: Spectrum,
+    /// Its reciprocal, which preconditions the solve.
+    pub total_normal_preconditioner: Spectrum,
     pub gel_normal: Spectrum,
     pub gel_lateral: [Spectrum; 2],
     /// The object's own indentation; None for a rigid object.
@@ -123,9 +126,11 @@ impl GridKernels {
                 total.push((gel_c, l));
             }
             let lateral = self.layer_lateral.as_ref();
+            let total_normal = combine(&total);
             self.weighted = Some(Weighted {
                 key,
-                total_normal: combine(&total),
+                total_normal_preconditioner: polonsky_keer::preconditioner(&total_normal),
+                total_normal,
                 gel_normal: layer(&self.half_space_normal, self.layer_normal.as_ref()),
                 gel_lateral: [
                     layer(&self.half_space_lateral[0], lateral.map(|l| &l[0])),

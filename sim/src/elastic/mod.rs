@@ -647,6 +647,7 @@ impl ContactSolver {
         let outcome = polonsky_keer::solve(
             conv,
             &weighted.total_normal,
+            &weighted.total_normal_preconditioner,
             separation,
             problem.approach_mm,
             start,

@@ -1,7 +1,8 @@
 //! Frictionless elastic contact at a prescribed approach by the constrained conjugate
 //! gradient of Polonsky & Keer (Wear 231, 1999), displacement-controlled variant (no load
 //! balance step): find p >= 0 with gap g = K p + h0 - delta >= 0 and p g = 0, the
-//! convolutions done by DC-FFT.
+//! convolutions done by DC-FFT, the conjugate gradient preconditioned by the kernel's
+//! inverse spectrum restricted to the contact (Vollebregt 2014).
 
 use super::convolution::{Convolver, Spectrum};
 
@@ -11,16 +12,20 @@ pub struct Settings {
     /// Stop when the relative change of the pressure field falls below this.
     pub tolerance: f64,
     pub max_iterations: usize,
+    /// Precondition the conjugate gradient with the inverse of the kernel's spectrum
+    /// (`preconditioner`), restricted to the contact set.
+    pub preconditioned: bool,
 }
 
 impl Default for Settings {
-    /// 1e-6: on the benched press it moves the gel surface by ~1 nm and the force by 3e-7
-    /// relative (`tactex bench contact`, RMS gel vs converged), a thousandth of the default
-    /// grid's own error, in two thirds of the steps that 1e-8 takes.
+    /// 1e-6: on the benched press it leaves the gel surface ~0.01 nm from the converged one
+    /// (`tactex bench contact`, RMS gel vs converged), far below the default grid's own
+    /// 1 um error, in 9.4 steps a frame against 12 at 1e-8.
     fn default() -> Self {
         Self {
             tolerance: 1e-6,
             max_iterations: 2000,
+            preconditioned: true,
         }
     }
 }
@@ -144,11 +149,46 @@ fn step(p: &mut [f64], t: &[f64], gap: &[f64], tau: f64, entry: f64) -> Stepped 
     }
 }
 
+/// The preconditioner of `kernel`'s solve: the reciprocal of its spectrum (real, as the
+/// kernel is even in both axes), floored at a millionth of its peak so that it stays
+/// positive definite. On the padded grid this inverts the kernel's circulant embedding,
+/// a close approximation of the inverse of the operator restricted to the contact
+/// (Vollebregt, J. Optim. Theory Appl. 162, 2014).
+pub fn preconditioner(kernel: &Spectrum) -> Spectrum {
+    let peak = kernel.0.iter().map(|c| c.re).fold(0.0, f64::max);
+    let floor = peak * 1e-6;
+    Spectrum(
+        kernel
+            .0
+            .iter()
+            .map(|c| (1.0 / c.re.max(floor)).into())
+            .collect(),
+    )
+}
+
+/// The diagonal of the circulant operator with half spectrum `spectrum` on the padded
+/// 2nx x 2ny grid: the mean of its full spectrum (columns 1..nx-1 of the half stand for two).
+fn circulant_diagonal(spectrum: &Spectrum, nx: usize, ny: usize) -> f64 {
+    let column = 2 * ny;
+    let sum: f64 = spectrum
+        .0
+        .chunks(column)
+        .enumerate()
+        .map(|(c, col)| {
+            let weight = if c == 0 || c == nx { 1.0 } else { 2.0 };
+            weight * col.iter().map(|v| v.re).sum::<f64>()
+        })
+        .sum();
+    sum / (4 * nx * ny) as f64
+}
+
 /// Solves for the pressure given `separation` = h0 - delta per cell (infinite where the
-/// object is absent), the total compliance kernel, and a starting pressure.
+/// object is absent), the total compliance kernel with its `preconditioner`, and a
+/// starting pressure.
 pub fn solve(
     conv: &mut Convolver,
     kernel: &Spectrum,
+    preconditioner: &Spectrum,
     separation: &[f64],
     approach_mm: f64,
     start: Vec<f64>,
@@ -172,6 +212,18 @@ pub fn solve(
     let mut gap = vec![0.0; n];
     let mut t = vec![0.0; n];
     let mut r = vec![0.0; n];
+    // The preconditioned gap z = P M P gap (P: restriction to the contact), and P gap.
+    let (mut z, mut gap_on_contact) = if settings.preconditioned {
+        (vec![0.0; n], vec![0.0; n])
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let entry_scale = if settings.preconditioned {
+        circulant_diagonal(preconditioner, conv.nx, conv.ny)
+    } else {
+        1.0
+    };
+    let self_compliance = circulant_diagonal(kernel, conv.nx, conv.ny);
     let mut g_old = 1.0;
     let mut conjugate = false;
     let mut iterations = 0;
@@ -182,16 +234,32 @@ pub fn solve(
     conv.convolve(&p, kernel, &mut u);
     while iterations < settings.max_iterations {
         iterations += 1;
-        let g_sum = gaps(&u, &separation, &p, &mut gap);
+        let mut g_sum = gaps(&u, &separation, &p, &mut gap);
+        let descent = if settings.preconditioned {
+            directions(&gap, &p, 0.0, &mut gap_on_contact);
+            conv.convolve(&gap_on_contact, preconditioner, &mut z);
+            // sum of gap z over the contact (z is masked by the contact there).
+            g_sum = step_sums(&gap, &gap_on_contact, &z, &p).1;
+            &z
+        } else {
+            &gap
+        };
         let ratio = if conjugate { g_sum / g_old } else { 0.0 };
-        directions(&gap, &p, ratio, &mut t);
+        directions(descent, &p, ratio, &mut t);
         g_old = g_sum;
         conv.convolve(&t, kernel, &mut r);
         let (num, den) = step_sums(&gap, &t, &r, &p);
         let tau = if den > 0.0 { num / den } else { 0.0 };
-        // Before any cell is in contact there is no step length yet: the overlap itself
+        // A free cell that overlaps enters at its overlap times the step length in pressure
+        // per gap: tau itself for the plain gradient, tau times the preconditioner's own
+        // per-cell weight (its diagonal) for the preconditioned one. Before any cell is in
+        // contact there is no step length yet: a cell's overlap over its own compliance
         // seeds the contact.
-        let entry = if tau > 0.0 { tau } else { 1.0 };
+        let entry = if tau > 0.0 {
+            tau * entry_scale
+        } else {
+            1.0 / self_compliance
+        };
         let stepped = step(&mut p, &t, &gap, tau, entry);
         conjugate = !stepped.entered;
         if stepped.total == 0.0 || stepped.change <= settings.tolerance * stepped.total {
@@ -244,6 +312,16 @@ mod tests {
     /// a 24x24 grid of 0.25 mm cells: the contact set grows, clips and settles, so the
     /// solve takes both the incremental and the fresh displacement updates.
     fn sphere_press(settings: Settings) -> (Vec<f64>, Vec<f64>, Outcome) {
+        sphere_press_with(settings, 1.0, false)
+    }
+
+    /// The same press on a half-space `compliance` times as compliant, started from the
+    /// overlap over the compliance, or from no pressure at all (every cell then enters).
+    fn sphere_press_with(
+        settings: Settings,
+        compliance: f64,
+        from_nothing: bool,
+    ) -> (Vec<f64>, Vec<f64>, Outcome) {
         let (n, cell, radius, approach) = (24usize, 0.25, 5.0, 0.2);
         let centre = (n as f64 - 1.0) / 2.0;
         let separation: Vec<f64> = (0..n * n)
@@ -253,12 +331,30 @@ mod tests {
                 radius - (radius * radius - r2).sqrt() - approach
             })
             .collect();
-        let coefficient =
-            |di: i64, dj: i64| love_normal(di as f64 * cell, dj as f64 * cell, cell / 2.0);
+        let coefficient = |di: i64, dj: i64| {
+            compliance * love_normal(di as f64 * cell, dj as f64 * cell, cell / 2.0)
+        };
         let mut conv = Convolver::new(n, n);
         let kernel = conv.padded_spectrum(&wrapped_kernel(n, n, coefficient));
-        let start = separation.iter().map(|s| (-s).max(0.0)).collect();
-        let outcome = solve(&mut conv, &kernel, &separation, approach, start, settings);
+        let start = separation
+            .iter()
+            .map(|s| {
+                if from_nothing {
+                    0.0
+                } else {
+                    (-s).max(0.0) / compliance
+                }
+            })
+            .collect();
+        let outcome = solve(
+            &mut conv,
+            &kernel,
+            &preconditioner(&kernel),
+            &separation,
+            approach,
+            start,
+            settings,
+        );
         // The displacement by direct summation, independent of the FFT and of the
         // solver's running update.
         let displacement = (0..n * n)
@@ -277,7 +373,15 @@ mod tests {
 
     #[test]
     fn the_solution_meets_the_contact_conditions_by_direct_summation() {
-        let settings = Settings::default();
+        for preconditioned in [true, false] {
+            meets_the_contact_conditions(Settings {
+                preconditioned,
+                ..Settings::default()
+            });
+        }
+    }
+
+    fn meets_the_contact_conditions(settings: Settings) {
         let (separation, displacement, outcome) = sphere_press(settings);
         assert!(outcome.converged, "{} iterations", outcome.iterations);
         let approach = 0.2;
@@ -308,5 +412,52 @@ mod tests {
         let force = |p: &[f64]| p.iter().sum::<f64>();
         let (ft, fl) = (force(&tight.pressure), force(&loose.pressure));
         assert!((fl / ft - 1.0).abs() < 1e-5, "force {fl} vs {ft}");
+    }
+
+    #[test]
+    fn preconditioning_reaches_the_same_contact_in_fewer_steps() {
+        let settings = |preconditioned| Settings {
+            preconditioned,
+            tolerance: 1e-10,
+            ..Settings::default()
+        };
+        let plain = sphere_press(settings(false)).2;
+        let pre = sphere_press(settings(true)).2;
+        assert!(plain.converged && pre.converged);
+        assert!(
+            pre.iterations < plain.iterations,
+            "{} steps preconditioned, {} plain",
+            pre.iterations,
+            plain.iterations
+        );
+        let peak = plain.pressure.iter().cloned().fold(0.0, f64::max);
+        for (a, b) in plain.pressure.iter().zip(&pre.pressure) {
+            assert!((a - b).abs() < 1e-6 * peak, "{a} vs {b}");
+        }
+    }
+
+    /// Displacement control with one compliance: the contact set does not depend on its
+    /// scale and the pressure goes as its inverse. A free cell entering the contact must
+    /// take a pressure in the kernel's units, or a soft contact diverges (as the
+    /// preconditioned solve did when an entry took its overlap times the dimensionless step).
+    #[test]
+    fn the_solve_is_the_same_at_any_compliance_scale() {
+        for preconditioned in [true, false] {
+            let settings = Settings {
+                preconditioned,
+                ..Settings::default()
+            };
+            let unit = sphere_press_with(settings, 1.0, true).2;
+            for compliance in [1e-5, 1e5] {
+                let scaled = sphere_press_with(settings, compliance, true).2;
+                assert!(scaled.converged, "compliance {compliance}");
+                let steps = scaled.iterations.abs_diff(unit.iterations);
+                assert!(steps <= 1, "compliance {compliance}: {steps} steps apart");
+                let peak = unit.pressure.iter().cloned().fold(0.0, f64::max);
+                for (a, b) in unit.pressure.iter().zip(&scaled.pressure) {
+                    assert!((a - b * compliance).abs() < 1e-9 * peak, "{a} vs {b}");
+                }
+            }
+        }
     }
 }
