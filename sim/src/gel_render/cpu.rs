@@ -204,9 +204,14 @@ fn expose(
 fn quantise_row(shaded: &[f32], draws: &[f32], sigma: f32, out: &mut [u8]) {
     for ((o, s), n) in out.iter_mut().zip(shaded).zip(draws) {
         let noisy = s + sigma * n;
-        // floor(x + 1/2) clamped to [0, 255]: on that range the saturating cast's
-        // truncation is the floor, without a libm call per channel.
-        *o = (noisy + 0.5).clamp(0.0, 255.0) as u8;
+        // floor(x + 1/2) clamped to [0, 255] (NaN to 0, as a saturating cast would give).
+        // A float cast to an integer does not vectorise (it saturates lane by lane), so
+        // the whole number is read from the mantissa: adding 2^23 to an integer below 2^23
+        // is exact and leaves it in the low bits.
+        // max/min, not clamp: clamp keeps a NaN, whose bits would then be read.
+        #[allow(clippy::manual_clamp)]
+        let level = (noisy + 0.5).max(0.0).min(255.0).floor();
+        *o = (level + 8_388_608.0).to_bits() as u8;
     }
 }
 
@@ -242,5 +247,42 @@ impl GelRenderer for CpuRenderer {
             .par_iter()
             .map(|f| self.render_one(optics, f))
             .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::quantise_row;
+
+    #[test]
+    fn quantising_rounds_half_up_and_saturates() {
+        let values = [
+            -3.0,
+            0.49,
+            0.5,
+            1.5,
+            2.5,
+            127.49,
+            254.5,
+            300.0,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        let expected = [0u8, 0, 1, 2, 3, 127, 255, 255, 0, 255, 0];
+        // Row lengths past the vector width, with no noise and with noise that cancels.
+        let row: Vec<f32> = values
+            .iter()
+            .cycle()
+            .take(3 * values.len())
+            .copied()
+            .collect();
+        let mut out = vec![0u8; row.len()];
+        quantise_row(&row, &vec![0.0; row.len()], 0.0, &mut out);
+        let want: Vec<u8> = expected.iter().cycle().take(row.len()).copied().collect();
+        assert_eq!(out, want);
+        let shifted: Vec<f32> = row.iter().map(|v| v - 2.0).collect();
+        quantise_row(&shifted, &vec![1.0; row.len()], 2.0, &mut out);
+        assert_eq!(out, want);
     }
 }
