@@ -238,7 +238,8 @@ pub fn solve(
         let descent = if settings.preconditioned {
             directions(&gap, &p, 0.0, &mut gap_on_contact);
             conv.convolve(&gap_on_contact, preconditioner, &mut z);
-            // sum of gap z over the contact (z is masked by the contact there).
+            // The sum of gap z over the contact: the second of step_sums' sums, with the
+            // masked gap in the place of the direction and z in that of K t.
             g_sum = step_sums(&gap, &gap_on_contact, &z, &p).1;
             &z
         } else {
