@@ -636,13 +636,15 @@ impl ContactSolver {
                 0.0
             }
         });
-        // Warm start: the previous frame of a press grown the way a Hertz contact grows.
-        let start: Vec<f64> = match warm {
-            Some(w) if w.grid == grid && w.approach_mm > 0.0 => {
-                warm_start::hertz_grown(&grid, &w.pressure_mpa, problem.approach_mm / w.approach_mm)
-            }
-            _ => cold.collect(),
-        };
+        // Warm start: the previous frame of a press grown the way a Hertz contact grows;
+        // the cold guess when it had no contact to grow.
+        let grown = warm
+            .filter(|w| w.grid == grid && w.approach_mm > 0.0)
+            .and_then(|w| {
+                let ratio = problem.approach_mm / w.approach_mm;
+                warm_start::hertz_grown(&grid, &w.pressure_mpa, ratio)
+            });
+        let start: Vec<f64> = grown.unwrap_or_else(|| cold.collect());
         let (conv, weighted) = k.weighted(gel_c, object_c);
         let outcome = polonsky_keer::solve(
             conv,

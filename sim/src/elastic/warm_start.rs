@@ -7,12 +7,13 @@ use super::grid::Grid;
 
 /// `previous` on `grid` grown by the approach ratio `ratio` (new over old): resampled
 /// bilinearly at positions pulled towards the pressure's centroid by sqrt(ratio) and
-/// multiplied by sqrt(ratio), so the total force goes as ratio^1.5.
-pub(crate) fn hertz_grown(grid: &Grid, previous: &[f64], ratio: f64) -> Vec<f64> {
+/// multiplied by sqrt(ratio), so the total force goes as ratio^1.5. None when there is
+/// nothing to grow (no pressure, or no meaningful ratio).
+pub(crate) fn hertz_grown(grid: &Grid, previous: &[f64], ratio: f64) -> Option<Vec<f64>> {
     let (nx, ny) = (grid.nx, grid.ny);
     let total: f64 = previous.iter().sum();
     if total <= 0.0 || !ratio.is_finite() || ratio <= 0.0 {
-        return previous.to_vec();
+        return None;
     }
     let (mut cx, mut cy) = (0.0, 0.0);
     for (q, p) in previous.iter().enumerate() {
@@ -28,7 +29,7 @@ pub(crate) fn hertz_grown(grid: &Grid, previous: &[f64], ratio: f64) -> Vec<f64>
             previous[j as usize * nx + i as usize]
         }
     };
-    (0..nx * ny)
+    let grown = (0..nx * ny)
         .map(|q| {
             let x = cx + ((q % nx) as f64 - cx) / stretch;
             let y = cy + ((q / nx) as f64 - cy) / stretch;
@@ -39,7 +40,8 @@ pub(crate) fn hertz_grown(grid: &Grid, previous: &[f64], ratio: f64) -> Vec<f64>
                 + (at(i, j + 1) * (1.0 - fx) + at(i + 1, j + 1) * fx) * fy;
             p * stretch
         })
-        .collect()
+        .collect();
+    Some(grown)
 }
 
 #[cfg(test)]
@@ -72,7 +74,7 @@ mod tests {
         // Hertz: a and p0 both grow as the square root of the approach.
         let (a1, p1) = (9.0, 0.2);
         let ratio = 2.25;
-        let grown = hertz_grown(&grid, &hertz(&grid, centre, a1, p1), ratio);
+        let grown = hertz_grown(&grid, &hertz(&grid, centre, a1, p1), ratio).unwrap();
         let expected = hertz(&grid, centre, a1 * 1.5, p1 * 1.5);
         let force = |p: &[f64]| p.iter().sum::<f64>();
         // The centroid of a sampled disc is off its centre by a fraction of a cell, and
@@ -96,13 +98,14 @@ mod tests {
     }
 
     #[test]
-    fn no_previous_pressure_gives_the_previous_field_back() {
+    fn no_previous_pressure_gives_nothing_to_grow() {
         let grid = Grid {
             origin_mm: DVec2::ZERO,
             cell_mm: 1.0,
             nx: 4,
             ny: 3,
         };
-        assert_eq!(hertz_grown(&grid, &[0.0; 12], 2.0), vec![0.0; 12]);
+        assert_eq!(hertz_grown(&grid, &[0.0; 12], 2.0), None);
+        assert_eq!(hertz_grown(&grid, &[1.0; 12], f64::NAN), None);
     }
 }
