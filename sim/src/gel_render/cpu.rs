@@ -1,6 +1,6 @@
 //! The reference renderer: the four shader stages in plain Rust, f32, the same operations in
-//! the same order, rows in parallel (pixels are independent, so the bytes do not depend on
-//! the thread count).
+//! the same order for each pixel. A frame goes through all four stages row by row, rows in
+//! parallel (pixels are independent, so the bytes do not depend on the thread count).
 
 use super::noise::gaussian3_row;
 use super::{GelRenderer, PressFrame, RenderError, RenderParams, SensorOptics, Shading};
@@ -12,18 +12,24 @@ pub struct CpuRenderer;
 
 /// Stage 1: slopes by central differences, one-sided at the edge (gel_slopes.wgsl).
 fn slopes(p: &RenderParams, heights: &[f32]) -> Vec<[f32; 2]> {
-    let (w, h) = (p.width as usize, p.height as usize);
-    let mut out = vec![[0.0f32; 2]; w * h];
-    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
-        let rows = [
-            &heights[y0 * w..][..w],
-            &heights[y * w..][..w],
-            &heights[y1 * w..][..w],
-        ];
-        slopes_row(rows, p.mm_per_px, ((y1 - y0) as f32) * p.mm_per_px, row);
-    });
+    let w = p.width as usize;
+    let mut out = vec![[0.0f32; 2]; w * p.height as usize];
+    out.par_chunks_mut(w)
+        .enumerate()
+        .for_each(|(y, row)| slopes_at(p, heights, y, row));
     out
+}
+
+/// Row `y` of the slopes.
+fn slopes_at(p: &RenderParams, heights: &[f32], y: usize, out: &mut [[f32; 2]]) {
+    let (w, h) = (p.width as usize, p.height as usize);
+    let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
+    let rows = [
+        &heights[y0 * w..][..w],
+        &heights[y * w..][..w],
+        &heights[y1 * w..][..w],
+    ];
+    slopes_row(rows, p.mm_per_px, ((y1 - y0) as f32) * p.mm_per_px, out);
 }
 
 /// One row of slopes from the rows above, at and below it (`dy_mm` apart); the edge
@@ -93,31 +99,54 @@ fn shade_row_lit(
 
 /// Stage 2: shading and vignetting (gel_shading.wgsl).
 fn shade(p: &RenderParams, optics: &SensorOptics, slopes: &[[f32; 2]]) -> Vec<[f32; 3]> {
-    let (w, h) = (p.width as usize, p.height as usize);
-    let mut out = vec![[0.0f32; 3]; w * h];
-    let lit = Lit::new(p);
-    let us: Vec<f32> = (0..w).map(|x| (x as f32 + 0.5) / w as f32 - 0.5).collect();
+    let w = p.width as usize;
+    let mut out = vec![[0.0f32; 3]; w * p.height as usize];
+    let frame = ShadedFrame::new(p, optics);
     out.par_chunks_mut(w).enumerate().for_each_init(
         || vec![0.0f32; w],
-        |fade, (y, row)| {
-            let v = (y as f32 + 0.5) / h as f32 - 0.5;
-            for (f, u) in fade.iter_mut().zip(&us) {
-                *f = 1.0 - p.vignette * (u * u + v * v);
-            }
-            let span = y * w..(y + 1) * w;
-            let (g, bg) = (&slopes[span.clone()], &optics.background[span]);
-            match &optics.shading {
-                Shading::Lights(_) => shade_row_lit(&lit, g, bg, fade, row),
-                Shading::Table(table) => {
-                    for x in 0..w {
-                        let d = table.change(g[x][0], g[x][1], 2.0 * us[x], 2.0 * v);
-                        row[x] = std::array::from_fn(|c| (bg[x][c] + d[c]) * fade[x]);
-                    }
-                }
-            }
-        },
+        |fade, (y, row)| frame.shade_row(y, &slopes[y * w..][..w], fade, row),
     );
     out
+}
+
+/// What shading needs of a frame beyond its slopes.
+struct ShadedFrame<'a> {
+    p: &'a RenderParams,
+    optics: &'a SensorOptics,
+    lit: Lit,
+    /// Pixel-centre x in [-1/2, 1/2] across the frame, for vignetting and the table.
+    us: Vec<f32>,
+}
+
+impl<'a> ShadedFrame<'a> {
+    fn new(p: &'a RenderParams, optics: &'a SensorOptics) -> Self {
+        let w = p.width as usize;
+        Self {
+            p,
+            optics,
+            lit: Lit::new(p),
+            us: (0..w).map(|x| (x as f32 + 0.5) / w as f32 - 0.5).collect(),
+        }
+    }
+
+    /// Row `y` of the shading from that row's slopes; `fade` is scratch of the row's width.
+    fn shade_row(&self, y: usize, g: &[[f32; 2]], fade: &mut [f32], row: &mut [[f32; 3]]) {
+        let (w, h) = (self.p.width as usize, self.p.height as usize);
+        let v = (y as f32 + 0.5) / h as f32 - 0.5;
+        for (f, u) in fade.iter_mut().zip(&self.us) {
+            *f = 1.0 - self.p.vignette * (u * u + v * v);
+        }
+        let bg = &self.optics.background[y * w..][..w];
+        match &self.optics.shading {
+            Shading::Lights(_) => shade_row_lit(&self.lit, g, bg, fade, row),
+            Shading::Table(table) => {
+                for x in 0..w {
+                    let d = table.change(g[x][0], g[x][1], 2.0 * self.us[x], 2.0 * v);
+                    row[x] = std::array::from_fn(|c| (bg[x][c] + d[c]) * fade[x]);
+                }
+            }
+        }
+    }
 }
 
 /// Stage 3: marker centres moved by the lateral field (marker_displacement.wgsl).
@@ -150,52 +179,68 @@ fn marker_centres(
         .collect()
 }
 
-/// Stage 4: marker dots, noise, quantisation (sensor_exposure.wgsl). Each dot only visits
-/// the pixels it can reach; a pixel still takes its dots' factors in marker order.
-fn expose(
-    p: &RenderParams,
-    mut shaded: Vec<[f32; 3]>,
-    centres: &[[f32; 2]],
-    seed: u32,
-) -> RgbImage {
-    let (w, h) = (p.width as usize, p.height as usize);
+/// The pixel box a dot can darken: columns `x0..x1`, rows `y0..y1`.
+struct DotReach {
+    centre: [f32; 2],
+    x0: usize,
+    x1: usize,
+    y0: usize,
+    y1: usize,
+}
+
+/// Each dot's box, in marker order; dots wholly off the frame are dropped.
+fn dot_reaches(p: &RenderParams, centres: &[[f32; 2]]) -> Vec<DotReach> {
+    let (w, h) = (p.width as f32, p.height as f32);
     let reach = p.marker_radius_px + 0.5;
-    for c in centres {
-        let (x0, x1) = (
-            (c[0] - reach).floor().max(0.0),
-            (c[0] + reach).ceil().min(w as f32),
-        );
-        let (y0, y1) = (
-            (c[1] - reach).floor().max(0.0),
-            (c[1] + reach).ceil().min(h as f32),
-        );
-        if !(x0 < x1 && y0 < y1) {
-            continue;
-        }
-        for y in y0 as usize..y1 as usize {
-            for x in x0 as usize..x1 as usize {
-                let (dx, dy) = (x as f32 + 0.5 - c[0], y as f32 + 0.5 - c[1]);
-                let d = (dx * dx + dy * dy).sqrt();
-                if d < reach {
-                    let f = 1.0 - p.marker_darkness * (reach - d).min(1.0);
-                    shaded[y * w + x] = shaded[y * w + x].map(|v| v * f);
-                }
+    centres
+        .iter()
+        .filter_map(|&c| {
+            let (x0, x1) = ((c[0] - reach).floor().max(0.0), (c[0] + reach).ceil().min(w));
+            let (y0, y1) = ((c[1] - reach).floor().max(0.0), (c[1] + reach).ceil().min(h));
+            (x0 < x1 && y0 < y1).then_some(DotReach {
+                centre: c,
+                x0: x0 as usize,
+                x1: x1 as usize,
+                y0: y0 as usize,
+                y1: y1 as usize,
+            })
+        })
+        .collect()
+}
+
+/// Stage 4 on one row: marker dots, noise, quantisation (sensor_exposure.wgsl). A pixel
+/// takes its dots' factors in marker order.
+fn expose_row(
+    p: &RenderParams,
+    dots: &[DotReach],
+    seed: u32,
+    y: usize,
+    shaded: &mut [[f32; 3]],
+    noise: &mut [[f32; 3]],
+    out: &mut [u8],
+) {
+    let w = p.width as usize;
+    let reach = p.marker_radius_px + 0.5;
+    for dot in dots.iter().filter(|d| (d.y0..d.y1).contains(&y)) {
+        for (x, px) in shaded.iter_mut().enumerate().take(dot.x1).skip(dot.x0) {
+            let (dx, dy) = (x as f32 + 0.5 - dot.centre[0], y as f32 + 0.5 - dot.centre[1]);
+            let d = (dx * dx + dy * dy).sqrt();
+            if d < reach {
+                let f = 1.0 - p.marker_darkness * (reach - d).min(1.0);
+                *px = px.map(|v| v * f);
             }
         }
     }
-    let mut bytes = vec![0u8; w * h * 3];
-    bytes.par_chunks_mut(3 * w).enumerate().for_each_init(
-        || vec![[0.0f32; 3]; w],
-        |noise, (y, row)| {
-            // No noise asked for: the draws would be multiplied by zero anyway.
-            if p.noise_sigma != 0.0 {
-                gaussian3_row(seed, (y * w) as u32, noise);
-            }
-            let shaded_row = shaded[y * w..(y + 1) * w].as_flattened();
-            quantise_row(shaded_row, noise.as_flattened(), p.noise_sigma, row);
-        },
+    // No noise asked for: the draws would be multiplied by zero anyway.
+    if p.noise_sigma != 0.0 {
+        gaussian3_row(seed, (y * w) as u32, noise);
+    }
+    quantise_row(
+        shaded.as_flattened(),
+        noise.as_flattened(),
+        p.noise_sigma,
+        out,
     );
-    RgbImage::from_raw(p.width, p.height, bytes).expect("sized from the frame")
 }
 
 /// One row of channel values plus sigma times their draws, to bytes. Over the flat channel
@@ -215,14 +260,45 @@ fn quantise_row(shaded: &[f32], draws: &[f32], sigma: f32, out: &mut [u8]) {
     }
 }
 
+/// One worker's row buffers, reused from row to row.
+struct RowScratch {
+    slopes: Vec<[f32; 2]>,
+    fade: Vec<f32>,
+    shaded: Vec<[f32; 3]>,
+    noise: Vec<[f32; 3]>,
+}
+
+impl RowScratch {
+    fn new(w: usize) -> Self {
+        Self {
+            slopes: vec![[0.0; 2]; w],
+            fade: vec![0.0; w],
+            shaded: vec![[0.0; 3]; w],
+            noise: vec![[0.0; 3]; w],
+        }
+    }
+}
+
 impl CpuRenderer {
+    /// The four stages row by row: a row goes from heights to bytes while it is in cache,
+    /// and no frame-sized intermediate is written.
     pub fn render_one(&self, optics: &SensorOptics, frame: &PressFrame) -> RgbImage {
         let p = RenderParams::new(optics, 1);
         let f = frame.fields;
-        let g = slopes(&p, &f.normal_mm);
-        let shaded = shade(&p, optics, &g);
+        let w = p.width as usize;
+        let shading = ShadedFrame::new(&p, optics);
         let centres = marker_centres(&p, optics, &f.lateral_x_mm, &f.lateral_y_mm);
-        expose(&p, shaded, &centres, frame.seed)
+        let dots = dot_reaches(&p, &centres);
+        let mut bytes = vec![0u8; w * p.height as usize * 3];
+        bytes.par_chunks_mut(3 * w).enumerate().for_each_init(
+            || RowScratch::new(w),
+            |s, (y, row)| {
+                slopes_at(&p, &f.normal_mm, y, &mut s.slopes);
+                shading.shade_row(y, &s.slopes, &mut s.fade, &mut s.shaded);
+                expose_row(&p, &dots, frame.seed, y, &mut s.shaded, &mut s.noise, row);
+            },
+        );
+        RgbImage::from_raw(p.width, p.height, bytes).expect("sized from the frame")
     }
 
     /// The shading stage alone (slopes + shading + vignetting), for timing it on its own.
