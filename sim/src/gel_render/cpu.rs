@@ -195,8 +195,14 @@ fn dot_reaches(p: &RenderParams, centres: &[[f32; 2]]) -> Vec<DotReach> {
     centres
         .iter()
         .filter_map(|&c| {
-            let (x0, x1) = ((c[0] - reach).floor().max(0.0), (c[0] + reach).ceil().min(w));
-            let (y0, y1) = ((c[1] - reach).floor().max(0.0), (c[1] + reach).ceil().min(h));
+            let (x0, x1) = (
+                (c[0] - reach).floor().max(0.0),
+                (c[0] + reach).ceil().min(w),
+            );
+            let (y0, y1) = (
+                (c[1] - reach).floor().max(0.0),
+                (c[1] + reach).ceil().min(h),
+            );
             (x0 < x1 && y0 < y1).then_some(DotReach {
                 centre: c,
                 x0: x0 as usize,
@@ -223,7 +229,10 @@ fn expose_row(
     let reach = p.marker_radius_px + 0.5;
     for dot in dots.iter().filter(|d| (d.y0..d.y1).contains(&y)) {
         for (x, px) in shaded.iter_mut().enumerate().take(dot.x1).skip(dot.x0) {
-            let (dx, dy) = (x as f32 + 0.5 - dot.centre[0], y as f32 + 0.5 - dot.centre[1]);
+            let (dx, dy) = (
+                x as f32 + 0.5 - dot.centre[0],
+                y as f32 + 0.5 - dot.centre[1],
+            );
             let d = (dx * dx + dy * dy).sqrt();
             if d < reach {
                 let f = 1.0 - p.marker_darkness * (reach - d).min(1.0);
