@@ -2,6 +2,7 @@
 //! pipeline), and the same wiring for evaluations that ask many questions.
 
 use crate::detector_choice::{DetectorChoice, GroundTruth};
+use crate::estimator_choice::EstimatorChoice;
 use crate::llm_explainer::{ExplainerChoice, explainer};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -9,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::{Arm, RgbdCamera, TactileSensor};
-use tactex_core::estimate::HertzSlopeEstimator;
+use tactex_core::estimate::HardnessEstimator;
 use tactex_core::explain::Explainer;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::perception::detect::Detector;
@@ -20,6 +21,7 @@ use tactex_hw::devices_toml::DevicesConfig;
 use tactex_hw::session::{SessionRecorder, TwinRecord, open_session};
 use tactex_sim::SimDevices;
 use tactex_sim::camera::InstanceImage;
+use tactex_sim::elastic::Fidelity;
 use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_render::{SceneRenderer, open_scene_renderer};
 
@@ -92,7 +94,19 @@ pub struct TwinOptions {
     /// TOML with base_url, model, api_key_env and timeout_s for --explainer llm.
     #[arg(long)]
     pub llm_config: Option<PathBuf>,
+    /// Contact physics of the sim GelSight: rigid, hertz, halfspace or layer (the bonded
+    /// 4 mm gel, the most faithful; see `tactex bench contact` for what each costs).
+    #[arg(long, default_value = "layer")]
+    pub fidelity: Fidelity,
+    /// Hardness estimator that reads the presses: learned (the built-in model),
+    /// indentation, hertz or FILE.onnx (a model with its card FILE.json beside it).
+    #[arg(long, default_value = DEFAULT_ESTIMATOR)]
+    pub estimator: EstimatorChoice,
 }
+
+/// The estimator `ask`, `serve`, `compare --session` and `eval scenarios` use unless told:
+/// chosen by the per-kind evaluation on the twin's scene fruit (README, "Hardness").
+pub const DEFAULT_ESTIMATOR: &str = "learned";
 
 /// What `TwinOptions` name, opened once: a YOLO model is loaded, a GPU adapter found, an
 /// LLM endpoint's settings read.
@@ -100,6 +114,8 @@ pub struct OpenedTwin {
     pub detector: DetectorChoice,
     pub renderer: Arc<dyn SceneRenderer>,
     pub explainer: Box<dyn Explainer>,
+    pub estimator: Box<dyn HardnessEstimator + Send + Sync>,
+    pub fidelity: Fidelity,
 }
 
 impl TwinOptions {
@@ -108,6 +124,8 @@ impl TwinOptions {
             detector: DetectorChoice::parse(&self.detector)?,
             renderer: scene_renderer(self.device)?,
             explainer: explainer(self.explainer, self.llm_config.as_ref())?,
+            estimator: self.estimator.open("--estimator")?,
+            fidelity: self.fidelity,
         })
     }
 }
@@ -143,6 +161,9 @@ pub struct Twin<'a> {
     pub detector: &'a DetectorChoice,
     pub renderer: &'a Arc<dyn SceneRenderer>,
     pub explainer: &'a dyn Explainer,
+    pub estimator: &'a dyn HardnessEstimator,
+    /// Contact physics of the sim GelSight.
+    pub fidelity: Fidelity,
 }
 
 /// The sim devices of one question and what an evaluation needs from the twin beside them.
@@ -155,7 +176,8 @@ struct Prepared<'d> {
 
 impl<'a> Twin<'a> {
     fn prepare(&self, catalog: &'a FruitCatalog) -> Result<Prepared<'a>> {
-        let mut sim = SimDevices::with_sensor(self.scene, self.seed, self.sensor.clone())?;
+        let mut sim =
+            SimDevices::with_sensor(self.scene, self.seed, self.sensor.clone(), self.fidelity)?;
         sim.camera.set_renderer(self.renderer.clone());
         let instances = sim.camera.clean()?.instances.clone();
         let labels: Vec<String> = self.scene.objects.iter().map(|o| o.label.clone()).collect();
@@ -193,7 +215,7 @@ impl<'a> Twin<'a> {
             instances,
             true_centres_m,
         } = self.prepare(&catalog)?;
-        let answer = answer_with(
+        let mut answer = pipeline::answer_with_progress(
             prompt,
             &catalog,
             Devices {
@@ -202,10 +224,12 @@ impl<'a> Twin<'a> {
                 arm: &mut sim.arm,
             },
             detector.as_ref(),
+            self.estimator,
             self.explainer,
             config,
             on_progress,
         )?;
+        answer.fidelity = Some(self.fidelity.name().into());
         Ok(TwinAnswer {
             answer,
             true_centres_m,
@@ -234,8 +258,10 @@ impl<'a> Twin<'a> {
             prompt,
             catalog: &catalog,
             detector: prepared.detector.as_ref(),
+            estimator: self.estimator,
             explainer: self.explainer,
             config,
+            fidelity: Some(self.fidelity),
         };
         let scene_toml = std::fs::read_to_string(&self.scene.path).with_context(|| {
             format!("{}: cannot read the scene again", self.scene.path.display())
@@ -250,6 +276,7 @@ impl<'a> Twin<'a> {
                     scene_toml,
                     scene_path: scene_path.display().to_string(),
                     seed: self.seed,
+                    fidelity: Some(self.fidelity.name().into()),
                 }),
             }),
         )
@@ -269,8 +296,11 @@ pub struct Question<'q> {
     pub prompt: &'q str,
     pub catalog: &'q FruitCatalog,
     pub detector: &'q dyn Detector,
+    pub estimator: &'q dyn HardnessEstimator,
     pub explainer: &'q dyn Explainer,
     pub config: &'q PipelineConfig,
+    /// The sim GelSight's contact physics, when the devices are the twin's.
+    pub fidelity: Option<Fidelity>,
 }
 
 impl Question<'_> {
@@ -282,91 +312,75 @@ impl Question<'_> {
         record: Option<Recording<'_>>,
     ) -> Result<Answer> {
         let Some(Recording { dir, backend, twin }) = record else {
-            return answer_with(
-                self.prompt,
-                self.catalog,
-                devices,
-                self.detector,
-                self.explainer,
-                self.config,
-                &|_| {},
-            );
+            return self.answer(devices);
         };
         let recorder = SessionRecorder::create(dir).context("--record")?;
         if let Some(twin) = twin {
             recorder.twin(twin);
         }
-        let answer = answer_with(
-            self.prompt,
-            self.catalog,
-            Devices {
-                camera: &mut recorder.camera(devices.camera),
-                tactile: &mut recorder.tactile(devices.tactile),
-                arm: &mut recorder.arm(devices.arm)?,
-            },
-            self.detector,
-            self.explainer,
-            self.config,
-            &|_| {},
-        )?;
+        let answer = self.answer(Devices {
+            camera: &mut recorder.camera(devices.camera),
+            tactile: &mut recorder.tactile(devices.tactile),
+            arm: &mut recorder.arm(devices.arm)?,
+        })?;
         let json = serde_json::to_value(&answer).context("serialising the answer")?;
         recorder
             .finish(backend, self.prompt, Some(json))
             .context("--record")?;
         Ok(answer)
     }
-}
 
-/// One question through the pipeline on any devices, with the Hertz slope estimator.
-#[allow(clippy::too_many_arguments)]
-fn answer_with<C: RgbdCamera, T: TactileSensor, A: Arm>(
-    prompt: &str,
-    catalog: &FruitCatalog,
-    devices: Devices<'_, C, T, A>,
-    detector: &dyn Detector,
-    explainer: &dyn Explainer,
-    config: &PipelineConfig,
-    on_progress: &dyn Fn(Progress),
-) -> Result<Answer> {
-    Ok(pipeline::answer_with_progress(
-        prompt,
-        catalog,
-        devices,
-        detector,
-        &HertzSlopeEstimator::default(),
-        explainer,
-        config,
-        on_progress,
-    )?)
+    /// The pipeline on `devices`, the answer naming the twin's fidelity when there is one.
+    fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
+        &self,
+        devices: Devices<'_, C, T, A>,
+    ) -> Result<Answer> {
+        let mut answer = pipeline::answer(
+            self.prompt,
+            self.catalog,
+            devices,
+            self.detector,
+            self.estimator,
+            self.explainer,
+            self.config,
+        )?;
+        answer.fidelity = self.fidelity.map(|f| f.name().into());
+        Ok(answer)
+    }
 }
 
 /// Answers `prompt` from the recorded session in `dir`: its frames in the order they were
 /// taken, its moves checked against the pipeline's.
 pub fn answer_on_replay(
     dir: &Path,
-    choice: &DetectorChoice,
-    explainer: &dyn Explainer,
+    opened: &OpenedTwin,
     prompt: &str,
     config: &PipelineConfig,
 ) -> Result<Answer> {
+    let (choice, explainer) = (&opened.detector, opened.explainer.as_ref());
     let catalog = FruitCatalog::builtin();
-    let (_, mut camera, mut tactile, mut arm) = open_session(dir).context("--session")?;
+    let (manifest, mut camera, mut tactile, mut arm) = open_session(dir).context("--session")?;
     let detector = detector_without_truth(choice, &catalog)?;
     let question = Question {
         prompt,
         catalog: &catalog,
         detector: detector.as_ref(),
+        estimator: opened.estimator.as_ref(),
         explainer,
         config,
+        fidelity: None,
     };
-    question.ask(
+    let mut answer = question.ask(
         Devices {
             camera: &mut camera,
             tactile: &mut tactile,
             arm: &mut arm,
         },
         None,
-    )
+    )?;
+    // A session recorded on the twin replays the twin's frames: it says at which fidelity.
+    answer.fidelity = manifest.twin.and_then(|t| t.fidelity);
+    Ok(answer)
 }
 
 /// The detector for devices that know no ground truth (real ones, or a replay of them).
@@ -391,6 +405,7 @@ fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> R
     let choice = DetectorChoice::parse(&args.twin.detector)?;
     let detector = detector_without_truth(&choice, &catalog)?;
     let explainer = explainer(args.twin.explainer, args.twin.llm_config.as_ref())?;
+    let estimator = args.twin.estimator.open("--estimator")?;
     // The sensors first, so that a missing camera never leaves the arm enabled.
     let mut camera = devices.open_camera()?;
     let mut tactile = devices.open_tactile()?;
@@ -399,8 +414,10 @@ fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> R
         prompt: &args.prompt,
         catalog: &catalog,
         detector: detector.as_ref(),
+        estimator: estimator.as_ref(),
         explainer: explainer.as_ref(),
         config,
+        fidelity: None,
     };
     question.ask(
         Devices {
@@ -456,13 +473,7 @@ pub fn run(args: &AskArgs) -> Result<()> {
                 bail!("--record: a replay is already a recording; record from --backend sim");
             }
             let opened = args.twin.open()?;
-            answer_on_replay(
-                dir,
-                &opened.detector,
-                opened.explainer.as_ref(),
-                &args.prompt,
-                &config,
-            )?
+            answer_on_replay(dir, &opened, &args.prompt, &config)?
         }
         Backend::Sim => {
             if args.session.is_some() {
@@ -478,6 +489,8 @@ pub fn run(args: &AskArgs) -> Result<()> {
                 detector: &opened.detector,
                 renderer: &opened.renderer,
                 explainer: opened.explainer.as_ref(),
+                estimator: opened.estimator.as_ref(),
+                fidelity: opened.fidelity,
             };
             match &args.record {
                 Some(dir) => twin.answer_recorded(&args.prompt, &config, dir)?,
@@ -536,6 +549,9 @@ fn print_answer(a: &Answer) {
             format!("({:+.3}, {:+.3}, {:.3})", p[0], p[1], p[2]),
             o.ripeness.as_deref().unwrap_or("-")
         );
+        if let Some(why) = &o.not_measured {
+            println!("    not measured: {why}");
+        }
         for w in &o.warnings {
             println!("    warning: {w}");
         }

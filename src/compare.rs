@@ -54,6 +54,10 @@ pub struct CompareArgs {
     #[arg(long, conflicts_with_all = ["calib", "images", "annotations"])]
     pub gel_modulus_mpa: Option<f64>,
     /// Which presses to score: eval (every third, held out of calibration), calib, or all.
+    /// With --session: the hardness estimator that reads both presses (learned,
+    /// indentation, hertz or FILE.onnx).
+    #[arg(long, conflicts_with_all = ["calib", "images", "annotations"], default_value = crate::ask::DEFAULT_ESTIMATOR)]
+    pub estimator: crate::estimator_choice::EstimatorChoice,
     #[arg(long, value_enum, default_value_t = Split::Eval)]
     pub split: Split,
     /// Contact model that rebuilds each press.
@@ -255,6 +259,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             scene: args.scene.as_deref(),
             seed: args.seed,
             gel_modulus_mpa: args.gel_modulus_mpa,
+            fidelity: args.fidelity,
+            estimator: &args.estimator,
             out: args.out.as_deref(),
             json: args.json,
         });

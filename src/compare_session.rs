@@ -9,6 +9,7 @@
 
 use crate::ask::sim_sensor;
 use crate::compare::side_by_side;
+use crate::estimator_choice::EstimatorChoice;
 use crate::output::{write_json_atomic, write_png_atomic};
 use crate::plot::{self, BarSeries};
 use anyhow::{Context, Result, bail};
@@ -18,18 +19,20 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::TactileSensor;
-use tactex_core::estimate::{HardnessEstimator, HertzSlopeEstimator, PressSequence};
+use tactex_core::estimate::{HardnessEstimator, PressSequence};
 use tactex_core::frames::TactileFrame;
 use tactex_core::hardness::HardnessReport;
+use tactex_core::perception::contact::ContactEvidence;
 use tactex_core::perception::markers::{detect_markers, track};
 use tactex_core::perception::ssim::ssim_rgb;
-use tactex_core::pipeline::{PipelineConfig, contact_test};
+use tactex_core::press::{Look, PressError, PressOutcome, PressProbe, PressProtocol, run_press};
 use tactex_core::scene::Scene;
 use tactex_core::tactile_spec::TactileSpec;
 use tactex_hw::session::presses::press_runs;
 use tactex_hw::session::{Manifest, open_session};
 use tactex_sim::SimDevices;
-use tactex_sim::contact::gel_contact;
+use tactex_sim::elastic::Fidelity;
+use tactex_sim::pad_contact::{deepest_touch, pad_of};
 
 /// What `compare --session` needs beside the session directory.
 pub struct SessionCompare<'a> {
@@ -38,6 +41,9 @@ pub struct SessionCompare<'a> {
     pub scene: Option<&'a Path>,
     pub seed: Option<u64>,
     pub gel_modulus_mpa: Option<f64>,
+    /// The twin's contact physics for the rebuild.
+    pub fidelity: Fidelity,
+    pub estimator: &'a EstimatorChoice,
     pub out: Option<&'a Path>,
     pub json: bool,
 }
@@ -76,9 +82,10 @@ pub struct PressReport {
     pub position_m: [f64; 3],
     /// Frames taken at this spot, search included.
     pub frames_at_spot: usize,
-    /// Index within those of the first frame the contact test calls contact, in the
-    /// recorded frames (None: the press never touched).
+    /// Index within those of the first frame the contact criterion calls contact, in the
+    /// recorded frames (None: the press never touched), and its evidence.
     pub contact_frame: Option<usize>,
+    pub contact: Option<ContactEvidence>,
     /// The no-contact frame, then the press frames from first contact on.
     pub frames: Vec<FrameComparison>,
     pub mean_ssim: f64,
@@ -98,6 +105,7 @@ pub struct SessionComparison {
     /// The gel the recording's sensor describes, and the one the twin rebuilt with.
     pub recorded_gel_modulus_mpa: f64,
     pub twin_gel_modulus_mpa: f64,
+    pub fidelity: String,
     pub estimator: String,
     pub presses: Vec<PressReport>,
     /// Over the press frames of every press (no-contact frames left out).
@@ -189,6 +197,40 @@ fn pair_markers(
         .collect()
 }
 
+/// A recorded descent read back by the press protocol: the spot's first two frames are its
+/// no-contact frames, frame 1 + k the pad lowered k steps.
+struct RecordedDescent<'a> {
+    run: &'a [usize],
+    recorded: &'a [TactileFrame],
+}
+
+/// The recording holds fewer frames at the spot than the protocol asks for.
+struct RecordingEnds;
+
+impl RecordedDescent<'_> {
+    fn at(&self, k: usize) -> Result<usize, RecordingEnds> {
+        self.run.get(k).copied().ok_or(RecordingEnds)
+    }
+}
+
+impl PressProbe for RecordedDescent<'_> {
+    type Frame = usize;
+    type Error = RecordingEnds;
+
+    fn look(&mut self, at: Look) -> Result<(RgbImage, usize), RecordingEnds> {
+        let i = self.at(match at {
+            Look::Reference => 0,
+            Look::NoiseFloor => 1,
+            Look::Search(k) => 1 + k,
+        })?;
+        Ok((self.recorded[i].image.clone(), i))
+    }
+
+    fn record(&mut self, k: usize) -> Result<usize, RecordingEnds> {
+        self.at(1 + k)
+    }
+}
+
 /// The session's tactile frames beside their rebuilds, and the SSIM of each pair.
 #[derive(Clone, Copy)]
 struct FramePairs<'a> {
@@ -206,6 +248,7 @@ fn compare_press(
     spec: &TactileSpec,
     sim: &SimDevices,
     scene: &Scene,
+    estimator: &dyn HardnessEstimator,
 ) -> PressReport {
     let FramePairs {
         manifest,
@@ -213,8 +256,6 @@ fn compare_press(
         rebuilt,
         ssim: frame_ssim,
     } = *pairs;
-    let config = PipelineConfig::default();
-    let estimator = HertzSlopeEstimator::default();
     let pitch_px = spec.markers.pitch_mm / spec.mm_per_px;
     let mut warnings = Vec::new();
     let reference = run[0];
@@ -222,15 +263,24 @@ fn compare_press(
     let rec_markers = detect_markers(&rec_ref.image);
     let sim_markers = detect_markers(&sim_ref.image);
     let marker_pairs = pair_markers(&rec_markers, &sim_markers, pitch_px);
-    let contact = run[1..]
-        .iter()
-        .position(|&i| contact_test(rec_ref, &rec_markers, &recorded[i], pitch_px, &config).contact)
-        .map(|k| k + 1);
-    let press_frames: Vec<usize> = match contact {
-        Some(c) => run[c..].iter().take(config.press_frames).copied().collect(),
-        None => {
-            warnings.push("the recorded frames never pass the contact test".into());
-            Vec::new()
+    let protocol = PressProtocol {
+        max_search_steps: run.len(),
+        ..PressProtocol::default()
+    };
+    let mut descent = RecordedDescent { run, recorded };
+    let (contact, evidence, press_frames) = match run_press(&protocol, &mut descent) {
+        Ok(PressOutcome::Pressed(p)) => (
+            run.iter().position(|&i| i == p.frames[0]),
+            Some(p.evidence),
+            p.frames,
+        ),
+        Ok(PressOutcome::NoContact { .. }) | Err(PressError::Probe(RecordingEnds)) => {
+            warnings.push("the recorded frames never pass the contact criterion".into());
+            (None, None, Vec::new())
+        }
+        Err(PressError::Invalid(m)) => {
+            warnings.push(m);
+            (None, None, Vec::new())
         }
     };
     let z = |i: usize| manifest.tactile.frames[i].arm_pose.position.z;
@@ -303,7 +353,7 @@ fn compare_press(
     let pose = manifest.tactile.frames[deepest].arm_pose;
     let object = {
         let world = sim.world.lock().expect("world lock");
-        gel_contact(&world, &pose, spec).map(|c| scene.objects[c.object].label.clone())
+        deepest_touch(&world, &pose, &pad_of(spec)).map(|c| scene.objects[c.object].label.clone())
     };
     let scored = &frames[1..];
     let ssims: Vec<f64> = scored.iter().map(|f| f.ssim).collect();
@@ -314,6 +364,7 @@ fn compare_press(
         position_m: pose.position.to_array(),
         frames_at_spot: run.len(),
         contact_frame: contact,
+        contact: evidence,
         mean_ssim: mean(&ssims).unwrap_or(f64::NAN),
         min_ssim: ssims.iter().copied().fold(f64::NAN, f64::min),
         mean_marker_error_px: mean(&errors),
@@ -378,7 +429,8 @@ pub fn run(args: &SessionCompare) -> Result<()> {
             spec.height_px
         );
     }
-    let mut sim = SimDevices::with_sensor(&scene, seed, spec.clone())
+    let estimator = args.estimator.open("--estimator")?;
+    let mut sim = SimDevices::with_sensor(&scene, seed, spec.clone(), args.fidelity)
         .with_context(|| format!("{scene_name}: the twin cannot stand it up"))?;
     let rebuilt = rebuild_frames(&mut sim, &manifest)?;
 
@@ -397,7 +449,7 @@ pub fn run(args: &SessionCompare) -> Result<()> {
         .iter()
         .filter(|run| run.len() >= 2)
         .enumerate()
-        .map(|(k, run)| compare_press(k, run, &pairs, &spec, &sim, &scene))
+        .map(|(k, run)| compare_press(k, run, &pairs, &spec, &sim, &scene, estimator.as_ref()))
         .collect();
     let press_ssims: Vec<f64> = presses
         .iter()
@@ -414,7 +466,8 @@ pub fn run(args: &SessionCompare) -> Result<()> {
         seed,
         recorded_gel_modulus_mpa: recorded_spec.gel.modulus_mpa,
         twin_gel_modulus_mpa: spec.gel.modulus_mpa,
-        estimator: HertzSlopeEstimator::default().name().into(),
+        fidelity: args.fidelity.name().into(),
+        estimator: estimator.name().into(),
         mean_ssim: mean(&press_ssims).unwrap_or(f64::NAN),
         min_ssim: press_ssims.iter().copied().fold(f64::NAN, f64::min),
         mean_marker_error_px: mean(&errors),
@@ -541,13 +594,14 @@ fn print_report(r: &SessionComparison) {
         }
     }
     println!(
-        "mean over press frames: SSIM {:.4} (min {:.4}), marker displacement error {} px; largest hardness difference {} Shore A; all {} frames' mean SSIM {:.4} ({})",
+        "mean over press frames: SSIM {:.4} (min {:.4}), marker displacement error {} px; largest hardness difference {} Shore A; all {} frames' mean SSIM {:.4} ({}, twin at {})",
         r.mean_ssim,
         r.min_ssim,
         opt(r.mean_marker_error_px, 3),
         opt(r.max_shore_a_difference, 1),
         r.frames,
         r.all_frames_mean_ssim,
-        r.estimator
+        r.estimator,
+        r.fidelity
     );
 }

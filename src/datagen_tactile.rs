@@ -26,9 +26,10 @@ use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::perception::contact::ContactEvidence;
+use tactex_core::press::PressProtocol;
 use tactex_sim::elastic::{ContactSolver, Fidelity};
 use tactex_sim::gel_render::{CpuRenderer, DeviceChoice, GelRenderer, open_renderer};
-use tactex_sim::press_protocol::{PlannedPress, PressProtocol};
+use tactex_sim::press_protocol::PlannedPress;
 use tactex_sim::tactile_sample::{SampleDraw, SampleSpace, ShapeFamily};
 
 const FORMAT: &str = "tactex-tactile-dataset/1";

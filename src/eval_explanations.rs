@@ -323,6 +323,7 @@ pub fn facts(case: &Case, catalog: &FruitCatalog) -> Result<Facts> {
                 Some(t.modulus_mpa * (1.0 + FACT_SE)),
             ],
             ripeness: t.ripeness.clone(),
+            not_measured: None,
         })
         .collect();
     let not_found = query

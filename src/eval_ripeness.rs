@@ -8,9 +8,10 @@
 //! log-normal factor (`--spot-spread`, log-sd 0.1 by default: within-fruit firmness of
 //! penetrometer surveys varies by 10-20 %), so the 20 presses differ in flesh as well as pose.
 
+use crate::estimator_choice::EstimatorChoice;
 use crate::plot::{self, StageGroup};
 use anyhow::{Context, Result, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -19,15 +20,13 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::estimate::{HardnessEstimator, HertzSlopeEstimator};
 use tactex_core::hardness::{modulus_to_shore_00, modulus_to_shore_a};
-use tactex_core::indentation_estimator::IndentationEstimator;
+use tactex_core::press::PressProtocol;
 use tactex_core::stats::{
     Alternative, MannWhitneyMethod, holm_bonferroni, mann_whitney_u, quantile,
 };
 use tactex_sim::elastic::{ContactSolver, Fidelity};
 use tactex_sim::gel_render::CpuRenderer;
-use tactex_sim::press_protocol::PressProtocol;
 use tactex_sim::tactile_sample::{
     SampleDraw, SensorDraw, ShapeDraw, ShapeFamily, press_with_redraws,
 };
@@ -35,19 +34,10 @@ use tactex_sim::tactile_sample::{
 /// The paper's Table III fruits.
 const TABLE_III: [&str; 5] = ["mango", "lime", "tomato", "banana", "avocado"];
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum EstimatorChoice {
-    /// Layer-aware split of the gel's integrated indentation (any shape, bonded gel).
-    Indentation,
-    /// Hertz half-space fit of the slope field.
-    HertzSlopes,
-    /// The built-in trained CNN (models/hardness-small.onnx).
-    Learned,
-}
-
 #[derive(Args, Debug)]
 pub struct RipenessEvalArgs {
-    #[arg(long, value_enum, default_value = "indentation")]
+    /// Hardness estimator: learned, indentation, hertz or FILE.onnx.
+    #[arg(long, default_value = "indentation")]
     estimator: EstimatorChoice,
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -157,11 +147,7 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         }
         fruits.push(spec.clone());
     }
-    let estimator: Box<dyn HardnessEstimator + Sync> = match args.estimator {
-        EstimatorChoice::Indentation => Box::new(IndentationEstimator::default()),
-        EstimatorChoice::HertzSlopes => Box::new(HertzSlopeEstimator::default()),
-        EstimatorChoice::Learned => Box::new(crate::learned_model::builtin_small()?),
-    };
+    let estimator = args.estimator.open("--estimator")?;
     let protocol = PressProtocol::default();
     let jobs: Vec<Job> = fruits
         .iter()

@@ -17,6 +17,7 @@
 
 use crate::ask::{Twin, TwinAnswer};
 use crate::detector_choice::DetectorChoice;
+use crate::estimator_choice::EstimatorChoice;
 use crate::eval_grounding::KINDS;
 use crate::output::{write_bytes_atomic, write_json_atomic};
 use crate::plot::{self, BarSeries};
@@ -34,6 +35,7 @@ use tactex_core::explain::TemplateExplainer;
 use tactex_core::pipeline::{Answer, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_core::tactile_spec::TactileSpec;
+use tactex_sim::elastic::Fidelity;
 use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_random::{Variation, random_scene};
 
@@ -69,6 +71,12 @@ pub struct ScenarioEvalArgs {
     /// on the machine), gpu or auto.
     #[arg(long, default_value = "cpu")]
     pub device: DeviceChoice,
+    /// Contact physics of the sim GelSight: rigid, hertz, halfspace or layer.
+    #[arg(long, default_value = "layer")]
+    pub fidelity: Fidelity,
+    /// Hardness estimator: learned, indentation, hertz or FILE.onnx.
+    #[arg(long, default_value = crate::ask::DEFAULT_ESTIMATOR)]
+    pub estimator: EstimatorChoice,
 }
 
 /// One question on one scene, before any detector answers it.
@@ -562,6 +570,7 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
         .map(|spec| DetectorChoice::parse(spec))
         .collect::<Result<Vec<_>>>()?;
     let renderer = crate::ask::scene_renderer(args.device)?;
+    let estimator = args.estimator.open("--estimator")?;
     let scenarios = tiers
         .iter()
         .flat_map(|&t| (0..args.runs).map(move |r| (t, r)))
@@ -586,6 +595,8 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
                 detector: &detectors[d],
                 renderer: &renderer,
                 explainer: &TemplateExplainer,
+                estimator: estimator.as_ref(),
+                fidelity: args.fidelity,
             }
             .answer(&sc.prompt, &config, &|_| {})
             .with_context(|| format!("tier {} run {}: {}", sc.tier, sc.run, args.detector[d]))?;
@@ -676,8 +687,8 @@ mod tests {
                 ripeness: None,
                 evidence: None,
                 contact_search_mm: None,
-                contact_ssim: None,
-                contact_marker_px: None,
+                contact: None,
+                not_measured: None,
                 warnings: Vec::new(),
             })
             .collect();
@@ -691,6 +702,7 @@ mod tests {
                 hardness: o.hardness,
                 modulus_interval_mpa: [None, None],
                 ripeness: None,
+                not_measured: None,
             })
             .collect();
         let selected = tactex_core::explain::select(&query, &measured, &catalog);
@@ -703,6 +715,8 @@ mod tests {
                 answer: text,
                 not_found: Vec::new(),
                 estimator: "test".into(),
+                contact_criterion: String::new(),
+                fidelity: None,
                 explainer: "template".into(),
                 explain_notice: None,
                 timing: Vec::new(),

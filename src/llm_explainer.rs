@@ -311,6 +311,7 @@ mod tests {
             hardness: Some(Hardness::ModulusMpa(e).into()),
             modulus_interval_mpa: [Some(e - 0.05), Some(e + 0.05)],
             ripeness: Some(r.into()),
+            not_measured: None,
         };
         let objects = vec![
             m("banana", 0.80, -0.15, -0.1, "ripe"),

@@ -17,6 +17,7 @@ mod datagen_scenes;
 mod datagen_tactile;
 mod detect_image;
 mod detector_choice;
+mod estimator_choice;
 mod eval_explanations;
 mod eval_grounding;
 mod eval_hardness;

@@ -24,6 +24,7 @@ pub mod onnx_runtime;
 pub mod perception;
 pub mod photometric;
 pub mod pipeline;
+pub mod press;
 pub mod query;
 pub mod scene;
 pub mod shading_table;

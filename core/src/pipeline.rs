@@ -10,10 +10,10 @@ use crate::geometry::Pose;
 use crate::hardness::HardnessReport;
 use crate::perception::centroid::median_depth;
 use crate::perception::colour_name::{colour_name, mean_colour};
+use crate::perception::contact::ContactEvidence;
 use crate::perception::detect::{DetectError, Detector, RgbdView};
 use crate::perception::grounding::locate;
-use crate::perception::markers::{detect_markers, mean_moved_displacement, track};
-use crate::perception::ssim::ssim_rgb;
+use crate::press::{Look, PressOutcome, PressProbe, PressProtocol, run_press};
 use crate::query::{self, Query, QueryError};
 use glam::DVec3;
 use serde::Serialize;
@@ -23,15 +23,10 @@ use std::time::Instant;
 pub struct PipelineConfig {
     /// Depth frames whose per-pixel median feeds the centroids (the paper: 10).
     pub depth_frames: usize,
-    /// Frames recorded from the first contact on (the paper: 8) and the step between them.
-    pub press_frames: usize,
-    pub press_step_mm: f64,
-    /// Contact test: SSIM to the no-contact frame at most this, and mean marker displacement
-    /// above `contact_marker_px`.
-    pub contact_ssim: f64,
-    pub contact_marker_px: f64,
-    /// The search for contact starts this far above the surface the camera saw, and gives up
-    /// after `max_search_mm` of descent.
+    /// The press (the paper's: 0.25 mm steps, 8 frames from the first contact on, the one
+    /// contact criterion); its search gives up after `max_search_mm` of descent.
+    pub press: PressProtocol,
+    /// The search for contact starts this far above the surface the camera saw.
     pub approach_clearance_mm: f64,
     pub max_search_mm: f64,
     pub safe_height_m: f64,
@@ -45,10 +40,7 @@ impl Default for PipelineConfig {
     fn default() -> Self {
         Self {
             depth_frames: 10,
-            press_frames: 8,
-            press_step_mm: 0.25,
-            contact_ssim: 0.96,
-            contact_marker_px: 2.0,
+            press: PressProtocol::default(),
             approach_clearance_mm: 4.0,
             max_search_mm: 20.0,
             safe_height_m: 0.20,
@@ -93,11 +85,56 @@ pub struct ObjectReport {
     pub ripeness: Option<String>,
     pub evidence: Option<Evidence>,
     /// Press facts: travel from the search start to the first contact frame, and the contact
-    /// test's values there.
+    /// criterion's evidence there.
     pub contact_search_mm: Option<f64>,
-    pub contact_ssim: Option<f64>,
-    pub contact_marker_px: Option<f64>,
+    pub contact: Option<ContactEvidence>,
+    /// Why the object has no hardness, when it has none.
+    pub not_measured: Option<NotMeasured>,
     pub warnings: Vec<String>,
+}
+
+/// Why an object the camera found was not measured. The rest of the question is answered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NotMeasuredReason {
+    /// The contact criterion never fired within the search.
+    NoContact,
+    /// The arm refused a move of the press (out of its workspace, or past its crush limit).
+    ArmRefused,
+    /// The first contact frame's imprint crosses the frame's edge: the pad came down beside
+    /// the object, and no estimator reads a cut imprint.
+    ImprintCut,
+    /// The estimator could not read the press.
+    Estimator,
+}
+
+/// The reason for machines, and the detail for people.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NotMeasured {
+    pub reason: NotMeasuredReason,
+    pub detail: String,
+}
+
+impl NotMeasured {
+    fn no_contact(travel_mm: f64) -> Self {
+        Self {
+            reason: NotMeasuredReason::NoContact,
+            detail: format!("no contact within {travel_mm} mm of descent"),
+        }
+    }
+
+    fn arm_refused(reason: &str) -> Self {
+        Self {
+            reason: NotMeasuredReason::ArmRefused,
+            detail: format!("the arm refused the press: {reason}"),
+        }
+    }
+}
+
+impl std::fmt::Display for NotMeasured {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.detail)
+    }
 }
 
 /// What a running question has got to, for a live view: the stage it entered, what the camera
@@ -119,9 +156,9 @@ pub enum Progress {
     Pressed {
         index: usize,
         label: String,
-        /// Press frames recorded; 0 when no contact was found.
+        /// Press frames recorded; 0 when the object could not be pressed.
         frames: usize,
-        warning: Option<String>,
+        not_measured: Option<NotMeasured>,
     },
     StageFinished(StageTiming),
 }
@@ -144,6 +181,11 @@ pub struct Answer {
     pub answer: String,
     pub not_found: Vec<String>,
     pub estimator: String,
+    /// The contact criterion every press ran (see `perception::contact`).
+    pub contact_criterion: String,
+    /// The twin's contact physics (rigid, hertz, halfspace, layer); None on real or replayed
+    /// devices.
+    pub fidelity: Option<String>,
     /// "template", or "llm:<model>" when a model's grounded reply is the answer.
     pub explainer: String,
     /// Why a model's reply was not used, when the template stood in for it.
@@ -174,8 +216,7 @@ struct Target {
 struct Press {
     sequence: PressSequence,
     search_mm: f64,
-    ssim: f64,
-    marker_px: f64,
+    evidence: ContactEvidence,
 }
 
 pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
@@ -273,7 +314,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
             index,
             label: target.label.clone(),
             frames: pressed.as_ref().map_or(0, |p| p.sequence.frames.len()),
-            warning: pressed.as_ref().err().cloned(),
+            not_measured: pressed.as_ref().err().cloned(),
         });
         presses.push(pressed);
     }
@@ -293,15 +334,14 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
             ripeness: None,
             evidence: None,
             contact_search_mm: None,
-            contact_ssim: None,
-            contact_marker_px: None,
+            contact: None,
+            not_measured: None,
             warnings: Vec::new(),
         };
         match pressed {
             Ok(p) => {
                 report.contact_search_mm = Some(p.search_mm);
-                report.contact_ssim = Some(p.ssim);
-                report.contact_marker_px = Some(p.marker_px);
+                report.contact = Some(p.evidence.clone());
                 match estimator.estimate(&p.sequence, tactile.spec()) {
                     Ok(est) => {
                         report.hardness = Some(est.hardness.into());
@@ -312,10 +352,15 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
                             .map(|f| f.stage_for_modulus(est.hardness.modulus_mpa()).name.clone());
                         report.evidence = Some(est.evidence);
                     }
-                    Err(e) => report.warnings.push(e.to_string()),
+                    Err(e) => {
+                        report.not_measured = Some(NotMeasured {
+                            reason: NotMeasuredReason::Estimator,
+                            detail: format!("the press could not be read: {e}"),
+                        })
+                    }
                 }
             }
-            Err(w) => report.warnings.push(w.clone()),
+            Err(why) => report.not_measured = Some(why.clone()),
         }
         objects.push(report);
     }
@@ -330,6 +375,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
             hardness: o.hardness,
             modulus_interval_mpa: o.modulus_interval_mpa,
             ripeness: o.ripeness.clone(),
+            not_measured: o.not_measured.as_ref().map(|n| n.to_string()),
         })
         .collect();
     let selected = explain::select(&query, &measured, catalog);
@@ -350,6 +396,8 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
         answer: explanation.text,
         not_found: facts.not_found,
         estimator: estimator.name().into(),
+        contact_criterion: CONTACT_CRITERION.into(),
+        fidelity: None,
         explainer: explanation.explainer,
         explain_notice: explanation.notice,
         timing,
@@ -443,95 +491,413 @@ fn apply_position(query: &Query, targets: Vec<Target>) -> Vec<Target> {
         .collect()
 }
 
-/// The press's contact test on one frame against the no-contact reference.
-#[derive(Clone, Copy, Debug)]
-pub struct ContactReading {
-    pub contact: bool,
-    pub ssim: f64,
-    /// Mean displacement of the markers that moved (px).
-    pub marker_px: f64,
+/// What `Answer::contact_criterion` says every press ran.
+pub const CONTACT_CRITERION: &str = "local SSIM against the no-contact frame (worst 32 px tile <= 0.88, or past 1.3x the sensor's noise floor from a second no-contact frame) or mean marker motion > 2 px";
+
+/// The pad over a target, lowered in the protocol's steps from `start_z_m`.
+struct ArmProbe<'d, T: TactileSensor, A: Arm> {
+    tactile: &'d mut T,
+    arm: &'d mut A,
+    touch: DVec3,
+    start_z_m: f64,
+    config: &'d PipelineConfig,
 }
 
-/// Contact when the frame's SSIM to the reference is at most `config.contact_ssim` and the
-/// markers that moved did so by more than `config.contact_marker_px` on average (markers
-/// tracked within 0.45 of the grid pitch).
-pub fn contact_test(
-    reference: &TactileFrame,
-    reference_markers: &[(f64, f64)],
-    frame: &TactileFrame,
-    pitch_px: f64,
-    config: &PipelineConfig,
-) -> ContactReading {
-    let ssim = ssim_rgb(&frame.image, &reference.image).unwrap_or(1.0);
-    let marker_px = mean_moved_displacement(&track(
-        reference_markers,
-        &detect_markers(&frame.image),
-        0.45 * pitch_px,
-    ));
-    ContactReading {
-        contact: ssim <= config.contact_ssim && marker_px > config.contact_marker_px,
-        ssim,
-        marker_px,
+impl<T: TactileSensor, A: Arm> ArmProbe<'_, T, A> {
+    fn above(&self, z: f64) -> Pose {
+        Pose::tool_down(DVec3::new(self.touch.x, self.touch.y, z))
+    }
+
+    /// The frame with the pad `k` steps down, and where the arm says the pad is (m).
+    fn lowered(&mut self, k: usize) -> Result<(TactileFrame, f64), DeviceError> {
+        let z = self.start_z_m - k as f64 * self.config.press.step_mm * 1e-3;
+        self.arm
+            .move_linear(&self.above(z), self.config.press_speed_m_s)?;
+        let frame = self.tactile.capture()?;
+        Ok((frame, self.arm.pose()?.position.z))
     }
 }
 
-/// Above the target, descend until the contact test fires, record the press frames, retract.
-/// A press that finds no contact is a warning for that object, not a failure of the question.
+impl<T: TactileSensor, A: Arm> PressProbe for ArmProbe<'_, T, A> {
+    type Frame = (TactileFrame, f64);
+    type Error = DeviceError;
+
+    fn look(&mut self, at: Look) -> Result<(image::RgbImage, (TactileFrame, f64)), DeviceError> {
+        let k = match at {
+            // Both no-contact frames at the start: the second gives the noise floor.
+            Look::Reference | Look::NoiseFloor => 0,
+            Look::Search(k) => k,
+        };
+        let (frame, z) = self.lowered(k)?;
+        Ok((frame.image.clone(), (frame, z)))
+    }
+
+    fn record(&mut self, k: usize) -> Result<(TactileFrame, f64), DeviceError> {
+        self.lowered(k)
+    }
+}
+
+/// Whether the imprint of the first contact frame lies at the frame's edge: the middle of
+/// its colour change against `reference` (where the change, smoothed over a few pixels
+/// against noise and marker dots, exceeds half its largest value) falls in the outer eighth
+/// of the frame. At first contact the imprint is small and a press centred on the object
+/// has it in the middle, a long ridge across the pad included; deeper frames of a large
+/// fruit reach the edge and are still read.
+fn imprint_cut(first_contact: &TactileFrame, reference: &TactileFrame) -> bool {
+    let (a, b) = (&first_contact.image, &reference.image);
+    if a.dimensions() != b.dimensions() {
+        return false;
+    }
+    let (w, h) = a.dimensions();
+    let change = image::ImageBuffer::<image::Luma<f32>, Vec<f32>>::from_fn(w, h, |x, y| {
+        let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
+        image::Luma([(0..3).map(|c| (p[c] as f32 - q[c] as f32).abs()).sum()])
+    });
+    let smooth = imageproc::filter::gaussian_blur_f32(&change, 4.0);
+    let peak = smooth.pixels().map(|p| p[0]).fold(0.0, f32::max);
+    if peak <= 0.0 {
+        return false;
+    }
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+    for (x, y, p) in smooth.enumerate_pixels() {
+        if p[0] > 0.5 * peak {
+            sx += x as f64;
+            sy += y as f64;
+            n += 1.0;
+        }
+    }
+    let (cx, cy) = (sx / n / w as f64, sy / n / h as f64);
+    !((0.125..=0.875).contains(&cx) && (0.125..=0.875).contains(&cy))
+}
+
+/// Above the target, run the press protocol from `approach_clearance_mm` above the surface
+/// the camera saw, retract. An object that cannot be pressed (no contact, a refused move, an
+/// imprint cut by the pad's edge) is reported as not measured, not a failure of the question;
+/// a device that fails otherwise fails it.
 fn press<T: TactileSensor, A: Arm>(
     target: &Target,
     tactile: &mut T,
     arm: &mut A,
     config: &PipelineConfig,
-) -> Result<Result<Press, String>, PipelineError> {
+) -> Result<Result<Press, NotMeasured>, PipelineError> {
+    let refused = |e: DeviceError| match e {
+        DeviceError::UnsafeMove { reason, .. } => Ok(NotMeasured::arm_refused(&reason)),
+        e => Err(PipelineError::Device(e)),
+    };
     let above = |z: f64| Pose::tool_down(DVec3::new(target.touch.x, target.touch.y, z));
     let safe = above(target.touch.z + config.safe_height_m);
-    arm.move_linear(&safe, config.travel_speed_m_s)?;
-    let start_z = target.touch.z + config.approach_clearance_mm * 1e-3;
-    arm.move_linear(&above(start_z), config.travel_speed_m_s)?;
-    let reference = tactile.capture()?;
-    let spec = tactile.spec().clone();
-    let pitch_px = spec.markers.pitch_mm / spec.mm_per_px;
-    let reference_markers = detect_markers(&reference.image);
-
-    let step_m = config.press_step_mm * 1e-3;
-    let max_steps = (config.max_search_mm / config.press_step_mm).ceil() as usize;
-    let mut found = None;
-    for i in 1..=max_steps {
-        arm.move_linear(&above(start_z - i as f64 * step_m), config.press_speed_m_s)?;
-        let frame = tactile.capture()?;
-        let test = contact_test(&reference, &reference_markers, &frame, pitch_px, config);
-        if test.contact {
-            found = Some((i, frame, test.ssim, test.marker_px));
-            break;
-        }
+    let start_z_m = target.touch.z + config.approach_clearance_mm * 1e-3;
+    let approach = arm
+        .move_linear(&safe, config.travel_speed_m_s)
+        .and_then(|()| arm.move_linear(&above(start_z_m), config.travel_speed_m_s));
+    if let Err(e) = approach {
+        return Ok(Err(refused(e)?));
     }
-    let Some((contact_step, first, ssim, moved)) = found else {
-        arm.move_linear(&safe, config.travel_speed_m_s)?;
-        return Ok(Err(format!(
-            "no contact within {} mm of descent",
-            config.max_search_mm
-        )));
+    let protocol = PressProtocol {
+        max_search_steps: (config.max_search_mm / config.press.step_mm).ceil() as usize,
+        ..config.press
     };
-    let contact_z = arm.pose()?.position.z;
-    let mut frames = vec![first];
-    let mut travel_mm = vec![0.0];
-    for j in 1..config.press_frames {
-        arm.move_linear(
-            &above(start_z - (contact_step + j) as f64 * step_m),
-            config.press_speed_m_s,
-        )?;
-        frames.push(tactile.capture()?);
-        travel_mm.push((contact_z - arm.pose()?.position.z) * 1e3);
-    }
+    let mut probe = ArmProbe {
+        tactile,
+        arm,
+        touch: target.touch,
+        start_z_m,
+        config,
+    };
+    let outcome = run_press(&protocol, &mut probe);
+    // Whatever happened below, the pad goes back up before the next object.
     arm.move_linear(&safe, config.travel_speed_m_s)?;
+    let pressed = match outcome {
+        Ok(PressOutcome::Pressed(p)) => p,
+        Ok(PressOutcome::NoContact { travel_mm, .. }) => {
+            return Ok(Err(NotMeasured::no_contact(travel_mm)));
+        }
+        Err(crate::press::PressError::Probe(e)) => return Ok(Err(refused(e)?)),
+        Err(crate::press::PressError::Invalid(m)) => {
+            return Err(PipelineError::Camera(format!("tactile sensor: {m}")));
+        }
+    };
+    let (reference, _) = pressed.reference;
+    let contact_z = pressed.frames[0].1;
+    let travel_mm = pressed
+        .frames
+        .iter()
+        .map(|(_, z)| (contact_z - z) * 1e3)
+        .collect();
+    let frames: Vec<TactileFrame> = pressed.frames.into_iter().map(|(f, _)| f).collect();
+    if imprint_cut(&frames[0], &reference) {
+        return Ok(Err(NotMeasured {
+            reason: NotMeasuredReason::ImprintCut,
+            detail: "the imprint was cut by the pad's edge: the pad came down beside the object"
+                .into(),
+        }));
+    }
     Ok(Ok(Press {
         sequence: PressSequence {
             reference,
             frames,
             travel_mm,
         },
-        search_mm: contact_step as f64 * config.press_step_mm,
-        ssim,
-        marker_px: moved,
+        search_mm: pressed.first_contact_step as f64 * config.press.step_mm,
+        evidence: pressed.evidence,
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    //! The pipeline on fake devices: one apple under a downward camera, a gel that shows a
+    //! disc once the pad is below the apple's top, and an arm that may refuse to go low.
+
+    use super::*;
+    use crate::estimate::{EstimateError, HardnessEstimate, PhysicsEvidence};
+    use crate::frames::{DepthImage, RgbdFrame};
+    use crate::geometry::CameraIntrinsics;
+    use crate::hardness::Hardness;
+    use crate::perception::detect::Detection;
+    use crate::tactile_spec::TactileSpec;
+    use image::{GrayImage, Luma, Rgb, RgbImage};
+    use std::cell::Cell;
+    use std::rc::Rc;
+
+    const TOP_M: f64 = 0.03;
+    const K: CameraIntrinsics = CameraIntrinsics {
+        width: 64,
+        height: 48,
+        fx: 60.0,
+        fy: 60.0,
+        cx: 32.0,
+        cy: 24.0,
+    };
+
+    fn on_apple(x: u32, y: u32) -> bool {
+        (x as f64 - 32.0).hypot(y as f64 - 24.0) < 14.0
+    }
+
+    struct Camera;
+    impl RgbdCamera for Camera {
+        fn name(&self) -> &str {
+            "fake-camera"
+        }
+        fn intrinsics(&self) -> CameraIntrinsics {
+            K
+        }
+        fn pose(&self) -> Pose {
+            Pose::tool_down(DVec3::new(0.0, 0.0, 0.7))
+        }
+        fn capture(&mut self) -> Result<RgbdFrame, DeviceError> {
+            Ok(RgbdFrame {
+                color: RgbImage::from_fn(64, 48, |x, y| {
+                    if on_apple(x, y) {
+                        Rgb([180, 30, 30])
+                    } else {
+                        Rgb([120, 110, 100])
+                    }
+                }),
+                depth_m: DepthImage::from_fn(64, 48, |x, y| {
+                    Luma([if on_apple(x, y) {
+                        0.7 - TOP_M as f32
+                    } else {
+                        0.7
+                    }])
+                }),
+                timestamp_s: 0.0,
+            })
+        }
+    }
+
+    struct OneApple;
+    impl Detector for OneApple {
+        fn name(&self) -> &str {
+            "one-apple"
+        }
+        fn detect(&self, _: &RgbdView<'_>) -> Result<Vec<Detection>, DetectError> {
+            Ok(vec![Detection {
+                label: "apple".into(),
+                score: 0.9,
+                bbox: [18, 10, 46, 38],
+                mask: GrayImage::from_fn(64, 48, |x, y| Luma([255 * on_apple(x, y) as u8])),
+                size_m: [0.07, 0.07, TOP_M],
+            }])
+        }
+    }
+
+    /// The gel shows a dark disc at `centre` growing with the pad's depth below the apple's
+    /// top (never, when `shows` is false).
+    struct Gel {
+        z: Rc<Cell<f64>>,
+        centre: (f64, f64),
+        shows: bool,
+        spec: TactileSpec,
+    }
+    impl TactileSensor for Gel {
+        fn name(&self) -> &str {
+            "fake-gel"
+        }
+        fn spec(&self) -> &TactileSpec {
+            &self.spec
+        }
+        fn capture(&mut self) -> Result<TactileFrame, DeviceError> {
+            let depth_mm = (TOP_M - self.z.get()) * 1e3;
+            let radius = if self.shows && depth_mm > 0.0 {
+                6.0 * depth_mm.sqrt()
+            } else {
+                0.0
+            };
+            Ok(TactileFrame {
+                image: RgbImage::from_fn(96, 80, |x, y| {
+                    let base = 120 + ((x * 7 + y * 13) % 17) as u8;
+                    let r = (x as f64 - self.centre.0).hypot(y as f64 - self.centre.1);
+                    if r < radius {
+                        Rgb([base / 3, base / 2, base])
+                    } else {
+                        Rgb([base, base, base])
+                    }
+                }),
+                timestamp_s: 0.0,
+            })
+        }
+    }
+
+    struct FakeArm {
+        z: Rc<Cell<f64>>,
+        refuse_below_m: f64,
+    }
+    impl Arm for FakeArm {
+        fn name(&self) -> &str {
+            "fake-arm"
+        }
+        fn pose(&self) -> Result<Pose, DeviceError> {
+            Ok(Pose::tool_down(DVec3::new(0.0, 0.0, self.z.get())))
+        }
+        fn move_linear(&mut self, target: &Pose, _: f64) -> Result<(), DeviceError> {
+            if target.position.z < self.refuse_below_m {
+                return Err(DeviceError::UnsafeMove {
+                    device: "fake-arm".into(),
+                    reason: "crush limit".into(),
+                });
+            }
+            self.z.set(target.position.z);
+            Ok(())
+        }
+        fn stop(&mut self) -> Result<(), DeviceError> {
+            Ok(())
+        }
+    }
+
+    /// Reads every press as 2 MPa: the pipeline is under test, not estimation.
+    struct TwoMpa;
+    impl HardnessEstimator for TwoMpa {
+        fn name(&self) -> &str {
+            "two-mpa"
+        }
+        fn estimate(
+            &self,
+            press: &PressSequence,
+            _: &TactileSpec,
+        ) -> Result<HardnessEstimate, EstimateError> {
+            assert_eq!(press.frames.len(), 8);
+            Ok(HardnessEstimate {
+                hardness: Hardness::ModulusMpa(2.0),
+                modulus_interval_mpa: [Some(1.8), Some(2.2)],
+                evidence: Evidence::Physics(PhysicsEvidence {
+                    gel_share: 0.1,
+                    gel_share_se: 0.0,
+                    local_radius_mm: 30.0,
+                    first_contact_approach_mm: 0.1,
+                    last_contact_radius_mm: 3.0,
+                    last_gel_indentation_mm: 0.2,
+                    frames_used: 8,
+                    gel_layer_factor: 1.0,
+                    fit_residual_rms: 0.0,
+                    fit_residual_unit: "mm",
+                    object_poisson: 0.35,
+                }),
+            })
+        }
+    }
+
+    fn ask(centre: (f64, f64), shows: bool, refuse_below_m: f64) -> Answer {
+        let z = Rc::new(Cell::new(0.3));
+        let mut gel = Gel {
+            z: z.clone(),
+            centre,
+            shows,
+            spec: TactileSpec::gelsight_mini(),
+        };
+        let mut arm = FakeArm { z, refuse_below_m };
+        answer(
+            "How hard is the apple?",
+            &FruitCatalog::builtin(),
+            Devices {
+                camera: &mut Camera,
+                tactile: &mut gel,
+                arm: &mut arm,
+            },
+            &OneApple,
+            &TwoMpa,
+            &explain::TemplateExplainer,
+            &PipelineConfig::default(),
+        )
+        .expect("the question is answered")
+    }
+
+    #[test]
+    fn a_press_records_eight_frames_from_the_first_contact_frame() {
+        let a = ask((48.0, 40.0), true, 0.0);
+        let o = &a.objects[0];
+        assert!(o.not_measured.is_none(), "{:?}", o.not_measured);
+        assert_eq!(o.hardness.unwrap().modulus_mpa, Some(2.0));
+        let evidence = o.contact.as_ref().unwrap();
+        assert!(evidence.contact && !evidence.fired_by.is_empty());
+        // The search starts 4 mm above the top the camera saw and fires once the disc shows.
+        let search = o.contact_search_mm.unwrap();
+        assert!((4.0..=5.0).contains(&search), "{search}");
+        let press = a.presses[0].as_ref().unwrap();
+        assert_eq!(press.travel_mm.len(), 8);
+        for (j, t) in press.travel_mm.iter().enumerate() {
+            assert!((t - 0.25 * j as f64).abs() < 1e-9, "{t}");
+        }
+        assert!(
+            a.answer.contains("2.00 MPa") || a.answer.contains("Shore"),
+            "{}",
+            a.answer
+        );
+    }
+
+    #[test]
+    fn a_gel_that_never_changes_is_no_contact_not_a_failed_question() {
+        let a = ask((48.0, 40.0), false, 0.0);
+        let o = &a.objects[0];
+        let why = o.not_measured.as_ref().unwrap();
+        assert_eq!(why.reason, NotMeasuredReason::NoContact);
+        assert!(o.hardness.is_none());
+        assert!(
+            a.answer
+                .contains("could not measure (no contact within 20 mm"),
+            "{}",
+            a.answer
+        );
+    }
+
+    #[test]
+    fn a_refused_move_is_reported_with_the_arms_reason() {
+        // The arm will not go below 1 mm above the apple's top: the search is cut short.
+        let a = ask((48.0, 40.0), true, TOP_M + 0.001);
+        let why = a.objects[0].not_measured.as_ref().unwrap();
+        assert_eq!(why.reason, NotMeasuredReason::ArmRefused);
+        assert!(why.detail.contains("crush limit"), "{}", why.detail);
+        assert!(
+            a.answer.contains("the arm refused the press"),
+            "{}",
+            a.answer
+        );
+    }
+
+    #[test]
+    fn an_imprint_at_the_frames_edge_is_reported_as_cut() {
+        let a = ask((4.0, 40.0), true, 0.0);
+        let why = a.objects[0].not_measured.as_ref().unwrap();
+        assert_eq!(why.reason, NotMeasuredReason::ImprintCut);
+        assert!(a.objects[0].hardness.is_none());
+    }
 }

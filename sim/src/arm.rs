@@ -2,7 +2,7 @@
 //! acceleration limits (trapezoidal profile), advancing the simulated clock, inside a
 //! workspace box and refusing moves that would crush an object.
 
-use crate::contact::gel_contact;
+use crate::pad_contact::{deepest_touch, pad_of};
 use crate::world::SharedWorld;
 use tactex_core::devices::{Arm, DeviceError};
 use tactex_core::geometry::Pose;
@@ -75,7 +75,7 @@ impl Arm for SimArm {
                 p.x, p.y, p.z
             )));
         }
-        if let Some(c) = gel_contact(&world, target, &self.spec)
+        if let Some(c) = deepest_touch(&world, target, &pad_of(&self.spec))
             && c.approach_mm > self.max_approach_mm
         {
             return Err(self.refuse(format!(

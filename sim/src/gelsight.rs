@@ -1,12 +1,17 @@
-//! The simulated GelSight Mini: gel fields from the contact model at the pad's pose ->
-//! the GelSight renderer (`gel_render`, CPU reference path: one frame at a time gains nothing
+//! The simulated GelSight Mini: the pad's contact with the object it presses, solved by the
+//! elastic solver at the chosen fidelity on the world's meshes (`pad_contact`) -> the
+//! GelSight renderer (`gel_render`, CPU reference path: one frame at a time gains nothing
 //! from a dispatch) -> a seeded tactile frame.
 
-use crate::contact::gel_fields;
-use crate::gel_render::{CpuRenderer, GelImageFields, PressFrame, SensorOptics};
+use crate::elastic::{ContactProblem, ContactSolver, Fidelity};
+use crate::gel_render::{
+    CpuRenderer, GelImageFields, PressFrame, SensorOptics, image_fields, pad_rect,
+};
+use crate::pad_contact::{PressGrid, Spot, deepest_touch};
 use crate::world::SharedWorld;
 use tactex_core::devices::{DeviceError, TactileSensor};
 use tactex_core::frames::TactileFrame;
+use tactex_core::hertz::Elastic;
 use tactex_core::tactile_spec::TactileSpec;
 
 pub struct SimGelSight {
@@ -14,19 +19,36 @@ pub struct SimGelSight {
     spec: TactileSpec,
     /// Background, shading, markers, vignetting and camera noise of the rendered frames.
     pub optics: SensorOptics,
+    fidelity: Fidelity,
+    solver: ContactSolver,
+    press: PressGrid,
     seed: u32,
     frames: u32,
 }
 
 impl SimGelSight {
-    pub fn new(world: SharedWorld, spec: TactileSpec, seed: u64) -> Self {
+    pub fn new(world: SharedWorld, spec: TactileSpec, fidelity: Fidelity, seed: u64) -> Self {
         let optics = SensorOptics::for_spec(&spec);
         Self {
             world,
             spec,
             optics,
+            fidelity,
+            solver: ContactSolver::new(),
+            press: PressGrid::default(),
             seed: (seed ^ (seed >> 32) ^ 0x6e15_5157) as u32,
             frames: 0,
+        }
+    }
+
+    pub fn fidelity(&self) -> Fidelity {
+        self.fidelity
+    }
+
+    fn failure(&self, message: String) -> DeviceError {
+        DeviceError::Failure {
+            device: self.name().into(),
+            message,
         }
     }
 }
@@ -41,18 +63,37 @@ impl TactileSensor for SimGelSight {
     }
 
     fn capture(&mut self) -> Result<TactileFrame, DeviceError> {
-        let mut world = self.world.lock().map_err(|_| DeviceError::Failure {
-            device: "sim-gelsight-mini".into(),
-            message: "the simulated world's lock is poisoned".into(),
-        })?;
-        let fields = match gel_fields(&world, &world.tool, &self.spec) {
-            Some(f) => GelImageFields {
-                width: self.spec.width_px,
-                height: self.spec.height_px,
-                normal_mm: f.normal_mm.iter().map(|v| *v as f32).collect(),
-                lateral_x_mm: f.lateral_x_mm.iter().map(|v| *v as f32).collect(),
-                lateral_y_mm: f.lateral_y_mm.iter().map(|v| *v as f32).collect(),
-            },
+        let world = self.world.clone();
+        let mut world = world
+            .lock()
+            .map_err(|_| self.failure("the simulated world's lock is poisoned".into()))?;
+        let pad = pad_rect(&self.optics);
+        let tool = world.tool;
+        let fields = match deepest_touch(&world, &tool, &pad) {
+            Some(touch) => {
+                let object = &world.objects[touch.object];
+                let problem = ContactProblem {
+                    surface: &touch.surface,
+                    object: Elastic {
+                        modulus_mpa: object.hardness.modulus_mpa(),
+                        poisson: object.poisson,
+                    },
+                    gel: self.spec.gel,
+                    pad,
+                    approach_mm: touch.approach_mm,
+                    cell_mm: None,
+                };
+                let solution = self
+                    .press
+                    .solve(
+                        &mut self.solver,
+                        &problem,
+                        self.fidelity,
+                        Spot::of(touch.object, &tool),
+                    )
+                    .map_err(|e| self.failure(format!("contact with the {}: {e}", object.label)))?;
+                image_fields(&mut self.solver, &solution, &self.spec.gel, &self.optics)
+            }
             None => GelImageFields::flat(self.spec.width_px, self.spec.height_px),
         };
         // Each frame its own noise: frame counter mixed into the device's seed.

@@ -7,13 +7,12 @@
 
 pub mod arm;
 pub mod camera;
-pub mod contact;
 pub mod depth_noise;
 pub mod elastic;
 pub mod gel_render;
 pub mod gelsight;
-pub mod layer;
 pub mod mesh;
+pub mod pad_contact;
 pub mod perception_error;
 pub mod press_protocol;
 pub mod render_device;
@@ -22,6 +21,7 @@ pub mod scene_render;
 pub mod tactile_sample;
 pub mod world;
 
+use elastic::Fidelity;
 use tactex_core::scene::Scene;
 use tactex_core::tactile_spec::TactileSpec;
 
@@ -34,21 +34,24 @@ pub struct SimDevices {
 }
 
 impl SimDevices {
+    /// The devices with the stock GelSight Mini, its contact solved at the `layer` level.
     pub fn from_scene(scene: &Scene, seed: u64) -> Result<Self, world::WorldError> {
-        Self::with_sensor(scene, seed, TactileSpec::gelsight_mini())
+        Self::with_sensor(scene, seed, TactileSpec::gelsight_mini(), Fidelity::Layer)
     }
 
     /// The devices with another tactile sensor than the stock GelSight Mini (a softer gel,
-    /// another marker grid): what-if runs, and sessions recorded with such a sensor.
+    /// another marker grid: what-if runs, and sessions recorded with such a sensor), its
+    /// contact solved at `fidelity`.
     pub fn with_sensor(
         scene: &Scene,
         seed: u64,
         spec: TactileSpec,
+        fidelity: Fidelity,
     ) -> Result<Self, world::WorldError> {
         let shared = world::SimWorld::from_scene(scene)?.shared();
         Ok(Self {
             camera: camera::SimCamera::new(shared.clone(), seed),
-            tactile: gelsight::SimGelSight::new(shared.clone(), spec.clone(), seed),
+            tactile: gelsight::SimGelSight::new(shared.clone(), spec.clone(), fidelity, seed),
             arm: arm::SimArm::new(shared.clone(), spec),
             world: shared,
         })

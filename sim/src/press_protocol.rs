@@ -1,48 +1,27 @@
-//! The paper's press protocol on the contact solver alone (no world, no arm): lower the pad in
-//! steps until the contact criterion fires on the rendered frame, then record a fixed number of
-//! frames at the same step. Data generation and the hardness evaluations run it directly; the
-//! pipeline runs the same protocol through the device traits.
+//! The paper's press protocol (`tactex_core::press`) on the contact solver alone (no world,
+//! no arm): each step of the descent is a contact solve at the step's approach, through the
+//! same per-press grid as the sim GelSight's (`pad_contact::PressGrid`). Data generation and
+//! the hardness evaluations run it directly; the pipeline runs the same protocol through the
+//! device traits.
 //!
 //! Search frames are rendered on the CPU reference path so that where contact fires never
 //! depends on the device; the recorded frames come back as gel fields and noise seeds, for any
 //! renderer to draw in batches. Frame k of the descent has noise seed `frame_seed(seed, k)`,
 //! so the recorded first frame is the very frame the criterion fired on.
 
-use crate::elastic::{
-    ContactError, ContactProblem, ContactSolution, ContactSolver, Fidelity, Grid, ObjectSurface,
-};
+use crate::elastic::{ContactError, ContactProblem, ContactSolver, Fidelity, ObjectSurface};
 use crate::gel_render::{
     CpuRenderer, GelImageFields, GelRenderer, PressFrame, RenderError, SensorOptics, image_fields,
     pad_rect,
 };
+use crate::pad_contact::{PressGrid, Spot};
 use image::RgbImage;
 use tactex_core::estimate::PressSequence;
 use tactex_core::frames::TactileFrame;
 use tactex_core::hertz::Elastic;
-use tactex_core::perception::contact::{ContactEvidence, ContactRule, ContactTest};
+use tactex_core::perception::contact::ContactEvidence;
+use tactex_core::press::{Look, PressOutcome, PressProbe, PressProtocol, run_press};
 use tactex_core::tactile_spec::GelSpec;
-
-/// How the press is run: the paper's 0.25 mm steps and 8 frames by default.
-#[derive(Clone, Copy, Debug)]
-pub struct PressProtocol {
-    pub step_mm: f64,
-    /// Frames recorded from the first contact frame on.
-    pub frames: usize,
-    /// The search gives up after this many steps past the first touch.
-    pub max_search_steps: usize,
-    pub rule: ContactRule,
-}
-
-impl Default for PressProtocol {
-    fn default() -> Self {
-        Self {
-            step_mm: 0.25,
-            frames: 8,
-            max_search_steps: 24,
-            rule: ContactRule::default(),
-        }
-    }
-}
 
 /// One object under the pad, and the sensor that presses it.
 #[derive(Clone, Copy, Debug)]
@@ -72,6 +51,8 @@ pub struct PressedFrame {
     pub force_n: f64,
     pub contact_radius_mm: f64,
     pub gel_max_indentation_mm: f64,
+    /// The solver's warnings on this frame.
+    pub warnings: Vec<String>,
 }
 
 /// The press as recorded, before rendering.
@@ -111,69 +92,97 @@ pub fn frame_seed(seed: u32, k: usize) -> u32 {
     (z ^ (z >> 31)) as u32
 }
 
-/// One frame of the descent: the solve on `grid` (warm-started from the previous frame of
-/// the same grid) and the gel fields at the frame's pixels.
-struct SolvedFrame {
-    fields: GelImageFields,
-    solution: Option<ContactSolution>,
+/// The descent as the solver sees it: step k is a solve at approach k * step - phase.
+struct SolverProbe<'s, 'a> {
+    solver: &'s mut ContactSolver,
+    grid: PressGrid,
+    setup: &'s PressSetup<'a>,
+    step_mm: f64,
 }
 
-impl SolvedFrame {
-    fn facts(&self) -> (f64, f64, f64) {
-        self.solution.as_ref().map_or((0.0, 0.0, 0.0), |s| {
-            (s.force_n, s.contact_radius_mm, s.gel_max_indentation_mm)
-        })
-    }
-}
-
-fn problem_at<'a>(setup: &PressSetup<'a>, approach_mm: f64) -> ContactProblem<'a> {
-    ContactProblem {
-        surface: setup.surface,
-        object: setup.object,
-        gel: setup.gel,
-        pad: pad_rect(setup.optics),
-        approach_mm,
-        cell_mm: setup.cell_mm,
-    }
-}
-
-fn solve_frame(
-    solver: &mut ContactSolver,
-    setup: &PressSetup,
-    approach_mm: f64,
-    grid: Option<Grid>,
-    warm: Option<&ContactSolution>,
-) -> Result<SolvedFrame, PressError> {
-    let optics = setup.optics;
-    if approach_mm <= 0.0 {
-        return Ok(SolvedFrame {
+impl SolverProbe<'_, '_> {
+    /// Frame `k` of the descent (0 and `NOISE_FLOOR_FRAME`: no contact).
+    fn frame(&mut self, k: usize) -> Result<PressedFrame, PressError> {
+        let setup = self.setup;
+        let optics = setup.optics;
+        let approach_mm = if k == NOISE_FLOOR_FRAME {
+            0.0
+        } else {
+            k as f64 * self.step_mm - setup.phase_mm
+        };
+        let mut frame = PressedFrame {
             fields: GelImageFields::flat(optics.width, optics.height),
-            solution: None,
-        });
+            seed: frame_seed(setup.seed, k),
+            approach_mm,
+            travel_mm: 0.0,
+            force_n: 0.0,
+            contact_radius_mm: 0.0,
+            gel_max_indentation_mm: 0.0,
+            warnings: Vec::new(),
+        };
+        if approach_mm <= 0.0 {
+            return Ok(frame);
+        }
+        let problem = ContactProblem {
+            surface: setup.surface,
+            object: setup.object,
+            gel: setup.gel,
+            pad: pad_rect(optics),
+            approach_mm,
+            cell_mm: setup.cell_mm,
+        };
+        let spot = Spot {
+            object: 0,
+            across_m: glam::DVec2::ZERO,
+            rotation: glam::DQuat::IDENTITY,
+        };
+        let solution = self
+            .grid
+            .solve(self.solver, &problem, setup.fidelity, spot)?;
+        frame.fields = image_fields(self.solver, &solution, &setup.gel, optics);
+        frame.force_n = solution.force_n;
+        frame.contact_radius_mm = solution.contact_radius_mm;
+        frame.gel_max_indentation_mm = solution.gel_max_indentation_mm;
+        frame.warnings = solution.warnings;
+        Ok(frame)
     }
-    let solution = solver.solve_on(&problem_at(setup, approach_mm), setup.fidelity, grid, warm)?;
-    let fields = image_fields(solver, &solution, &setup.gel, optics);
-    Ok(SolvedFrame {
-        fields,
-        solution: Some(solution),
-    })
 }
 
-/// Runs the search and records the press (see the module docs).
+impl PressProbe for SolverProbe<'_, '_> {
+    type Frame = PressedFrame;
+    type Error = PressError;
+
+    fn look(&mut self, at: Look) -> Result<(RgbImage, PressedFrame), PressError> {
+        let k = match at {
+            Look::Reference => 0,
+            Look::NoiseFloor => NOISE_FLOOR_FRAME,
+            Look::Search(k) => k,
+        };
+        let frame = self.frame(k)?;
+        let image = CpuRenderer.render_one(
+            self.setup.optics,
+            &PressFrame {
+                fields: &frame.fields,
+                seed: frame.seed,
+            },
+        );
+        Ok((image, frame))
+    }
+
+    fn record(&mut self, k: usize) -> Result<PressedFrame, PressError> {
+        self.frame(k)
+    }
+}
+
+/// Runs the protocol on the solver (see the module docs); `max_search_steps` counts from
+/// first touch.
 pub fn plan_press(
     solver: &mut ContactSolver,
     setup: &PressSetup,
     protocol: &PressProtocol,
 ) -> Result<PlannedPress, PressError> {
+    protocol.validate().map_err(PressError::Invalid)?;
     let step = protocol.step_mm;
-    if !(step.is_finite() && step > 0.0) {
-        return Err(PressError::Invalid(format!(
-            "step_mm must be positive, got {step}"
-        )));
-    }
-    if protocol.frames == 0 {
-        return Err(PressError::Invalid("frames must be at least 1".into()));
-    }
     if !(setup.phase_mm.is_finite() && (0.0..step).contains(&setup.phase_mm)) {
         return Err(PressError::Invalid(format!(
             "phase_mm must be in [0, {step}), got {}",
@@ -181,93 +190,38 @@ pub fn plan_press(
         )));
     }
     setup.optics.validate()?;
-    let approach = |k: usize| k as f64 * step - setup.phase_mm;
-    let reference_seed = frame_seed(setup.seed, 0);
-    let flat = GelImageFields::flat(setup.optics.width, setup.optics.height);
-    let reference = CpuRenderer.render_one(
-        setup.optics,
-        &PressFrame {
-            fields: &flat,
-            seed: reference_seed,
-        },
-    );
-
-    // A second no-contact frame gives the sensor's noise floor (see `ContactTest`).
-    let second = CpuRenderer.render_one(
-        setup.optics,
-        &PressFrame {
-            fields: &flat,
-            seed: frame_seed(setup.seed, NOISE_FLOOR_FRAME),
-        },
-    );
-    let test = ContactTest::with_noise_floor(&reference, &second, &protocol.rule)
-        .ok_or_else(|| PressError::Invalid("frame smaller than one SSIM tile".into()))?;
-
-    // Each search step solves on the grid its deepest recorded frame would need, so that
-    // once contact fires the recorded frames share one grid (and its kernels) with warm starts.
-    let deepest = (protocol.frames - 1) as f64 * step;
-    let mut found = None;
-    for k in 1..=protocol.max_search_steps {
-        let a = approach(k);
-        if a <= 0.0 {
-            continue;
+    let mut probe = SolverProbe {
+        solver,
+        grid: PressGrid::default(),
+        setup,
+        step_mm: step,
+    };
+    let pressed = match run_press(protocol, &mut probe).map_err(|e| match e {
+        tactex_core::press::PressError::Probe(e) => e,
+        tactex_core::press::PressError::Invalid(m) => PressError::Invalid(m),
+    })? {
+        PressOutcome::Pressed(p) => p,
+        PressOutcome::NoContact { travel_mm, .. } => {
+            return Err(PressError::NoContact {
+                travel_mm: travel_mm - setup.phase_mm,
+            });
         }
-        let grid = solver.plan_grid(&problem_at(setup, a), setup.fidelity, a + deepest)?;
-        let frame = solve_frame(solver, setup, a, grid, None)?;
-        let seed = frame_seed(setup.seed, k);
-        let image = CpuRenderer.render_one(
-            setup.optics,
-            &PressFrame {
-                fields: &frame.fields,
-                seed,
-            },
-        );
-        let evidence = test
-            .evidence(&image)
-            .expect("frames of one optics have one size");
-        if evidence.contact {
-            found = Some((k, evidence, grid, frame));
-            break;
-        }
-    }
-    let Some((first_step, contact, grid, first)) = found else {
-        return Err(PressError::NoContact {
-            travel_mm: approach(protocol.max_search_steps),
-        });
     };
     let mut warnings: Vec<String> = Vec::new();
-    let mut frames = Vec::with_capacity(protocol.frames);
-    let mut first = Some(first);
-    let mut previous: Option<ContactSolution> = None;
-    for j in 0..protocol.frames {
-        let k = first_step + j;
-        let a = approach(k);
-        let frame = match first.take() {
-            Some(f) => f,
-            None => solve_frame(solver, setup, a, grid, previous.as_ref())?,
-        };
-        let (force_n, contact_radius_mm, gel_max_indentation_mm) = frame.facts();
-        for w in frame.solution.iter().flat_map(|s| &s.warnings) {
+    let mut frames = pressed.frames;
+    for (j, f) in frames.iter_mut().enumerate() {
+        f.travel_mm = j as f64 * step;
+        for w in &f.warnings {
             if !warnings.contains(w) {
                 warnings.push(w.clone());
             }
         }
-        frames.push(PressedFrame {
-            fields: frame.fields,
-            seed: frame_seed(setup.seed, k),
-            approach_mm: a,
-            travel_mm: j as f64 * step,
-            force_n,
-            contact_radius_mm,
-            gel_max_indentation_mm,
-        });
-        previous = frame.solution;
     }
     Ok(PlannedPress {
-        reference_seed,
+        reference_seed: pressed.reference.seed,
         frames,
-        search_steps: first_step,
-        contact,
+        search_steps: pressed.first_contact_step,
+        contact: pressed.evidence,
         warnings,
     })
 }
@@ -377,9 +331,12 @@ mod tests {
                 seed: frame_seed(7, NOISE_FLOOR_FRAME),
             },
         );
-        let test =
-            ContactTest::with_noise_floor(&images[0], &second, &PressProtocol::default().rule)
-                .unwrap();
+        let test = tactex_core::perception::contact::ContactTest::with_noise_floor(
+            &images[0],
+            &second,
+            &PressProtocol::default().rule,
+        )
+        .unwrap();
         assert_eq!(test.evidence(&images[1]).unwrap(), p.contact);
         assert!(p.contact.contact);
     }

@@ -7,7 +7,7 @@
 use crate::elastic::{ContactSolver, Fidelity, ObjectSurface};
 use crate::gel_render::{SensorOptics, Shading, synthetic_background};
 use crate::mesh::{self, Lobe};
-use crate::press_protocol::{PlannedPress, PressError, PressProtocol, PressSetup, plan_press};
+use crate::press_protocol::{PlannedPress, PressError, PressSetup, plan_press};
 use glam::{DQuat, DVec2, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -19,6 +19,7 @@ use tactex_core::hardness::shore_a_to_modulus_mpa;
 use tactex_core::hardness::{modulus_to_shore_00, modulus_to_shore_a, shore_00_to_modulus_mpa};
 use tactex_core::hertz::Elastic;
 use tactex_core::photometric::PhotometricModel;
+use tactex_core::press::PressProtocol;
 use tactex_core::tactile_spec::{GelSpec, TactileSpec};
 
 /// The kinds of object a data set draws from.

@@ -24,12 +24,14 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
+use tactex_core::estimate::HardnessEstimator;
 use tactex_core::explain::Explainer;
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
 use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::SimDevices;
 use tactex_sim::camera::SimCamera;
+use tactex_sim::elastic::Fidelity;
 use tactex_sim::scene_render::SceneRenderer;
 use tokio::sync::Semaphore;
 
@@ -66,6 +68,8 @@ struct Served {
     detector: DetectorChoice,
     renderer: Arc<dyn SceneRenderer>,
     explainer: Box<dyn Explainer>,
+    estimator: Box<dyn HardnessEstimator + Send + Sync>,
+    fidelity: Fidelity,
     seed: u64,
     /// The live view's camera: the twin's camera on its own noise stream.
     live: Mutex<SimCamera>,
@@ -88,6 +92,8 @@ pub fn run(args: &ServeArgs) -> Result<()> {
         detector,
         renderer,
         explainer,
+        estimator,
+        fidelity,
     } = args.twin.open()?;
     let mut live = SimDevices::from_scene(&scene, args.seed.wrapping_add(1))?.camera;
     live.set_renderer(renderer.clone());
@@ -98,6 +104,8 @@ pub fn run(args: &ServeArgs) -> Result<()> {
         detector,
         renderer,
         explainer,
+        estimator,
+        fidelity,
         seed: args.seed,
         live: Mutex::new(live),
         queries: Mutex::default(),
@@ -298,6 +306,8 @@ fn answer_question(s: &Served, run: &QueryRun, prompt: &str) {
         detector: &s.detector,
         renderer: &s.renderer,
         explainer: s.explainer.as_ref(),
+        estimator: s.estimator.as_ref(),
+        fidelity: s.fidelity,
     };
     let answered = twin.answer(prompt, &PipelineConfig::default(), &|p| run.progress(&p));
     match answered {

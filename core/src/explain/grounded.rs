@@ -265,6 +265,7 @@ mod tests {
             hardness: Some(Hardness::ModulusMpa(e).into()),
             modulus_interval_mpa: [Some(e * 0.9), Some(e * 1.1)],
             ripeness: Some(r.into()),
+            not_measured: None,
         };
         let objects = vec![
             m("banana", 0.80, -0.15, -0.1, "ripe"),

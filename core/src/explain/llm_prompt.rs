@@ -76,6 +76,7 @@ mod tests {
                 hardness: Some(Hardness::ModulusMpa(0.8).into()),
                 modulus_interval_mpa: [Some(0.72), Some(0.88)],
                 ripeness: Some("ripe".into()),
+                not_measured: None,
             }],
             selected: vec![0],
             not_found: vec!["kiwi".into()],

@@ -25,6 +25,8 @@ pub struct Measured {
     /// One-standard-error modulus interval (MPa).
     pub modulus_interval_mpa: [Option<f64>; 2],
     pub ripeness: Option<String>,
+    /// Why there is no hardness, when there is none (a sentence fragment).
+    pub not_measured: Option<String>,
 }
 
 /// Everything an explanation may say: the question, what was measured, which objects answer

@@ -84,7 +84,10 @@ fn describe(m: &Measured) -> String {
                 s += &format!(", {r}");
             }
         }
-        None => s += ", which I could not measure",
+        None => match &m.not_measured {
+            Some(why) => s += &format!(", which I could not measure ({why})"),
+            None => s += ", which I could not measure",
+        },
     }
     s
 }
@@ -205,6 +208,13 @@ pub fn explain(
             objects.len()
         ));
     }
+    // A fruit that was found but could not be pressed is said so, with why, once.
+    for (i, m) in objects.iter().enumerate() {
+        let asked = query.all || query.targets.is_empty() || query.targets.contains(&m.label);
+        if m.hardness.is_none() && asked && !selected.contains(&i) {
+            parts.push(capitalise(&format!("{}.", describe(m))));
+        }
+    }
     for kind in missing {
         parts.push(format!("I could not find a {kind} on the table."));
     }
@@ -230,6 +240,7 @@ mod tests {
             hardness: Some(Hardness::ModulusMpa(e).into()),
             modulus_interval_mpa: [None, None],
             ripeness: Some("ripe".into()),
+            not_measured: None,
         }
     }
 

@@ -16,7 +16,8 @@ pub struct Located {
     pub surface: DVec3,
     /// x, y of the centroid; z half the top height (the object rests on the table).
     pub centre: DVec3,
-    /// The highest mask point within 15 mm of the centroid, where the gel presses.
+    /// Where the gel presses: the crest near the centroid (the median of the highest tenth of
+    /// the mask points within 15 mm of it).
     pub touch: DVec3,
     /// The mask used: the inner mask, or the full one where the inner had too few points.
     pub mask: GrayImage,
@@ -45,13 +46,21 @@ pub fn locate(
     let mut heights: Vec<f64> = points.iter().map(|p| p.z).collect();
     heights.sort_by(f64::total_cmp);
     let top = heights[((heights.len() - 1) as f64 * 0.98).round() as usize];
-    // A curved fruit's centroid can fall beside it: press the crest near the centroid.
+    // A curved fruit's centroid can fall beside it: press the crest near the centroid. The
+    // single highest point is the depth noise's largest draw and can lie a centimetre from
+    // the crest; the median of the highest tenth lies on it.
     let near = |p: &&DVec3| p.truncate().distance(surface.truncate());
-    let touch = *points
+    let mut close: Vec<DVec3> = points
         .iter()
         .filter(|p| near(p) <= 0.015)
-        .max_by(|a, b| a.z.total_cmp(&b.z))
-        .or_else(|| points.iter().min_by(|a, b| near(a).total_cmp(&near(b))))?;
+        .copied()
+        .collect();
+    if close.is_empty() {
+        close.push(*points.iter().min_by(|a, b| near(a).total_cmp(&near(b)))?);
+    }
+    close.sort_by(|a, b| b.z.total_cmp(&a.z));
+    close.truncate(close.len().div_ceil(10));
+    let touch = median_point(&close)?;
     Some(Located {
         surface,
         centre: DVec3::new(surface.x, surface.y, top / 2.0),

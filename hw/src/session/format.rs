@@ -68,6 +68,9 @@ pub struct TwinRecord {
     pub scene_path: String,
     /// The seed of the sim devices (sensor noise).
     pub seed: u64,
+    /// The sim GelSight's contact physics (rigid, hertz, halfspace, layer).
+    #[serde(default)]
+    pub fidelity: Option<String>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

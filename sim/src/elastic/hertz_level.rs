@@ -15,7 +15,7 @@ pub struct EquivalentSphere {
 }
 
 /// Least-squares quadric z = c0 + c1 x + c2 y + c3 x^2 + c4 xy + c5 y^2.
-pub fn fit_quadric(points: &[(DVec2, f64)]) -> Option<[f64; 6]> {
+fn fit_quadric(points: &[(DVec2, f64)]) -> Option<[f64; 6]> {
     let mut a = [[0.0f64; 7]; 6];
     for (p, z) in points {
         let row = [1.0, p.x, p.y, p.x * p.x, p.x * p.y, p.y * p.y];
