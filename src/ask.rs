@@ -102,6 +102,10 @@ pub struct TwinOptions {
     /// indentation, hertz or FILE.onnx (a model with its card FILE.json beside it).
     #[arg(long, default_value = DEFAULT_ESTIMATOR)]
     pub estimator: EstimatorChoice,
+    /// Interval calibration (JSON from `tactex eval fruits --calibrate`) the estimates' 68%
+    /// and 95% intervals come from; unset: the one shipped for the estimator at --fidelity.
+    #[arg(long)]
+    pub intervals: Option<PathBuf>,
 }
 
 /// The estimator `ask`, `serve`, `compare --session` and `eval scenarios` use unless told:
@@ -124,7 +128,11 @@ impl TwinOptions {
             detector: DetectorChoice::parse(&self.detector)?,
             renderer: scene_renderer(self.device)?,
             explainer: explainer(self.explainer, self.llm_config.as_ref())?,
-            estimator: self.estimator.open("--estimator")?,
+            estimator: self.estimator.open(
+                "--estimator",
+                self.fidelity.name(),
+                self.intervals.as_deref(),
+            )?,
             fidelity: self.fidelity,
         })
     }
@@ -140,11 +148,18 @@ pub fn scene_renderer(device: DeviceChoice) -> Result<Arc<dyn SceneRenderer>> {
     Ok(choice.renderer)
 }
 
+/// Objects closer than this count as touching (the meshes' vertex spacing is about 2.6 mm).
+pub const TOUCH_GAP_M: f64 = 0.003;
+
 /// An answer from the twin, with the ground truth an evaluation scores it against.
 pub struct TwinAnswer {
     pub answer: Answer,
     /// Where each scene object came to rest (world frame, m), in the scene's order.
     pub true_centres_m: Vec<[f64; 3]>,
+    /// Each object's outline centre seen from above (`TriMesh::top_view_centre`), what a
+    /// report's position estimates; and which objects touch another (`TOUCH_GAP_M`).
+    pub true_top_centres_m: Vec<[f64; 3]>,
+    pub touching: Vec<bool>,
     /// The clean render's instance ids (object i is id i + 1) and the camera that took it.
     pub instances: InstanceImage,
     pub intrinsics: CameraIntrinsics,
@@ -172,6 +187,8 @@ struct Prepared<'d> {
     detector: Box<dyn Detector + 'd>,
     instances: InstanceImage,
     true_centres_m: Vec<[f64; 3]>,
+    true_top_centres_m: Vec<[f64; 3]>,
+    touching: Vec<bool>,
 }
 
 impl<'a> Twin<'a> {
@@ -188,15 +205,25 @@ impl<'a> Twin<'a> {
                 labels: &labels,
             });
         let detector = self.detector.detector(catalog, truth, self.seed)?;
-        let true_centres_m = {
+        let (true_centres_m, true_top_centres_m, touching) = {
             let world = sim.world.lock().expect("world lock");
-            world.objects.iter().map(|o| o.centre.to_array()).collect()
+            (
+                world.objects.iter().map(|o| o.centre.to_array()).collect(),
+                world
+                    .objects
+                    .iter()
+                    .map(|o| o.mesh.top_view_centre().to_array())
+                    .collect(),
+                world.touching(TOUCH_GAP_M),
+            )
         };
         Ok(Prepared {
             sim,
             detector,
             instances,
             true_centres_m,
+            true_top_centres_m,
+            touching,
         })
     }
 
@@ -214,6 +241,8 @@ impl<'a> Twin<'a> {
             detector,
             instances,
             true_centres_m,
+            true_top_centres_m,
+            touching,
         } = self.prepare(&catalog)?;
         let mut answer = pipeline::answer_with_progress(
             prompt,
@@ -233,6 +262,8 @@ impl<'a> Twin<'a> {
         Ok(TwinAnswer {
             answer,
             true_centres_m,
+            true_top_centres_m,
+            touching,
             intrinsics: sim.camera.intrinsics(),
             camera_pose: sim.camera.pose(),
             instances,
@@ -405,7 +436,12 @@ fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> R
     let choice = DetectorChoice::parse(&args.twin.detector)?;
     let detector = detector_without_truth(&choice, &catalog)?;
     let explainer = explainer(args.twin.explainer, args.twin.llm_config.as_ref())?;
-    let estimator = args.twin.estimator.open("--estimator")?;
+    // The twin's most faithful physics stands in for the real gel's.
+    let estimator = args.twin.estimator.open(
+        "--estimator",
+        Fidelity::Layer.name(),
+        args.twin.intervals.as_deref(),
+    )?;
     // The sensors first, so that a missing camera never leaves the arm enabled.
     let mut camera = devices.open_camera()?;
     let mut tactile = devices.open_tactile()?;
@@ -528,9 +564,22 @@ fn print_answer(a: &Answer) {
     }
     println!("{}\n", a.answer);
     println!(
-        "{:<3} {:<11} {:<13} {:>24} {:>9} {:>9} {:>10}  ripeness",
-        "#", "object", "location", "position (m)", "Shore A", "Shore 00", "E (MPa)"
+        "{:<3} {:<11} {:<13} {:>24} {:>9} {:>9} {:>10} {:>13} {:>13}  ripeness",
+        "#",
+        "object",
+        "location",
+        "position (m)",
+        "Shore A",
+        "Shore 00",
+        "E (MPa)",
+        "68% (MPa)",
+        "95% (MPa)"
     );
+    let range = |r: [Option<f64>; 2]| match r {
+        [Some(lo), Some(hi)] => format!("{lo:.2}-{hi:.2}"),
+        [Some(lo), None] => format!("> {lo:.2}"),
+        _ => "-".into(),
+    };
     for (i, o) in a.objects.iter().enumerate() {
         let p = o.position_m;
         let (sa, s00, e) = match &o.hardness {
@@ -542,8 +591,11 @@ fn print_answer(a: &Answer) {
             None => ("-".into(), "-".into(), "-".into()),
         };
         let mark = if a.selected.contains(&i) { "*" } else { " " };
+        let (p68, p95) = o.interval.as_ref().map_or(("-".into(), "-".into()), |v| {
+            (range(v.p68_mpa), range(v.p95_mpa))
+        });
         println!(
-            "{mark}{i:<2} {:<11} {:<13} {:>24} {sa:>9} {s00:>9} {e:>10}  {}",
+            "{mark}{i:<2} {:<11} {:<13} {:>24} {sa:>9} {s00:>9} {e:>10} {p68:>13} {p95:>13}  {}",
             o.label,
             o.location,
             format!("({:+.3}, {:+.3}, {:.3})", p[0], p[1], p[2]),

@@ -429,7 +429,9 @@ pub fn run(args: &SessionCompare) -> Result<()> {
             spec.height_px
         );
     }
-    let estimator = args.estimator.open("--estimator")?;
+    let estimator = args
+        .estimator
+        .open("--estimator", args.fidelity.name(), None)?;
     let mut sim = SimDevices::with_sensor(&scene, seed, spec.clone(), args.fidelity)
         .with_context(|| format!("{scene_name}: the twin cannot stand it up"))?;
     let rebuilt = rebuild_frames(&mut sim, &manifest)?;

@@ -1,11 +1,13 @@
 //! `--estimator`: which hardness estimator reads the presses (`ask`, `serve`, `compare
-//! --session`, `eval scenarios`, `eval ripeness`).
+//! --session`, `eval scenarios`, `eval ripeness`, `eval fruits`), and the calibration its
+//! intervals come from (`--intervals`, or the one shipped for it at the twin's fidelity).
 
-use anyhow::{Result, bail};
-use std::path::PathBuf;
+use anyhow::{Context, Result, bail};
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 use tactex_core::estimate::{HardnessEstimator, HertzSlopeEstimator};
 use tactex_core::indentation_estimator::IndentationEstimator;
+use tactex_core::interval_calibration::{Calibrated, IntervalCalibration};
 
 /// A hardness estimator by name, or a trained model file.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,6 +24,32 @@ pub enum EstimatorChoice {
 
 /// What `--estimator` takes, for help texts and errors.
 pub const ESTIMATOR_VALUES: &str = "learned, indentation, hertz or FILE.onnx";
+
+/// Interval calibrations shipped with the binary, made by `tactex eval fruits --calibrate`
+/// on held-out presses: (estimator name, fidelity, file name, text).
+const BUILTIN_INTERVALS: &[(&str, &str, &str, &str)] = &[
+    (
+        LEARNED_NAME,
+        "layer",
+        "models/intervals/learned-layer.json",
+        include_str!("../models/intervals/learned-layer.json"),
+    ),
+    (
+        "indentation",
+        "layer",
+        "models/intervals/indentation-layer.json",
+        include_str!("../models/intervals/indentation-layer.json"),
+    ),
+    (
+        "hertz_slopes",
+        "layer",
+        "models/intervals/hertz-layer.json",
+        include_str!("../models/intervals/hertz-layer.json"),
+    ),
+];
+
+/// The built-in model's estimator name (`onnx_` and its card's model).
+const LEARNED_NAME: &str = "onnx_small";
 
 impl FromStr for EstimatorChoice {
     type Err = String;
@@ -40,9 +68,21 @@ impl FromStr for EstimatorChoice {
     }
 }
 
+pub type BoxedEstimator = Box<dyn HardnessEstimator + Send + Sync>;
+
 impl EstimatorChoice {
-    /// Loads the estimator; `flag` names the option in errors.
-    pub fn open(&self, flag: &str) -> Result<Box<dyn HardnessEstimator + Send + Sync>> {
+    /// The value of `--estimator` that names this choice.
+    pub fn flag_value(&self) -> String {
+        match self {
+            Self::Learned => "learned".into(),
+            Self::Indentation => "indentation".into(),
+            Self::Hertz => "hertz".into(),
+            Self::Model(path) => path.display().to_string(),
+        }
+    }
+
+    /// Loads the estimator with its own intervals; `flag` names the option in errors.
+    pub fn open_uncalibrated(&self, flag: &str) -> Result<BoxedEstimator> {
         Ok(match self {
             Self::Learned => Box::new(crate::learned_model::builtin_small()?),
             Self::Indentation => Box::new(IndentationEstimator::default()),
@@ -55,4 +95,71 @@ impl EstimatorChoice {
             }
         })
     }
+
+    /// Loads the estimator with calibrated intervals: from `intervals` (a file `eval fruits
+    /// --calibrate` wrote) when given, else the calibration shipped for it at `fidelity`,
+    /// else its own intervals, which say that they are not calibrated.
+    pub fn open(
+        &self,
+        flag: &str,
+        fidelity: &str,
+        intervals: Option<&Path>,
+    ) -> Result<BoxedEstimator> {
+        let inner = self.open_uncalibrated(flag)?;
+        let calibration = match intervals {
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .with_context(|| format!("--intervals {}: cannot read", path.display()))?;
+                let c =
+                    IntervalCalibration::parse(&text, &format!("--intervals {}", path.display()))?;
+                if c.estimator != inner.name() {
+                    bail!(
+                        "--intervals {}: calibrated for the {} estimator, not {}",
+                        path.display(),
+                        c.estimator,
+                        inner.name()
+                    );
+                }
+                Some(c)
+            }
+            None => builtin_intervals(inner.name(), fidelity, self)?,
+        };
+        Ok(match calibration {
+            Some(calibration) => Box::new(Calibrated { inner, calibration }),
+            None => inner,
+        })
+    }
+}
+
+/// The name of the calibration shipped for `choice` at `fidelity`, if one is.
+pub fn builtin_interval_file(choice: &EstimatorChoice, fidelity: &str) -> Option<&'static str> {
+    let name = match choice {
+        EstimatorChoice::Model(_) => return None,
+        EstimatorChoice::Learned => LEARNED_NAME,
+        EstimatorChoice::Indentation => "indentation",
+        EstimatorChoice::Hertz => "hertz_slopes",
+    };
+    BUILTIN_INTERVALS
+        .iter()
+        .find(|(e, f, _, _)| *e == name && *f == fidelity)
+        .map(|(_, _, file, _)| *file)
+}
+
+/// The shipped calibration of an estimator at a fidelity; a model file given by path has none
+/// (its name may be the built-in's, its residuals are not).
+fn builtin_intervals(
+    name: &str,
+    fidelity: &str,
+    choice: &EstimatorChoice,
+) -> Result<Option<IntervalCalibration>> {
+    if matches!(choice, EstimatorChoice::Model(_)) {
+        return Ok(None);
+    }
+    BUILTIN_INTERVALS
+        .iter()
+        .find(|(e, f, _, _)| *e == name && *f == fidelity)
+        .map(|(_, _, file, text)| {
+            IntervalCalibration::parse(text, &format!("{file} (built in)")).map_err(Into::into)
+        })
+        .transpose()
 }

@@ -318,9 +318,13 @@ pub fn facts(case: &Case, catalog: &FruitCatalog) -> Result<Facts> {
             label: t.label.clone(),
             location: t.location.clone(),
             hardness: Some(Hardness::ModulusMpa(t.modulus_mpa).into()),
-            modulus_interval_mpa: [
+            interval_68_mpa: [
                 Some(t.modulus_mpa * (1.0 - FACT_SE)),
                 Some(t.modulus_mpa * (1.0 + FACT_SE)),
+            ],
+            interval_95_mpa: [
+                Some(t.modulus_mpa * (1.0 - 2.0 * FACT_SE)),
+                Some(t.modulus_mpa * (1.0 + 2.0 * FACT_SE)),
             ],
             ripeness: t.ripeness.clone(),
             not_measured: None,

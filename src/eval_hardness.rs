@@ -75,7 +75,7 @@ struct HardnessEval {
 struct Prediction {
     estimator: String,
     shore_a: Option<f64>,
-    modulus_interval_mpa: Option<[Option<f64>; 2]>,
+    interval: Option<tactex_core::estimate::ModulusInterval>,
     evidence: Option<Evidence>,
     error: Option<String>,
 }
@@ -135,14 +135,14 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
                         Ok(h) => Prediction {
                             estimator: name,
                             shore_a: Some(h.hardness.shore_a()),
-                            modulus_interval_mpa: Some(h.modulus_interval_mpa),
+                            interval: Some(h.interval.clone()),
                             evidence: Some(h.evidence),
                             error: None,
                         },
                         Err(err) => Prediction {
                             estimator: name,
                             shore_a: None,
-                            modulus_interval_mpa: None,
+                            interval: None,
                             evidence: None,
                             error: Some(err.to_string()),
                         },

@@ -147,7 +147,7 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         }
         fruits.push(spec.clone());
     }
-    let estimator = args.estimator.open("--estimator")?;
+    let estimator = args.estimator.open("--estimator", fidelity.name(), None)?;
     let protocol = PressProtocol::default();
     let jobs: Vec<Job> = fruits
         .iter()

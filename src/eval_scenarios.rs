@@ -285,7 +285,11 @@ pub fn scenario(tier: u8, run: usize, seed: u64, catalog: &FruitCatalog) -> Resu
 /// Which report identifies which scene object: a report of the object's kind whose surface
 /// centroid (where the arm will touch) lies on the object in the clean render, as in
 /// `eval grounding`; the highest-scoring such report when there are several.
-fn match_reports(answer: &Answer, scenario: &Scenario, twin: &TwinAnswer) -> Vec<Option<usize>> {
+pub(crate) fn match_reports(
+    answer: &Answer,
+    kinds: &[String],
+    twin: &TwinAnswer,
+) -> Vec<Option<usize>> {
     let (k, to_camera) = (twin.intrinsics, twin.camera_pose.inverse());
     let id_under = |p: [f64; 3]| -> Option<usize> {
         let (u, v) = k.project(to_camera.transform_point(glam::DVec3::from_array(p)))?;
@@ -293,12 +297,12 @@ fn match_reports(answer: &Answer, scenario: &Scenario, twin: &TwinAnswer) -> Vec
         let id = inside.then(|| twin.instances.get_pixel(u as u32, v as u32)[0])?;
         (id > 0).then(|| id as usize - 1)
     };
-    let mut of_object: Vec<Option<usize>> = vec![None; scenario.kinds.len()];
+    let mut of_object: Vec<Option<usize>> = vec![None; kinds.len()];
     for (r, report) in answer.objects.iter().enumerate() {
         let Some(o) = id_under(report.surface_centroid_m) else {
             continue;
         };
-        if scenario.kinds[o] != report.label {
+        if kinds[o] != report.label {
             continue;
         }
         let better =
@@ -314,7 +318,7 @@ fn match_reports(answer: &Answer, scenario: &Scenario, twin: &TwinAnswer) -> Vec
 pub fn score(scenario: &Scenario, detector: &str, twin: &TwinAnswer) -> RunScore {
     let answer = &twin.answer;
     let centres = &twin.true_centres_m;
-    let of_object = match_reports(answer, scenario, twin);
+    let of_object = match_reports(answer, &scenario.kinds, twin);
     let text = answer.answer.to_lowercase();
     let estimate = |r: usize| {
         answer.objects[r]
@@ -570,7 +574,9 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
         .map(|spec| DetectorChoice::parse(spec))
         .collect::<Result<Vec<_>>>()?;
     let renderer = crate::ask::scene_renderer(args.device)?;
-    let estimator = args.estimator.open("--estimator")?;
+    let estimator = args
+        .estimator
+        .open("--estimator", args.fidelity.name(), None)?;
     let scenarios = tiers
         .iter()
         .flat_map(|&t| (0..args.runs).map(move |r| (t, r)))
@@ -683,7 +689,7 @@ mod tests {
                 hardness: Some(
                     Hardness::ModulusMpa(true_modulus(&sc.scene, i) * estimate_scale[i]).into(),
                 ),
-                modulus_interval_mpa: [None, None],
+                interval: None,
                 ripeness: None,
                 evidence: None,
                 contact_search_mm: None,
@@ -700,7 +706,8 @@ mod tests {
                 label: o.label.clone(),
                 location: o.location.clone(),
                 hardness: o.hardness,
-                modulus_interval_mpa: [None, None],
+                interval_68_mpa: [None, None],
+                interval_95_mpa: [None, None],
                 ripeness: None,
                 not_measured: None,
             })
@@ -722,6 +729,8 @@ mod tests {
                 timing: Vec::new(),
                 presses: Vec::new(),
             },
+            true_top_centres_m: centres.clone(),
+            touching: vec![false; centres.len()],
             true_centres_m: centres,
             instances,
             intrinsics: sim.camera.intrinsics(),

@@ -309,7 +309,8 @@ mod tests {
             label: label.into(),
             location: location_words(x, y),
             hardness: Some(Hardness::ModulusMpa(e).into()),
-            modulus_interval_mpa: [Some(e - 0.05), Some(e + 0.05)],
+            interval_68_mpa: [Some(e - 0.05), Some(e + 0.05)],
+            interval_95_mpa: [Some(e - 0.1), Some(e + 0.1)],
             ripeness: Some(r.into()),
             not_measured: None,
         };

@@ -19,6 +19,7 @@ mod detect_image;
 mod detector_choice;
 mod estimator_choice;
 mod eval_explanations;
+mod eval_fruits;
 mod eval_grounding;
 mod eval_hardness;
 mod eval_ripeness;
@@ -129,6 +130,9 @@ enum EvalCommand {
     Ripeness(eval_ripeness::RipenessEvalArgs),
     /// The paper's four query tiers end to end: object- and scenario-level success, latency.
     Scenarios(eval_scenarios::ScenarioEvalArgs),
+    /// The whole pipeline per catalog fruit kind, alone and on crowded tables: located,
+    /// measured, ln error and interval coverage (and `--calibrate`: the intervals' file).
+    Fruits(eval_fruits::FruitEvalArgs),
     /// The explainer alone: 100 prompts over random scenes, scored for accuracy,
     /// completeness and clarity against the truth.
     Explanations(eval_explanations::ExplanationEvalArgs),
@@ -259,6 +263,9 @@ fn main() -> ExitCode {
         Command::Eval {
             command: EvalCommand::Scenarios(args),
         } => eval_scenarios::run(&args),
+        Command::Eval {
+            command: EvalCommand::Fruits(args),
+        } => eval_fruits::run(&args),
         Command::Eval {
             command: EvalCommand::Explanations(args),
         } => eval_explanations::run(&args),

@@ -78,7 +78,41 @@ fn demo_scene_answers_the_softest_fruit_with_positions_hardness_and_latency() {
             "{o}"
         );
         assert_eq!(o["position_m"].as_array().unwrap().len(), 3);
+        // Each estimate carries its 68% and 95% intervals, nested around it, and what they
+        // rest on.
+        let e = modulus(o);
+        let [lo68, hi68, lo95, hi95] = [
+            ("p68_mpa", 0),
+            ("p68_mpa", 1),
+            ("p95_mpa", 0),
+            ("p95_mpa", 1),
+        ]
+        .map(|(k, i)| o["interval"][k][i].as_f64().unwrap());
+        assert!(lo95 <= lo68 && lo68 < e && e < hi68 && hi68 <= hi95, "{o}");
+        assert!(
+            o["interval"]["source"]
+                .as_str()
+                .unwrap()
+                .contains("calibrated on"),
+            "{o}"
+        );
+        assert!(
+            o["contact"]["fired_by"]
+                .as_array()
+                .is_some_and(|f| !f.is_empty()),
+            "{o}"
+        );
     }
+    // The answer names what it ran on.
+    assert_eq!(a["fidelity"], "layer");
+    assert_eq!(a["estimator"], "onnx_small");
+    assert!(
+        a["contact_criterion"]
+            .as_str()
+            .unwrap()
+            .contains("noise floor"),
+        "{a}"
+    );
 }
 
 #[test]
@@ -316,6 +350,24 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
 
     let e = fails(&["ask", "  "]);
     assert!(e.contains("prompt: empty"), "{e}");
+    // A bad flag value is clap's usage error (exit 2), naming the flag and the choices.
+    let out = tactex(&["ask", "--estimator", "magic", softest]);
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("--estimator") && e.contains("unknown estimator \"magic\""),
+        "{e}"
+    );
+    let e = fails(&["ask", "--intervals", "no/such/intervals.json", softest]);
+    assert!(
+        e.contains("--intervals no/such/intervals.json: cannot read"),
+        "{e}"
+    );
+    let e = fails(&["ask", "--intervals", "models/hardness-small.json", softest]);
+    assert!(
+        e.contains("--intervals models/hardness-small.json: "),
+        "{e}"
+    );
     let e = fails(&["ask", "How hard is the pineapple?"]);
     assert!(
         e.contains("prompt: 'pineapple' is not in the fruit catalog"),

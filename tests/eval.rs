@@ -1,5 +1,5 @@
-//! `tactex eval hardness`, `eval ripeness`, `eval grounding`, `eval scenarios` and `eval
-//! explanations` end to end on small runs: their JSON contracts, plots and raw records, tests
+//! `tactex eval hardness`, `eval ripeness`, `eval grounding`, `eval scenarios`, `eval fruits`
+//! and `eval explanations` end to end on small runs: their JSON contracts, plots and raw records, tests
 //! that recompute from the raw predictions, and bad input named.
 
 use std::process::Command;
@@ -362,5 +362,83 @@ fn explanations_of_the_template_are_accurate_and_complete_on_every_prompt_kind()
     bad_arguments_are_named(
         "explanations",
         &[(&["--prompts", "0"], "--prompts: must be at least 1")],
+    );
+}
+
+#[test]
+fn fruits_scores_each_kind_and_writes_tables_that_ask_answers_again() {
+    let (dir, v) = eval_json(&[
+        "fruits",
+        "--placements",
+        "2",
+        "--crowded",
+        "0",
+        "--kinds",
+        "strawberry,lime",
+    ]);
+    let kinds = v["kinds"].as_array().unwrap();
+    assert_eq!(kinds.len(), 2, "{v}");
+    for k in kinds {
+        assert_eq!(k["fruits"], 2, "{k}");
+        assert_eq!(k["located_and_measured"], 1.0, "{k}");
+        // Catalog fruit read by the calibrated default estimator: within 0.5 in ln E.
+        assert!(k["worst_abs_ln_error"].as_f64().unwrap() < 0.5, "{k}");
+    }
+    assert!(
+        v["intervals"]
+            .as_str()
+            .unwrap()
+            .contains("learned-layer.json"),
+        "{v}"
+    );
+    let rows: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("fruits.json")).unwrap()).unwrap();
+    let first = &rows[0];
+    for png in ["ln_error.png", "coverage.png", "estimate_vs_true.png"] {
+        assert!(dir.path().join(png).is_file(), "{png}");
+    }
+    // The written table is a scene file `ask` answers with the same estimate.
+    let scene = dir.path().join("scenes/table-0.toml");
+    let seed = first["seed"].as_u64().unwrap().to_string();
+    let o = tactex(&[
+        "ask",
+        "--json",
+        "--reproducible",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--seed",
+        &seed,
+        "Describe the hardness of all the fruits.",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let a: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let e = a["objects"][0]["hardness"]["modulus_mpa"].as_f64().unwrap();
+    assert!(
+        (e - first["estimate_mpa"].as_f64().unwrap()).abs() < 1e-9,
+        "{a}"
+    );
+
+    bad_arguments_are_named(
+        "fruits",
+        &[
+            (&["--kinds", "durian"], "--kinds: no fruit \"durian\""),
+            (
+                &[
+                    "--placements",
+                    "1",
+                    "--crowded",
+                    "0",
+                    "--kinds",
+                    "lime",
+                    "--calibrate",
+                    "c.json",
+                ],
+                "at least 40",
+            ),
+            (
+                &["--placements", "0", "--crowded", "0"],
+                "--placements, --crowded",
+            ),
+        ],
     );
 }

@@ -80,10 +80,54 @@ pub struct PhysicsEvidence {
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct HardnessEstimate {
     pub hardness: Hardness,
-    /// One-standard-error interval of the modulus in MPa (upper None: not distinguishable from rigid).
-    pub modulus_interval_mpa: [Option<f64>; 2],
+    pub interval: ModulusInterval,
     pub evidence: Evidence,
 }
+
+/// How far the true modulus may lie from an estimate: a 68% and a 95% interval (MPa; an upper
+/// bound of None: not distinguishable from rigid), and what they rest on. An estimator gives
+/// its own (its fit's or its model card's error); `interval_calibration` replaces them with
+/// intervals whose coverage was measured on held-out presses.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct ModulusInterval {
+    pub p68_mpa: [Option<f64>; 2],
+    pub p95_mpa: [Option<f64>; 2],
+    pub source: String,
+}
+
+/// Normal quantile of the two-sided 95% interval.
+pub const Z95: f64 = 1.959_964;
+
+impl ModulusInterval {
+    /// A log-normal interval: `ln_modulus` +- one and +- 1.96 standard deviations.
+    pub fn log_normal(ln_modulus: f64, ln_sigma: f64, source: impl Into<String>) -> Self {
+        let at = |k: f64| Some((ln_modulus + k * ln_sigma).exp());
+        Self {
+            p68_mpa: [at(-1.0), at(1.0)],
+            p95_mpa: [at(-Z95), at(Z95)],
+            source: source.into(),
+        }
+    }
+
+    /// No interval at all (a test's or a hand-made report's).
+    pub fn none(source: impl Into<String>) -> Self {
+        Self {
+            p68_mpa: [None, None],
+            p95_mpa: [None, None],
+            source: source.into(),
+        }
+    }
+
+    /// Whether the 68% (`wide` false) or 95% interval holds `modulus_mpa` (infinite: rigid).
+    pub fn holds(&self, modulus_mpa: f64, wide: bool) -> Option<bool> {
+        let [lo, hi] = if wide { self.p95_mpa } else { self.p68_mpa };
+        let lo = lo?;
+        Some(modulus_mpa >= lo && hi.is_none_or(|hi| modulus_mpa <= hi))
+    }
+}
+
+/// What an estimator's own interval rests on, for `ModulusInterval::source`.
+pub const OWN_FIT_INTERVAL: &str = "the fit's own standard error (not calibrated)";
 
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum EstimateError {
@@ -102,6 +146,21 @@ pub trait HardnessEstimator {
         press: &PressSequence,
         spec: &TactileSpec,
     ) -> Result<HardnessEstimate, EstimateError>;
+}
+
+/// A boxed estimator estimates as the one inside (the binary picks one at run time).
+impl<T: HardnessEstimator + ?Sized> HardnessEstimator for Box<T> {
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+
+    fn estimate(
+        &self,
+        press: &PressSequence,
+        spec: &TactileSpec,
+    ) -> Result<HardnessEstimate, EstimateError> {
+        (**self).estimate(press, spec)
+    }
 }
 
 /// Physics inversion of the Hertz compliance split from the slope field (see the module docs).
@@ -289,7 +348,14 @@ impl HardnessEstimator for HertzSlopeEstimator {
         };
         Ok(HardnessEstimate {
             hardness,
-            modulus_interval_mpa: [to_modulus(share - share_se), to_modulus(share + share_se)],
+            interval: ModulusInterval {
+                p68_mpa: [to_modulus(share - share_se), to_modulus(share + share_se)],
+                p95_mpa: [
+                    to_modulus(share - Z95 * share_se),
+                    to_modulus(share + Z95 * share_se),
+                ],
+                source: OWN_FIT_INTERVAL.into(),
+            },
             evidence: Evidence::Physics(PhysicsEvidence {
                 gel_share: share,
                 gel_share_se: share_se,

@@ -9,7 +9,8 @@
 //! modulus.
 
 use crate::estimate::{
-    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, PhysicsEvidence, PressSequence,
+    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval,
+    OWN_FIT_INTERVAL, PhysicsEvidence, PressSequence, Z95,
 };
 use crate::gel_share_fit::{fit_gel_share, gel_share};
 use crate::hardness::Hardness;
@@ -123,6 +124,9 @@ impl HardnessEstimator for IndentationEstimator {
             None => Hardness::Rigid,
         };
         let [rho_lo, rho_hi] = fit.compliance_ratio_interval;
+        // The fit's interval is one standard error in ln rho; the 95% one widens it in ln.
+        let rho = fit.compliance_ratio;
+        let widen = |r: f64| rho * (r / rho).powf(Z95);
         let last = *used.last().expect("at least two frames used");
         let share_at = |rho: f64| gel_share(layer[last], rho);
         let last_approach = fit.first_contact_approach_mm + press.travel_mm[last];
@@ -130,7 +134,11 @@ impl HardnessEstimator for IndentationEstimator {
         Ok(HardnessEstimate {
             hardness,
             // A softer object has the larger compliance ratio.
-            modulus_interval_mpa: [to_modulus(rho_hi), to_modulus(rho_lo)],
+            interval: ModulusInterval {
+                p68_mpa: [to_modulus(rho_hi), to_modulus(rho_lo)],
+                p95_mpa: [to_modulus(widen(rho_hi)), to_modulus(widen(rho_lo))],
+                source: OWN_FIT_INTERVAL.into(),
+            },
             evidence: Evidence::Physics(PhysicsEvidence {
                 gel_share: share_at(fit.compliance_ratio),
                 // Carried over from the ratio's interval.

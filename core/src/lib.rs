@@ -17,6 +17,7 @@ pub mod geometry;
 pub mod hardness;
 pub mod hertz;
 pub mod indentation_estimator;
+pub mod interval_calibration;
 pub mod layer_compliance;
 pub mod onnx_estimator;
 pub mod onnx_metadata;

@@ -8,7 +8,8 @@
 //! held-out RMSE with the spread of the answers over the four flips of the input.
 
 use crate::estimate::{
-    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, LearnedEvidence, PressSequence,
+    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, LearnedEvidence, ModulusInterval,
+    PressSequence,
 };
 use crate::hardness::Hardness;
 use crate::onnx_runtime::{OnnxError, backend, open_session};
@@ -245,7 +246,11 @@ impl HardnessEstimator for OnnxEstimator {
         })?;
         Ok(HardnessEstimate {
             hardness,
-            modulus_interval_mpa: [Some((mean - sigma).exp()), Some((mean + sigma).exp())],
+            interval: ModulusInterval::log_normal(
+                mean,
+                sigma,
+                "the model card's held-out RMSE and the flip spread (not calibrated)",
+            ),
             evidence: Evidence::Learned(LearnedEvidence {
                 model: self.label.clone(),
                 backend: self.backend.clone(),

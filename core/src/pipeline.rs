@@ -3,7 +3,7 @@
 
 use crate::catalog::FruitCatalog;
 use crate::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
-use crate::estimate::{Evidence, HardnessEstimator, PressSequence};
+use crate::estimate::{Evidence, HardnessEstimator, ModulusInterval, PressSequence};
 use crate::explain::{self, Explainer, Facts, Measured, location_words};
 use crate::frames::TactileFrame;
 use crate::geometry::Pose;
@@ -81,7 +81,8 @@ pub struct ObjectReport {
     pub surface_centroid_m: [f64; 3],
     pub location: String,
     pub hardness: Option<HardnessReport>,
-    pub modulus_interval_mpa: [Option<f64>; 2],
+    /// The estimate's 68% and 95% intervals and what they rest on.
+    pub interval: Option<ModulusInterval>,
     pub ripeness: Option<String>,
     pub evidence: Option<Evidence>,
     /// Press facts: travel from the search start to the first contact frame, and the contact
@@ -330,7 +331,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
             surface_centroid_m: target.surface.to_array(),
             location: location_words(target.centre.x, target.centre.y),
             hardness: None,
-            modulus_interval_mpa: [None, None],
+            interval: None,
             ripeness: None,
             evidence: None,
             contact_search_mm: None,
@@ -345,7 +346,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
                 match estimator.estimate(&p.sequence, tactile.spec()) {
                     Ok(est) => {
                         report.hardness = Some(est.hardness.into());
-                        report.modulus_interval_mpa = est.modulus_interval_mpa;
+                        report.interval = Some(est.interval);
                         report.ripeness = catalog
                             .get(&target.label)
                             .filter(|f| f.has_ripeness())
@@ -373,7 +374,8 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
             label: o.label.clone(),
             location: o.location.clone(),
             hardness: o.hardness,
-            modulus_interval_mpa: o.modulus_interval_mpa,
+            interval_68_mpa: o.interval.as_ref().map_or([None, None], |i| i.p68_mpa),
+            interval_95_mpa: o.interval.as_ref().map_or([None, None], |i| i.p95_mpa),
             ripeness: o.ripeness.clone(),
             not_measured: o.not_measured.as_ref().map(|n| n.to_string()),
         })
@@ -798,7 +800,7 @@ mod tests {
             assert_eq!(press.frames.len(), 8);
             Ok(HardnessEstimate {
                 hardness: Hardness::ModulusMpa(2.0),
-                modulus_interval_mpa: [Some(1.8), Some(2.2)],
+                interval: ModulusInterval::log_normal(2f64.ln(), 0.1, "test"),
                 evidence: Evidence::Physics(PhysicsEvidence {
                     gel_share: 0.1,
                     gel_share_se: 0.0,

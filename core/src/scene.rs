@@ -11,6 +11,7 @@
 //! yaw_deg = 30                   # optional
 //! ripeness = "ripe"              # optional: a catalog stage
 //! hardness = "35A"               # optional, overrides ripeness; or modulus_mpa = 0.8
+//! size_m = [0.19, 0.06, 0.036]   # optional for a fruit: its own size, not the catalog's
 //! ```
 //! Every error names the file and the field (`objects[2].ripeness`).
 
@@ -132,6 +133,80 @@ const DEFAULT_OBJECT_COLOR: [f64; 3] = [0.70, 0.70, 0.72];
 const DEFAULT_POISSON: f64 = 0.35;
 
 impl Scene {
+    /// The scene as a scene file that loads back to it (a random scene saved so that `ask
+    /// --scene` can replay it). The camera is written as its position, the point it looks at
+    /// on the table plane, and its intrinsics.
+    pub fn to_toml(&self) -> String {
+        let v3 = |v: [f64; 3]| format!("[{:?}, {:?}, {:?}]", v[0], v[1], v[2]);
+        let eye = self.camera_pose.position;
+        let forward = self.camera_pose.rotation * DVec3::Z;
+        // Where the optical axis meets the table (or 1 m ahead of a camera looking up).
+        let reach = if forward.z < -1e-9 {
+            -eye.z / forward.z
+        } else {
+            1.0
+        };
+        let k = &self.intrinsics;
+        let mut out = format!("name = {:?}\n\n[camera]\n", self.name);
+        out += &format!("position_m = {}\n", v3(eye.to_array()));
+        out += &format!("look_at_m = {}\n", v3((eye + forward * reach).to_array()));
+        out += &format!(
+            "intrinsics = {{ width = {}, height = {}, fx = {:?}, fy = {:?}, cx = {:?}, cy = {:?} }}\n",
+            k.width, k.height, k.fx, k.fy, k.cx, k.cy
+        );
+        out += &format!(
+            "\n[table]\nsize_m = [{:?}, {:?}]\ncolor = {}\n",
+            self.table.size_m[0],
+            self.table.size_m[1],
+            v3(self.table.color)
+        );
+        for o in &self.objects {
+            out += "\n[[objects]]\n";
+            match &o.kind {
+                ObjectKind::Fruit { name, size_m, .. } => {
+                    out += &format!("kind = {name:?}\nsize_m = {}\n", v3(*size_m));
+                }
+                ObjectKind::Sphere { radius_m } => {
+                    out += &format!("kind = \"sphere\"\nradius_m = {radius_m:?}\n");
+                }
+                ObjectKind::Ellipsoid { radii_m } => {
+                    out += &format!("kind = \"ellipsoid\"\nradii_m = {}\n", v3(*radii_m));
+                }
+                ObjectKind::Box { size_m } => {
+                    out += &format!("kind = \"box\"\nsize_m = {}\n", v3(*size_m));
+                }
+                ObjectKind::Mesh { path, scale } => {
+                    out += &format!(
+                        "kind = \"mesh\"\nmesh = {:?}\nscale = {scale:?}\n",
+                        path.display().to_string()
+                    );
+                }
+            }
+            if !matches!(o.kind, ObjectKind::Fruit { .. }) || o.label != self.fruit_name(o) {
+                out += &format!("label = {:?}\n", o.label);
+            }
+            out += &format!(
+                "position_m = [{:?}, {:?}]\nyaw_deg = {:?}\n",
+                o.position_m[0], o.position_m[1], o.yaw_deg
+            );
+            out += &match o.hardness {
+                Hardness::ModulusMpa(e) => format!("modulus_mpa = {e:?}\n"),
+                Hardness::ShoreA(v) => format!("hardness = \"{v:?} A\"\n"),
+                Hardness::Shore00(v) => format!("hardness = \"{v:?} 00\"\n"),
+                Hardness::Rigid => "hardness = \"rigid\"\n".into(),
+            };
+            out += &format!("color = {}\npoisson = {:?}\n", v3(o.color), o.poisson);
+        }
+        out
+    }
+
+    fn fruit_name<'o>(&self, o: &'o SceneObject) -> &'o str {
+        match &o.kind {
+            ObjectKind::Fruit { name, .. } => name,
+            _ => &o.label,
+        }
+    }
+
     pub fn load(path: &Path, catalog: &FruitCatalog) -> Result<Scene, SceneError> {
         let shown = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| SceneError {
@@ -401,10 +476,14 @@ impl Scene {
                 let color = o
                     .color
                     .unwrap_or(fruit.stage(&ripeness).map_or(stage.color, |s| s.color));
+                let size_m = match o.size_m {
+                    Some(size) => need3("size_m", Some(size))?,
+                    None => fruit.size_m,
+                };
                 let kind = ObjectKind::Fruit {
                     name: fruit.name.clone(),
                     shape: fruit.shape,
-                    size_m: fruit.size_m,
+                    size_m,
                 };
                 (kind, fruit.name.clone(), hardness, Some(ripeness), color)
             }
@@ -436,6 +515,43 @@ mod tests {
 
     fn parse(text: &str) -> Result<Scene, SceneError> {
         Scene::parse(text, Path::new("t.toml"), &FruitCatalog::builtin())
+    }
+
+    #[test]
+    fn a_written_scene_loads_back_to_itself() {
+        let s = parse(
+            r#"name = "written"
+            [camera]
+            position_m = [0.1, -0.05, 0.65]
+            look_at_m = [0.02, 0.01, 0.0]
+            [[objects]]
+            kind = "banana"
+            position_m = [0.1, -0.05]
+            yaw_deg = 33.3
+            size_m = [0.2, 0.055, 0.04]
+            modulus_mpa = 0.61
+            [[objects]]
+            kind = "box"
+            size_m = [0.04, 0.05, 0.03]
+            hardness = "rigid"
+            position_m = [-0.1, 0.1]
+            label = "block"
+            "#,
+        )
+        .unwrap();
+        let back = parse(&s.to_toml()).unwrap();
+        assert_eq!(back.objects, s.objects);
+        assert_eq!(back.table, s.table);
+        assert_eq!(back.intrinsics, s.intrinsics);
+        let (a, b) = (back.camera_pose, s.camera_pose);
+        assert!(a.position.distance(b.position) < 1e-12);
+        assert!(a.rotation.angle_between(b.rotation) < 1e-6);
+        // A fruit's own size replaces the catalog's; a bad one names the field.
+        let e = parse(
+            "name = \"x\"\n[[objects]]\nkind = \"lime\"\nsize_m = [0.05, -1, 0.05]\nposition_m = [0, 0]\n",
+        )
+        .unwrap_err();
+        assert_eq!(e.field, "objects[0].size_m", "{e}");
     }
 
     #[test]

@@ -85,7 +85,7 @@ fn probe_model_output_is_the_known_function_of_the_picked_frames() {
     // Every probe term is an image mean, so the four flips agree and the interval is the
     // card's held-out RMSE (0.25 in ln E) either side.
     assert!(ev.flip_spread_ln < 1e-6, "spread {}", ev.flip_spread_ln);
-    let [lo, hi] = got.modulus_interval_mpa;
+    let [lo, hi] = got.interval.p68_mpa;
     assert!((lo.unwrap().ln() - (expected_ln - 0.25)).abs() < 1e-5);
     assert!((hi.unwrap().ln() - (expected_ln + 0.25)).abs() < 1e-5);
 }

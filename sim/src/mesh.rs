@@ -42,6 +42,30 @@ impl TriMesh {
         self
     }
 
+    /// The centre of the mesh's outline seen from above (x, y of the centroid of its
+    /// projected upward-facing area; z its highest point): where a top-down camera's mask of
+    /// it is centred. A curved banana's box centre lies off the fruit; this does not.
+    pub fn top_view_centre(&self) -> DVec3 {
+        let (mut sum, mut area) = (DVec3::ZERO, 0.0);
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| self.vertices[i as usize]);
+            // Twice the projected area, signed: positive where the face looks up.
+            let up = (b - a).cross(c - a).z;
+            if up > 0.0 {
+                sum += (a + b + c) / 3.0 * up;
+                area += up;
+            }
+        }
+        let top = self.bounds().1.z;
+        if area > 0.0 {
+            let c = sum / area;
+            DVec3::new(c.x, c.y, top)
+        } else {
+            let (lo, hi) = self.bounds();
+            DVec3::new((lo.x + hi.x) / 2.0, (lo.y + hi.y) / 2.0, top)
+        }
+    }
+
     pub fn transformed(&self, rotation: DQuat, translation: DVec3) -> TriMesh {
         TriMesh {
             vertices: self

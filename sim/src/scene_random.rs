@@ -21,6 +21,10 @@ pub struct Variation {
     pub gap_m: f64,
     /// Margin from the table edge (m).
     pub margin_m: f64,
+    /// Share of the fruits after the first that are put against an earlier one (their
+    /// outlines overlapping slightly, so that the physics settles them touching): crowded
+    /// tables.
+    pub touching_share: f64,
 }
 
 impl Default for Variation {
@@ -31,6 +35,7 @@ impl Default for Variation {
             channel_sigma: 0.025,
             gap_m: 0.015,
             margin_m: 0.03,
+            touching_share: 0.0,
         }
     }
 }
@@ -89,26 +94,63 @@ pub fn random_scene(
             size_m[0] / 2.0 + variation.gap_m / 2.0,
             size_m[1] / 2.0 + variation.gap_m / 2.0,
         ];
-        let spot = (0..2000).find_map(|_| {
-            let yaw: f64 = rng.random_range(-180.0..180.0);
+        let semi = [size_m[0] / 2.0, size_m[1] / 2.0];
+        // Where a footprint of this yaw may have its centre: [lo_x, hi_x, lo_y, hi_y].
+        let room = |yaw: f64| {
             let (c, s) = (yaw.to_radians().cos().abs(), yaw.to_radians().sin().abs());
             let reach = [c * half[0] + s * half[1], s * half[0] + c * half[1]];
-            let lo_x = (-tw / 2.0 + variation.margin_m).max(x_min_view) + reach[0];
-            let hi_x = tw / 2.0 - variation.margin_m - reach[0];
-            let lo_y = -th / 2.0 + variation.margin_m + reach[1];
-            let hi_y = th / 2.0 - variation.margin_m - reach[1];
-            if lo_x >= hi_x || lo_y >= hi_y {
-                return None;
-            }
-            let here = Footprint {
-                centre: [rng.random_range(lo_x..hi_x), rng.random_range(lo_y..hi_y)],
+            [
+                (-tw / 2.0 + variation.margin_m).max(x_min_view) + reach[0],
+                tw / 2.0 - variation.margin_m - reach[0],
+                -th / 2.0 + variation.margin_m + reach[1],
+                th / 2.0 - variation.margin_m - reach[1],
+            ]
+        };
+        // Scenes without touching fruit draw exactly as before the option existed.
+        let against = variation.touching_share > 0.0
+            && !placed.is_empty()
+            && rng.random::<f64>() < variation.touching_share;
+        let beside = (0..if against { 500 } else { 0 }).find_map(|_| {
+            let anchor = rng.random_range(0..placed.len());
+            let yaw: f64 = rng.random_range(-180.0..180.0);
+            let angle: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+            let dir = [angle.cos(), angle.sin()];
+            let mut here = Footprint {
+                centre: [0.0, 0.0],
                 half,
+                semi,
                 yaw_rad: yaw.to_radians(),
             };
-            placed
+            let a = &placed[anchor];
+            let reach = a.radius_along(dir) + here.radius_along(dir);
+            here.centre = [a.centre[0] + dir[0] * reach, a.centre[1] + dir[1] * reach];
+            let [lo_x, hi_x, lo_y, hi_y] = room(yaw);
+            let inside =
+                (lo_x..=hi_x).contains(&here.centre[0]) && (lo_y..=hi_y).contains(&here.centre[1]);
+            let free = placed
                 .iter()
-                .all(|p| !p.overlaps(&here))
-                .then_some((here, yaw))
+                .enumerate()
+                .all(|(i, p)| i == anchor || !p.overlaps(&here));
+            (inside && free).then_some((here, yaw))
+        });
+        let spot = beside.or_else(|| {
+            (0..2000).find_map(|_| {
+                let yaw: f64 = rng.random_range(-180.0..180.0);
+                let [lo_x, hi_x, lo_y, hi_y] = room(yaw);
+                if lo_x >= hi_x || lo_y >= hi_y {
+                    return None;
+                }
+                let here = Footprint {
+                    centre: [rng.random_range(lo_x..hi_x), rng.random_range(lo_y..hi_y)],
+                    half,
+                    semi,
+                    yaw_rad: yaw.to_radians(),
+                };
+                placed
+                    .iter()
+                    .all(|p| !p.overlaps(&here))
+                    .then_some((here, yaw))
+            })
         });
         let Some((footprint, yaw_deg)) = spot else {
             return Err(RandomSceneError::NoRoom { count: kinds.len() });
@@ -137,15 +179,24 @@ pub fn random_scene(
     Ok(scene)
 }
 
-/// A fruit's footprint on the table: a rectangle of half extents along its length and width,
-/// turned by its yaw.
+/// A fruit's footprint on the table: a rectangle of half extents along its length and width
+/// (with half the gap), turned by its yaw; `semi` the semi-axes of the outline's ellipse.
 struct Footprint {
     centre: [f64; 2],
     half: [f64; 2],
+    semi: [f64; 2],
     yaw_rad: f64,
 }
 
 impl Footprint {
+    /// Distance from the centre to the outline ellipse along the unit direction `dir` (either
+    /// way: the ellipse is symmetric).
+    fn radius_along(&self, dir: [f64; 2]) -> f64 {
+        let [u, v] = self.axes();
+        let (du, dv) = (dir[0] * u[0] + dir[1] * u[1], dir[0] * v[0] + dir[1] * v[1]);
+        1.0 / ((du / self.semi[0]).powi(2) + (dv / self.semi[1]).powi(2)).sqrt()
+    }
+
     fn axes(&self) -> [[f64; 2]; 2] {
         let (c, s) = (self.yaw_rad.cos(), self.yaw_rad.sin());
         [[c, s], [-s, c]]

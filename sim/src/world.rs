@@ -174,6 +174,37 @@ impl SimWorld {
         })
     }
 
+    /// For each object, whether another comes within `gap_m` of it (vertex to vertex: the
+    /// meshes' vertices lie under 3 mm apart, so a touch reads as under 3 mm).
+    pub fn touching(&self, gap_m: f64) -> Vec<bool> {
+        let n = self.objects.len();
+        let mut touching = vec![false; n];
+        let near = |m: &crate::mesh::TriMesh, (lo, hi): (DVec3, DVec3)| -> Vec<DVec3> {
+            let pad = DVec3::splat(gap_m);
+            m.vertices
+                .iter()
+                .filter(|v| v.cmpge(lo - pad).all() && v.cmple(hi + pad).all())
+                .copied()
+                .collect()
+        };
+        for i in 0..n {
+            for j in i + 1..n {
+                let (a, b) = (&self.objects[i].mesh, &self.objects[j].mesh);
+                let (a_near, b_near) = (near(a, b.bounds()), near(b, a.bounds()));
+                let close = a_near.iter().any(|p| {
+                    b_near
+                        .iter()
+                        .any(|q| p.distance_squared(*q) < gap_m * gap_m)
+                });
+                if close {
+                    touching[i] = true;
+                    touching[j] = true;
+                }
+            }
+        }
+        touching
+    }
+
     pub fn shared(self) -> SharedWorld {
         Arc::new(Mutex::new(self))
     }

@@ -3,7 +3,7 @@
 //! must not drop an object that answers the question, its hardness, its ripeness or a kind
 //! that was not found.
 
-use super::template::uncertainty_mpa;
+use super::template::{likely_range_mpa, range_percent};
 use super::{Facts, Measured};
 use crate::catalog::FruitCatalog;
 
@@ -113,7 +113,7 @@ fn words(text: &str) -> Vec<String> {
 }
 
 /// The hardness values a reply may quote for one object: modulus (MPa, and kPa / Pa), Shore
-/// A and 00, the interval ends and half-width.
+/// A and 00, and the ends of its intervals.
 fn hardness_values(m: &Measured) -> Vec<f64> {
     let Some(h) = m.hardness else {
         return Vec::new();
@@ -122,14 +122,17 @@ fn hardness_values(m: &Measured) -> Vec<f64> {
     if let Some(e) = h.modulus_mpa {
         v.extend([e, e * 1e3, e * 1e6]);
     }
-    v.extend(m.modulus_interval_mpa.iter().flatten());
-    if let Some(u) = uncertainty_mpa(m) {
-        v.push(u);
-        if let Some(e) = h.modulus_mpa.filter(|&e| e > 0.0) {
-            v.push(100.0 * u / e);
-        }
-    }
+    v.extend(m.interval_68_mpa.iter().chain(&m.interval_95_mpa).flatten());
     v
+}
+
+/// The percentages a reply may quote for one object: the ends of its likely range relative to
+/// the estimate, as the template words them.
+fn percent_values(m: &Measured) -> Vec<f64> {
+    match (m.hardness.and_then(|h| h.modulus_mpa), likely_range_mpa(m)) {
+        (Some(e), Some(r)) if e > 0.0 => range_percent(e, r).map(f64::abs).to_vec(),
+        _ => Vec::new(),
+    }
 }
 
 /// Checks `reply` against `facts`: nothing invented, nothing dropped; the first problem
@@ -162,6 +165,7 @@ pub fn check_invented(
         }
     }
     let hardness: Vec<f64> = facts.objects.iter().flat_map(hardness_values).collect();
+    let percents: Vec<f64> = facts.objects.iter().flat_map(percent_values).collect();
     let counts: Vec<f64> = [
         Some(facts.objects.len()),
         Some(facts.selected.len()),
@@ -173,7 +177,9 @@ pub fn check_invented(
     .map(|n| n as f64)
     .collect();
     for (n, unit) in numbers_with_units(reply) {
-        let grounded = if HARDNESS_UNITS.contains(&unit.as_str()) || unit == PERCENT {
+        let grounded = if unit == PERCENT {
+            percents.iter().any(|&v| n.matches(v))
+        } else if HARDNESS_UNITS.contains(&unit.as_str()) {
             hardness.iter().any(|&v| n.matches(v))
         } else {
             hardness.iter().chain(&counts).any(|&v| n.matches(v))
@@ -263,7 +269,8 @@ mod tests {
             label: label.into(),
             location: location_words(x, y),
             hardness: Some(Hardness::ModulusMpa(e).into()),
-            modulus_interval_mpa: [Some(e * 0.9), Some(e * 1.1)],
+            interval_68_mpa: [Some(e * 0.9), Some(e * 1.1)],
+            interval_95_mpa: [Some(e * 0.8), Some(e * 1.2)],
             ripeness: Some(r.into()),
             not_measured: None,
         };

@@ -2,7 +2,7 @@
 //! reply checkable by `grounded::check`, and the facts as JSON. Pure text; the client that
 //! sends them is the binary's.
 
-use super::template::{shore_words, uncertainty_mpa, uncertainty_percent};
+use super::template::{likely_range_mpa, range_words, shore_words};
 use super::{Facts, Measured};
 use serde_json::{Value, json};
 
@@ -24,7 +24,7 @@ fn object(i: usize, m: &Measured, facts: &Facts) -> Value {
             json!({
                 "shore": shore_words(&h),
                 "modulus": format!("{e:.2} MPa"),
-                "uncertainty": uncertainty_mpa(m).map(|u| format!("± {}", uncertainty_percent(e, u))),
+                "likely_range_68_percent": likely_range_mpa(m).map(range_words),
             })
         }
     });
@@ -74,7 +74,8 @@ mod tests {
                 label: "banana".into(),
                 location: "left front".into(),
                 hardness: Some(Hardness::ModulusMpa(0.8).into()),
-                modulus_interval_mpa: [Some(0.72), Some(0.88)],
+                interval_68_mpa: [Some(0.72), Some(0.88)],
+                interval_95_mpa: [Some(0.6), Some(1.0)],
                 ripeness: Some("ripe".into()),
                 not_measured: None,
             }],
@@ -88,7 +89,7 @@ mod tests {
             "\"label\":\"banana\"",
             "\"location\":\"left front\"",
             "0.80 MPa",
-            "± 10%",
+            "\"likely_range_68_percent\":\"0.72 MPa to 0.88 MPa\"",
             "24 Shore A",
             "\"ripeness\":\"ripe\"",
             "\"not_found\":[\"kiwi\"]",

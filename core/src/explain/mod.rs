@@ -22,8 +22,9 @@ pub struct Measured {
     pub label: String,
     pub location: String,
     pub hardness: Option<HardnessReport>,
-    /// One-standard-error modulus interval (MPa).
-    pub modulus_interval_mpa: [Option<f64>; 2],
+    /// The 68% and 95% modulus intervals (MPa; upper None: rigid or unbounded).
+    pub interval_68_mpa: [Option<f64>; 2],
+    pub interval_95_mpa: [Option<f64>; 2],
     pub ripeness: Option<String>,
     /// Why there is no hardness, when there is none (a sentence fragment).
     pub not_measured: Option<String>,

@@ -1,5 +1,5 @@
 //! The template explainer: deterministic, offline text from the measured result, with each
-//! hardness given with its one-standard-error uncertainty.
+//! hardness given with its likely range (the calibrated 68% interval).
 
 use super::{Explainer, Explanation, Facts, Measured, stiffness};
 use crate::hardness::HardnessReport;
@@ -28,33 +28,36 @@ impl Explainer for TemplateExplainer {
     }
 }
 
-/// Half the one-standard-error interval (MPa), when the estimator gave one.
-pub fn uncertainty_mpa(m: &Measured) -> Option<f64> {
-    match m.modulus_interval_mpa {
-        [Some(lo), Some(hi)] if hi >= lo && hi.is_finite() => Some((hi - lo) / 2.0),
+/// The 68% interval (MPa) when it is bounded on both sides.
+pub fn likely_range_mpa(m: &Measured) -> Option<[f64; 2]> {
+    match m.interval_68_mpa {
+        [Some(lo), Some(hi)] if hi >= lo && hi.is_finite() => Some([lo, hi]),
         _ => None,
     }
 }
 
-/// The uncertainty as a share of the modulus, written as a percentage ("8%", "0.3%").
-pub fn uncertainty_percent(e: f64, uncertainty_mpa: f64) -> String {
-    let pct = 100.0 * uncertainty_mpa / e;
-    if pct < 1.0 {
-        format!("{pct:.1}%")
-    } else {
-        format!("{pct:.0}%")
-    }
+/// A modulus range in words, each number with its unit: "1.21 MPa to 1.72 MPa".
+pub fn range_words([lo, hi]: [f64; 2]) -> String {
+    format!("{lo:.2} MPa to {hi:.2} MPa")
 }
 
-/// "36 Shore A (1.46 MPa ± 8%)", "55 Shore 00 (0.29 MPa)", "rigid". The percentage is the
-/// estimator's one standard error, relative: a fit's error can be far below 0.01 MPa.
-pub fn describe_hardness(h: &HardnessReport, uncertainty_mpa: Option<f64>) -> String {
+/// The ends of a range around `e` in percent of it, as the answer words them: [-9, 7].
+pub fn range_percent(e: f64, [lo, hi]: [f64; 2]) -> [f64; 2] {
+    [lo, hi].map(|v| (100.0 * (v / e - 1.0)).round())
+}
+
+/// "36 Shore A (1.46 MPa, likely -9% to +7%)", "55 Shore 00 (0.29 MPa)", "rigid". The range
+/// is the 68% interval, whose coverage is measured (`eval fruits`), relative to the estimate.
+pub fn describe_hardness(h: &HardnessReport, likely: Option<[f64; 2]>) -> String {
     let Some(e) = h.modulus_mpa else {
         return "rigid".into();
     };
-    let modulus = match uncertainty_mpa {
-        Some(u) if e > 0.0 => format!("{e:.2} MPa ± {}", uncertainty_percent(e, u)),
-        _ => format!("{e:.2} MPa"),
+    let modulus = match likely.filter(|_| e > 0.0) {
+        Some(r) => {
+            let [lo, hi] = range_percent(e, r);
+            format!("{e:.2} MPa, likely {lo:+.0}% to {hi:+.0}%")
+        }
+        None => format!("{e:.2} MPa"),
     };
     format!("{} ({modulus})", shore_words(h))
 }
@@ -72,7 +75,7 @@ pub fn shore_words(h: &HardnessReport) -> String {
 fn hardness_of(m: &Measured) -> Option<String> {
     m.hardness
         .as_ref()
-        .map(|h| describe_hardness(h, uncertainty_mpa(m)))
+        .map(|h| describe_hardness(h, likely_range_mpa(m)))
 }
 
 fn describe(m: &Measured) -> String {
@@ -92,14 +95,12 @@ fn describe(m: &Measured) -> String {
     s
 }
 
-/// Whether two measured moduli lie within each other's one-standard-error reach.
+/// Whether two measured moduli may be equal: their 68% intervals overlap.
 fn within_uncertainty(a: &Measured, b: &Measured) -> bool {
-    let (ea, eb) = (stiffness(a), stiffness(b));
-    if !(ea.is_finite() && eb.is_finite()) {
-        return false;
+    match (likely_range_mpa(a), likely_range_mpa(b)) {
+        (Some([a0, a1]), Some([b0, b1])) => a0 <= b1 && b0 <= a1,
+        _ => false,
     }
-    let reach = uncertainty_mpa(a).unwrap_or(0.0) + uncertainty_mpa(b).unwrap_or(0.0);
-    (ea - eb).abs() <= reach
 }
 
 fn capitalise(s: &str) -> String {
@@ -238,7 +239,8 @@ mod tests {
             label: label.into(),
             location: location_words(x, y),
             hardness: Some(Hardness::ModulusMpa(e).into()),
-            modulus_interval_mpa: [None, None],
+            interval_68_mpa: [None, None],
+            interval_95_mpa: [None, None],
             ripeness: Some("ripe".into()),
             not_measured: None,
         }
@@ -312,11 +314,14 @@ mod tests {
     #[test]
     fn hardness_is_given_with_its_uncertainty() {
         let mut lime = m("lime", 1.46, 0.0, 0.0);
-        lime.modulus_interval_mpa = [Some(1.34), Some(1.58)];
+        lime.interval_68_mpa = [Some(1.34), Some(1.58)];
         let c = FruitCatalog::builtin();
         let q = crate::query::parse("How hard is the lime?", &c).unwrap();
         let text = explain(&q, std::slice::from_ref(&lime), &[0], &[]);
-        assert!(text.contains("36 Shore A (1.46 MPa ± 8%)"), "{text}");
+        assert!(
+            text.contains("36 Shore A (1.46 MPa, likely -8% to +8%)"),
+            "{text}"
+        );
     }
 
     #[test]
@@ -325,8 +330,8 @@ mod tests {
         let q = crate::query::parse("Is the lime harder than the lemon?", &c).unwrap();
         let mut lime = m("lime", 1.50, 0.1, 0.0);
         let mut lemon = m("lemon", 1.40, -0.1, 0.0);
-        lime.modulus_interval_mpa = [Some(1.40), Some(1.60)];
-        lemon.modulus_interval_mpa = [Some(1.30), Some(1.50)];
+        lime.interval_68_mpa = [Some(1.40), Some(1.60)];
+        lemon.interval_68_mpa = [Some(1.30), Some(1.50)];
         let objs = [lime.clone(), lemon.clone()];
         let text = explain(&q, &objs, &[0, 1], &[]);
         assert!(text.contains("is harder than the lemon"), "{text}");
@@ -336,7 +341,7 @@ mod tests {
         );
         // Far apart: no hedge.
         lemon.hardness = Some(Hardness::ModulusMpa(0.5).into());
-        lemon.modulus_interval_mpa = [Some(0.45), Some(0.55)];
+        lemon.interval_68_mpa = [Some(0.45), Some(0.55)];
         let text = explain(&q, &[lime, lemon], &[0, 1], &[]);
         assert!(!text.contains("uncertainty"), "{text}");
     }

@@ -10,6 +10,7 @@ pub mod contact_circle;
 pub mod depth;
 pub mod detect;
 pub mod grounding;
+pub mod height_split;
 pub mod markers;
 pub mod mask;
 pub mod slopes;

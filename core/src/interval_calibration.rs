@@ -1,0 +1,370 @@
+//! Intervals whose coverage is measured: an estimator's 68% and 95% intervals taken from the
+//! residuals ln(E_true / E_est) of held-out presses rather than from its own fit.
+//!
+//! The residuals are grouped in bins of the estimated modulus (soft and hard fruit are read
+//! with different errors: a soft one makes a wide contact, a hard one hardly dents). Each bin
+//! keeps its median residual, the estimator's bias there, which recentres new estimates
+//! (interpolated linearly in ln E between bin medians, so that the order of two close
+//! estimates never flips), and the quantiles at 2.5, 16, 84 and 97.5% of what is left. A new
+//! estimate gets its recentred value times exp(those quantiles): a split-conformal interval,
+//! which holds the truth on new presses as often as on the held-out ones when both come from
+//! the same kind of scene. The quantile levels are widened by (n + 1) / n, the finite-sample
+//! correction.
+
+use crate::estimate::{
+    EstimateError, HardnessEstimate, HardnessEstimator, ModulusInterval, PressSequence,
+};
+use crate::hardness::Hardness;
+use crate::stats::quantile;
+use crate::tactile_spec::TactileSpec;
+use serde::{Deserialize, Serialize};
+
+pub const FORMAT: &str = "tactex-interval-calibration/1";
+/// The two-sided levels: 68% and 95%.
+const LEVELS: [f64; 4] = [0.025, 0.16, 0.84, 0.975];
+/// The fewest held-out presses a bin may rest on: below about 40 the 2.5% and 97.5%
+/// quantiles are each one press.
+pub const MIN_PER_BIN: usize = 40;
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct IntervalCalibration {
+    pub format: String,
+    /// The estimator whose residuals these are (`HardnessEstimator::name`).
+    pub estimator: String,
+    /// The twin's contact physics the held-out presses were made at.
+    pub fidelity: String,
+    /// How the held-out presses were made (the command), so that anyone can make them again.
+    pub protocol: String,
+    pub presses: usize,
+    pub bins: Vec<ResidualBin>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ResidualBin {
+    /// Estimates with ln(E_est / MPa) below this fall in the bin (the last bin: no edge).
+    pub ln_modulus_below: Option<f64>,
+    pub presses: usize,
+    /// Median ln(E_est / MPa) of the bin's presses, and their median ln(E_true / E_est):
+    /// the recentring at that estimate.
+    pub ln_modulus_median: f64,
+    pub median_residual: f64,
+    /// Quantiles of ln(E_true / E_recentred) at 2.5, 16, 84 and 97.5%.
+    pub residual_quantiles: [f64; 4],
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum CalibrationError {
+    #[error("{source_name}: {message}")]
+    Invalid {
+        source_name: String,
+        message: String,
+    },
+}
+
+impl IntervalCalibration {
+    /// Fits the bins from held-out `(ln E_est, ln(E_true / E_est))` pairs: as many equal-count
+    /// bins as hold `MIN_PER_BIN` presses each, up to `max_bins`.
+    pub fn fit(
+        estimator: &str,
+        fidelity: &str,
+        protocol: &str,
+        samples: &[(f64, f64)],
+        max_bins: usize,
+    ) -> Result<Self, CalibrationError> {
+        let invalid = |message: String| CalibrationError::Invalid {
+            source_name: format!("calibration of {estimator}"),
+            message,
+        };
+        if samples
+            .iter()
+            .any(|(a, b)| !(a.is_finite() && b.is_finite()))
+        {
+            return Err(invalid("a residual or estimate is not finite".into()));
+        }
+        if samples.len() < MIN_PER_BIN {
+            return Err(invalid(format!(
+                "{} held-out presses; at least {MIN_PER_BIN} are needed",
+                samples.len()
+            )));
+        }
+        let mut sorted = samples.to_vec();
+        sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let bins = (sorted.len() / MIN_PER_BIN).clamp(1, max_bins.max(1));
+        let n = sorted.len();
+        let mut out = Vec::with_capacity(bins);
+        let range = |b: usize| (b * n / bins, (b + 1) * n / bins);
+        let median = |v: Vec<f64>| quantile(&v, 0.5).expect("a bin is not empty");
+        let centres: Vec<(f64, f64)> = (0..bins)
+            .map(|b| {
+                let (lo, hi) = range(b);
+                let part = &sorted[lo..hi];
+                (
+                    median(part.iter().map(|s| s.0).collect()),
+                    median(part.iter().map(|s| s.1).collect()),
+                )
+            })
+            .collect();
+        for (b, &(ln_modulus_median, median_residual)) in centres.iter().enumerate() {
+            let (lo, hi) = range(b);
+            let residuals: Vec<f64> = sorted[lo..hi]
+                .iter()
+                .map(|s| s.1 - shift_at(&centres, s.0))
+                .collect();
+            let m = residuals.len() as f64;
+            let widen = |q: f64| (0.5 + (q - 0.5) * (m + 1.0) / m).clamp(0.0, 1.0);
+            let residual_quantiles = LEVELS.map(|q| {
+                quantile(&residuals, widen(q)).expect("non-empty, finite, level in [0, 1]")
+            });
+            let ln_modulus_below = (b + 1 < bins).then(|| (sorted[hi - 1].0 + sorted[hi].0) / 2.0);
+            out.push(ResidualBin {
+                ln_modulus_below,
+                presses: residuals.len(),
+                ln_modulus_median,
+                median_residual,
+                residual_quantiles,
+            });
+        }
+        Ok(Self {
+            format: FORMAT.into(),
+            estimator: estimator.into(),
+            fidelity: fidelity.into(),
+            protocol: protocol.into(),
+            presses: n,
+            bins: out,
+        })
+    }
+
+    /// Reads and checks a calibration file's text; `source_name` names it in errors.
+    pub fn parse(text: &str, source_name: &str) -> Result<Self, CalibrationError> {
+        let invalid = |message: String| CalibrationError::Invalid {
+            source_name: source_name.into(),
+            message,
+        };
+        let c: Self = serde_json::from_str(text).map_err(|e| invalid(e.to_string()))?;
+        if c.format != FORMAT {
+            return Err(invalid(format!("format: {:?} is not {FORMAT:?}", c.format)));
+        }
+        if c.bins.is_empty() {
+            return Err(invalid("bins: none".into()));
+        }
+        for (i, b) in c.bins.iter().enumerate() {
+            let q = b.residual_quantiles;
+            if q.iter().any(|v| !v.is_finite()) || q.windows(2).any(|w| w[0] > w[1]) {
+                return Err(invalid(format!(
+                    "bins[{i}].residual_quantiles: must be finite and rising"
+                )));
+            }
+            let last = i + 1 == c.bins.len();
+            match (b.ln_modulus_below, last) {
+                (Some(_), true) => {
+                    return Err(invalid(format!(
+                        "bins[{i}].ln_modulus_below: the last bin has no edge"
+                    )));
+                }
+                (None, false) => {
+                    return Err(invalid(format!("bins[{i}].ln_modulus_below: missing")));
+                }
+                (Some(e), false) if !e.is_finite() => {
+                    return Err(invalid(format!("bins[{i}].ln_modulus_below: not finite")));
+                }
+                _ => {}
+            }
+        }
+        let edges: Vec<f64> = c.bins.iter().filter_map(|b| b.ln_modulus_below).collect();
+        if edges.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(invalid("bins: edges must rise".into()));
+        }
+        let centres = c.centres();
+        if centres
+            .iter()
+            .any(|(a, b)| !(a.is_finite() && b.is_finite()))
+            || centres.windows(2).any(|w| w[0].0 >= w[1].0)
+        {
+            return Err(invalid(
+                "bins: ln_modulus_median and median_residual must be finite, medians rising".into(),
+            ));
+        }
+        // Recentring must keep the order of estimates: ln E + shift(ln E) must rise.
+        if centres
+            .windows(2)
+            .any(|w| (w[1].1 - w[0].1) / (w[1].0 - w[0].0) <= -1.0)
+        {
+            return Err(invalid(
+                "bins: the recentring would reverse the order of estimates".into(),
+            ));
+        }
+        Ok(c)
+    }
+
+    fn centres(&self) -> Vec<(f64, f64)> {
+        self.bins
+            .iter()
+            .map(|b| (b.ln_modulus_median, b.median_residual))
+            .collect()
+    }
+
+    /// The recentred estimate of a raw `modulus_mpa`.
+    pub fn recentred(&self, modulus_mpa: f64) -> f64 {
+        modulus_mpa * shift_at(&self.centres(), modulus_mpa.ln()).exp()
+    }
+
+    /// The calibrated intervals for a raw estimate of `modulus_mpa`, around its recentred
+    /// value.
+    pub fn interval(&self, modulus_mpa: f64) -> ModulusInterval {
+        let ln = modulus_mpa.ln();
+        let bin = self
+            .bins
+            .iter()
+            .find(|b| b.ln_modulus_below.is_none_or(|edge| ln < edge))
+            .expect("the last bin has no edge");
+        let e = self.recentred(modulus_mpa);
+        let [a, b, c, d] = bin.residual_quantiles.map(|q| Some(e * q.exp()));
+        ModulusInterval {
+            p68_mpa: [b, c],
+            p95_mpa: [a, d],
+            source: format!(
+                "calibrated on {} held-out presses at {} ({} in this bin; the estimator's {:.3} MPa recentred by {:+.0}%)",
+                self.presses,
+                self.fidelity,
+                bin.presses,
+                modulus_mpa,
+                100.0 * (e / modulus_mpa - 1.0)
+            ),
+        }
+    }
+}
+
+/// The recentring ln(E_true / E_est) at `ln_modulus`: linear between the bins' medians,
+/// constant beyond the first and last.
+fn shift_at(centres: &[(f64, f64)], ln_modulus: f64) -> f64 {
+    let (first, last) = (centres[0], centres[centres.len() - 1]);
+    if ln_modulus <= first.0 {
+        return first.1;
+    }
+    if ln_modulus >= last.0 {
+        return last.1;
+    }
+    let w = centres
+        .windows(2)
+        .find(|w| ln_modulus <= w[1].0)
+        .expect("inside the range");
+    let t = (ln_modulus - w[0].0) / (w[1].0 - w[0].0);
+    w[0].1 + t * (w[1].1 - w[0].1)
+}
+
+/// An estimator whose intervals come from a calibration; its estimates are its inner one's.
+pub struct Calibrated<E> {
+    pub inner: E,
+    pub calibration: IntervalCalibration,
+}
+
+impl<E: HardnessEstimator> HardnessEstimator for Calibrated<E> {
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+
+    fn estimate(
+        &self,
+        press: &PressSequence,
+        spec: &TactileSpec,
+    ) -> Result<HardnessEstimate, EstimateError> {
+        let mut estimate = self.inner.estimate(press, spec)?;
+        // A rigid reading keeps the estimator's own bound: no held-out press was rigid.
+        if let Some(e) = estimate.hardness.modulus_mpa().filter(|e| *e > 0.0) {
+            estimate.interval = self.calibration.interval(e);
+            let recentred = Hardness::from_modulus_mpa(self.calibration.recentred(e))
+                .map_err(|err| EstimateError::Model(format!("recentred estimate: {err}")))?;
+            estimate.hardness = recentred;
+        }
+        Ok(estimate)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deterministic stand-in for a normal residual: the inverse normal CDF at evenly
+    /// spaced levels (exact quantiles, no sampling noise), shifted by `bias`.
+    fn normal_residuals(n: usize, sigma: f64, bias: f64) -> Vec<f64> {
+        let normal = statrs::distribution::Normal::new(0.0, 1.0).unwrap();
+        use statrs::distribution::ContinuousCDF;
+        (0..n)
+            .map(|i| bias + sigma * normal.inverse_cdf((i as f64 + 0.5) / n as f64))
+            .collect()
+    }
+
+    #[test]
+    fn normal_residuals_give_the_normal_intervals_and_each_bin_its_own() {
+        // Soft estimates scatter by 0.1 in ln E and read 5% low; hard ones scatter by 0.3.
+        let mut samples: Vec<(f64, f64)> = normal_residuals(400, 0.1, 0.05)
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| (-1.0 + 0.001 * i as f64, r))
+            .collect();
+        samples.extend(
+            normal_residuals(400, 0.3, 0.0)
+                .into_iter()
+                .enumerate()
+                .map(|(i, r)| (1.0 + 0.001 * i as f64, r)),
+        );
+        let c = IntervalCalibration::fit("test", "layer", "test", &samples, 2).unwrap();
+        assert_eq!(c.bins.len(), 2);
+        // Below the first bin's median the bias applies whole: the soft read is raised 5%.
+        let soft_e = (-1.0f64).exp();
+        assert!((c.recentred(soft_e) / soft_e - 0.05f64.exp()).abs() < 0.005);
+        let soft = c.interval(soft_e);
+        let [lo, hi] = soft.p68_mpa.map(|v| (v.unwrap() / soft_e).ln());
+        assert!(
+            (lo - (0.05 - 0.1)).abs() < 0.01 && (hi - (0.05 + 0.1)).abs() < 0.01,
+            "{lo} {hi}"
+        );
+        let hard = c.interval(3.0);
+        let [lo, hi] = hard.p95_mpa.map(|v| (v.unwrap() / 3.0).ln());
+        assert!(
+            (lo + 1.96 * 0.3).abs() < 0.02 && (hi - 1.96 * 0.3).abs() < 0.02,
+            "{lo} {hi}"
+        );
+        let text = serde_json::to_string(&c).unwrap();
+        let back = IntervalCalibration::parse(&text, "t.json").unwrap();
+        for (a, b) in back.bins.iter().zip(&c.bins) {
+            for (x, y) in a.residual_quantiles.iter().zip(b.residual_quantiles) {
+                assert!((x - y).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn too_few_presses_and_broken_files_are_refused_with_the_field() {
+        let few: Vec<(f64, f64)> = (0..10).map(|i| (i as f64, 0.0)).collect();
+        let e = IntervalCalibration::fit("learned", "layer", "", &few, 3).unwrap_err();
+        assert!(e.to_string().contains("at least 40"), "{e}");
+        let ok = IntervalCalibration::fit(
+            "learned",
+            "layer",
+            "",
+            &(0..80)
+                .map(|i| (i as f64, 0.01 * i as f64))
+                .collect::<Vec<_>>(),
+            2,
+        )
+        .unwrap();
+        let mut flips = ok.clone();
+        flips.bins[1].median_residual = flips.bins[0].median_residual
+            - 2.0 * (flips.bins[1].ln_modulus_median - flips.bins[0].ln_modulus_median);
+        let e = IntervalCalibration::parse(&serde_json::to_string(&flips).unwrap(), "c.json")
+            .unwrap_err();
+        assert!(e.to_string().contains("reverse the order"), "{e}");
+        let mut bad = ok.clone();
+        bad.bins[0].residual_quantiles = [0.1, 0.0, 0.2, 0.3];
+        let e = IntervalCalibration::parse(&serde_json::to_string(&bad).unwrap(), "c.json")
+            .unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("c.json: bins[0].residual_quantiles"),
+            "{e}"
+        );
+        let e = IntervalCalibration::parse("{}", "c.json").unwrap_err();
+        assert!(e.to_string().starts_with("c.json: "), "{e}");
+    }
+}
