@@ -24,6 +24,7 @@ use tactex_sim::camera::InstanceImage;
 use tactex_sim::elastic::Fidelity;
 use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_render::{SceneRenderer, open_scene_renderer};
+use tactex_sim::world::SharedWorld;
 
 #[derive(Args)]
 pub struct AskArgs {
@@ -148,18 +149,13 @@ pub fn scene_renderer(device: DeviceChoice) -> Result<Arc<dyn SceneRenderer>> {
     Ok(choice.renderer)
 }
 
-/// Objects closer than this count as touching (the meshes' vertex spacing is about 2.6 mm).
-pub const TOUCH_GAP_M: f64 = 0.003;
-
 /// An answer from the twin, with the ground truth an evaluation scores it against.
 pub struct TwinAnswer {
     pub answer: Answer,
     /// Where each scene object came to rest (world frame, m), in the scene's order.
     pub true_centres_m: Vec<[f64; 3]>,
-    /// Each object's outline centre seen from above (`TriMesh::top_view_centre`), what a
-    /// report's position estimates; and which objects touch another (`TOUCH_GAP_M`).
-    pub true_top_centres_m: Vec<[f64; 3]>,
-    pub touching: Vec<bool>,
+    /// The settled world, for evaluations that need more of the truth (meshes, contacts).
+    pub world: SharedWorld,
     /// The clean render's instance ids (object i is id i + 1) and the camera that took it.
     pub instances: InstanceImage,
     pub intrinsics: CameraIntrinsics,
@@ -187,8 +183,6 @@ struct Prepared<'d> {
     detector: Box<dyn Detector + 'd>,
     instances: InstanceImage,
     true_centres_m: Vec<[f64; 3]>,
-    true_top_centres_m: Vec<[f64; 3]>,
-    touching: Vec<bool>,
 }
 
 impl<'a> Twin<'a> {
@@ -205,25 +199,15 @@ impl<'a> Twin<'a> {
                 labels: &labels,
             });
         let detector = self.detector.detector(catalog, truth, self.seed)?;
-        let (true_centres_m, true_top_centres_m, touching) = {
+        let true_centres_m = {
             let world = sim.world.lock().expect("world lock");
-            (
-                world.objects.iter().map(|o| o.centre.to_array()).collect(),
-                world
-                    .objects
-                    .iter()
-                    .map(|o| o.mesh.top_view_centre().to_array())
-                    .collect(),
-                world.touching(TOUCH_GAP_M),
-            )
+            world.objects.iter().map(|o| o.centre.to_array()).collect()
         };
         Ok(Prepared {
             sim,
             detector,
             instances,
             true_centres_m,
-            true_top_centres_m,
-            touching,
         })
     }
 
@@ -241,8 +225,6 @@ impl<'a> Twin<'a> {
             detector,
             instances,
             true_centres_m,
-            true_top_centres_m,
-            touching,
         } = self.prepare(&catalog)?;
         let mut answer = pipeline::answer_with_progress(
             prompt,
@@ -262,8 +244,7 @@ impl<'a> Twin<'a> {
         Ok(TwinAnswer {
             answer,
             true_centres_m,
-            true_top_centres_m,
-            touching,
+            world: sim.world.clone(),
             intrinsics: sim.camera.intrinsics(),
             camera_pose: sim.camera.pose(),
             instances,

@@ -26,10 +26,10 @@ pub enum EstimatorChoice {
 pub const ESTIMATOR_VALUES: &str = "learned, indentation, hertz or FILE.onnx";
 
 /// Interval calibrations shipped with the binary, made by `tactex eval fruits --calibrate`
-/// on held-out presses: (estimator name, fidelity, file name, text).
+/// on held-out presses: (`--estimator` value, fidelity, file name, text).
 const BUILTIN_INTERVALS: &[(&str, &str, &str, &str)] = &[
     (
-        LEARNED_NAME,
+        "learned",
         "layer",
         "models/intervals/learned-layer.json",
         include_str!("../models/intervals/learned-layer.json"),
@@ -41,15 +41,12 @@ const BUILTIN_INTERVALS: &[(&str, &str, &str, &str)] = &[
         include_str!("../models/intervals/indentation-layer.json"),
     ),
     (
-        "hertz_slopes",
+        "hertz",
         "layer",
         "models/intervals/hertz-layer.json",
         include_str!("../models/intervals/hertz-layer.json"),
     ),
 ];
-
-/// The built-in model's estimator name (`onnx_` and its card's model).
-const LEARNED_NAME: &str = "onnx_small";
 
 impl FromStr for EstimatorChoice {
     type Err = String;
@@ -122,7 +119,7 @@ impl EstimatorChoice {
                 }
                 Some(c)
             }
-            None => builtin_intervals(inner.name(), fidelity, self)?,
+            None => builtin_intervals(self, fidelity)?,
         };
         Ok(match calibration {
             Some(calibration) => Box::new(Calibrated { inner, calibration }),
@@ -131,34 +128,30 @@ impl EstimatorChoice {
     }
 }
 
-/// The name of the calibration shipped for `choice` at `fidelity`, if one is.
-pub fn builtin_interval_file(choice: &EstimatorChoice, fidelity: &str) -> Option<&'static str> {
-    let name = match choice {
-        EstimatorChoice::Model(_) => return None,
-        EstimatorChoice::Learned => LEARNED_NAME,
-        EstimatorChoice::Indentation => "indentation",
-        EstimatorChoice::Hertz => "hertz_slopes",
-    };
+/// The calibration shipped for `choice` at `fidelity`: (file name, text). A model file given
+/// by path has none (its name may be the built-in's, its residuals are not).
+fn builtin_entry(choice: &EstimatorChoice, fidelity: &str) -> Option<(&'static str, &'static str)> {
+    if matches!(choice, EstimatorChoice::Model(_)) {
+        return None;
+    }
+    let flag = choice.flag_value();
     BUILTIN_INTERVALS
         .iter()
-        .find(|(e, f, _, _)| *e == name && *f == fidelity)
-        .map(|(_, _, file, _)| *file)
+        .find(|(e, f, _, _)| *e == flag && *f == fidelity)
+        .map(|(_, _, file, text)| (*file, *text))
 }
 
-/// The shipped calibration of an estimator at a fidelity; a model file given by path has none
-/// (its name may be the built-in's, its residuals are not).
+/// The name of the calibration shipped for `choice` at `fidelity`, if one is.
+pub fn builtin_interval_file(choice: &EstimatorChoice, fidelity: &str) -> Option<&'static str> {
+    builtin_entry(choice, fidelity).map(|(file, _)| file)
+}
+
 fn builtin_intervals(
-    name: &str,
-    fidelity: &str,
     choice: &EstimatorChoice,
+    fidelity: &str,
 ) -> Result<Option<IntervalCalibration>> {
-    if matches!(choice, EstimatorChoice::Model(_)) {
-        return Ok(None);
-    }
-    BUILTIN_INTERVALS
-        .iter()
-        .find(|(e, f, _, _)| *e == name && *f == fidelity)
-        .map(|(_, _, file, text)| {
+    builtin_entry(choice, fidelity)
+        .map(|(file, text)| {
             IntervalCalibration::parse(text, &format!("{file} (built in)")).map_err(Into::into)
         })
         .transpose()

@@ -169,15 +169,21 @@ fn modulus_for(fruit: &FruitSpec, i: usize, rng: &mut ChaCha8Rng) -> (f64, Strin
         let s = &fruit.stages[(i / 2) % fruit.stages.len()];
         return (s.modulus_mpa, s.name.clone());
     }
-    let moduli = fruit.stages.iter().map(|s| s.modulus_mpa);
-    let (lo, hi) = moduli.fold((f64::MAX, 0.0f64), |(l, h), e| (l.min(e), h.max(e)));
-    let (lo, hi) = if hi / lo < 1.01 {
-        (lo / SINGLE_STAGE_SPAN, hi * SINGLE_STAGE_SPAN)
-    } else {
-        (lo, hi)
-    };
+    let [lo, hi] = between_range(fruit);
     let e = (lo.ln() + rng.random::<f64>() * (hi / lo).ln()).exp();
     (e, "between".into())
+}
+
+/// The moduli "between stages" are drawn from: the kind's softest to hardest stage, or
+/// within `SINGLE_STAGE_SPAN` of its one stage.
+fn between_range(fruit: &FruitSpec) -> [f64; 2] {
+    let moduli = fruit.stages.iter().map(|s| s.modulus_mpa);
+    let (lo, hi) = moduli.fold((f64::MAX, 0.0f64), |(l, h), e| (l.min(e), h.max(e)));
+    if hi / lo < 1.01 {
+        [lo / SINGLE_STAGE_SPAN, hi * SINGLE_STAGE_SPAN]
+    } else {
+        [lo, hi]
+    }
 }
 
 /// Sets each fruit's modulus (and the ripeness it implies).
@@ -279,10 +285,28 @@ fn tables(args: &FruitEvalArgs, catalog: &FruitCatalog) -> Result<Vec<Table>> {
     Ok(out)
 }
 
-fn score(table: &Table, twin: &TwinAnswer) -> Vec<FruitRow> {
+/// Objects closer than this count as touching (the meshes' vertex spacing is about 2.6 mm).
+const TOUCH_GAP_M: f64 = 0.003;
+
+/// Each fruit's row, and how many reports matched no fruit.
+fn score(table: &Table, twin: &TwinAnswer) -> (Vec<FruitRow>, usize) {
     let answer = &twin.answer;
     let of_object = match_reports(answer, &table.kinds, twin);
-    (0..table.kinds.len())
+    let false_reports = (0..answer.objects.len())
+        .filter(|r| !of_object.contains(&Some(*r)))
+        .count();
+    // What a report's position estimates: the outline's centre seen from above.
+    let (top_centres, touching): (Vec<[f64; 3]>, Vec<bool>) = {
+        let world = twin.world.lock().expect("world lock");
+        let centres = world.objects.iter();
+        (
+            centres
+                .map(|o| o.mesh.top_view_centre().to_array())
+                .collect(),
+            world.touching(TOUCH_GAP_M),
+        )
+    };
+    let rows = (0..table.kinds.len())
         .map(|o| {
             let truth = table.scene.objects[o]
                 .hardness
@@ -290,7 +314,7 @@ fn score(table: &Table, twin: &TwinAnswer) -> Vec<FruitRow> {
                 .expect("the eval sets a modulus");
             let report = of_object[o].map(|r| &answer.objects[r]);
             let position_error_mm = report.map(|r| {
-                let c = twin.true_top_centres_m[o];
+                let c = top_centres[o];
                 (r.position_m[0] - c[0]).hypot(r.position_m[1] - c[1]) * 1e3
             });
             let estimate_mpa = report
@@ -305,7 +329,7 @@ fn score(table: &Table, twin: &TwinAnswer) -> Vec<FruitRow> {
                 kind: table.kinds[o].clone(),
                 stage: table.stages[o].clone(),
                 true_modulus_mpa: truth,
-                touching: twin.touching[o],
+                touching: touching[o],
                 located: report.is_some(),
                 position_error_mm,
                 placed: position_error_mm.is_some_and(|e| e <= PLACED_WITHIN_M * 1e3),
@@ -320,17 +344,19 @@ fn score(table: &Table, twin: &TwinAnswer) -> Vec<FruitRow> {
                 not_measured: report
                     .and_then(|r| r.not_measured.as_ref())
                     .map(|n| n.to_string()),
-                nearest_report: report.is_none().then(|| nearest(twin, o)).flatten(),
+                nearest_report: report
+                    .is_none()
+                    .then(|| nearest(answer, top_centres[o]))
+                    .flatten(),
             }
         })
-        .collect()
+        .collect();
+    (rows, false_reports)
 }
 
-fn nearest(twin: &TwinAnswer, o: usize) -> Option<String> {
-    let c = twin.true_top_centres_m[o];
+fn nearest(answer: &tactex_core::pipeline::Answer, c: [f64; 3]) -> Option<String> {
     let distance = |p: [f64; 3]| (p[0] - c[0]).hypot(p[1] - c[1]);
-    let r = twin
-        .answer
+    let r = answer
         .objects
         .iter()
         .min_by(|a, b| distance(a.position_m).total_cmp(&distance(b.position_m)))?;
@@ -546,11 +572,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
                 format!("{what} {} ({})", t.index, t.kinds.join(", "))
             })?;
             bar.inc(1);
-            let matched = match_reports(&twin.answer, &t.kinds, &twin);
-            let false_reports = (0..twin.answer.objects.len())
-                .filter(|r| !matched.contains(&Some(*r)))
-                .count();
-            Ok((score(t, &twin), false_reports))
+            Ok(score(t, &twin))
         })
         .collect::<Result<_>>()?;
     bar.finish_and_clear();
