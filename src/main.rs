@@ -4,6 +4,7 @@
 mod arm_cli;
 mod ask;
 mod ball_presses;
+mod bench_ask;
 mod bench_contact;
 mod bench_datagen;
 mod bench_render;
@@ -118,6 +119,9 @@ enum BenchCommand {
     Datagen(bench_datagen::DatagenBenchArgs),
     /// RGB-D scene rendering (640x480 colour, depth, instance ids), CPU and GPU paths.
     Scene(bench_scene::SceneBenchArgs),
+    /// The main job: each pipeline stage's wall time at each fidelity, beside the estimates'
+    /// error on the scene's true moduli.
+    Ask(bench_ask::AskBenchArgs),
 }
 
 #[derive(Subcommand)]
@@ -290,6 +294,9 @@ fn main() -> ExitCode {
         Command::Bench {
             command: BenchCommand::Scene(args),
         } => bench_scene::run(&args),
+        Command::Bench {
+            command: BenchCommand::Ask(args),
+        } => bench_ask::run(&args),
         Command::Scene {
             command: SceneCommand::Check { file },
         } => scene_check(&file),

@@ -375,6 +375,10 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
     );
     let e = fails(&["ask", "What is the weather like?"]);
     assert!(e.contains("prompt: names no known fruit"), "{e}");
+    let e = fails(&["bench", "ask", "--reps", "0"]);
+    assert!(e.contains("--reps: must be at least 1"), "{e}");
+    let e = fails(&["bench", "ask", "--prompt", "What is the weather like?"]);
+    assert!(e.contains("--prompt: prompt: names no known fruit"), "{e}");
 }
 
 #[test]

@@ -139,7 +139,9 @@ pub enum EstimateError {
     Model(String),
 }
 
-pub trait HardnessEstimator {
+/// Reads a modulus from a press. Shared across threads: the pipeline reads one object's
+/// press while the arm presses the next.
+pub trait HardnessEstimator: Send + Sync {
     fn name(&self) -> &str;
     fn estimate(
         &self,

@@ -3,7 +3,9 @@
 
 use crate::catalog::FruitCatalog;
 use crate::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
-use crate::estimate::{Evidence, HardnessEstimator, ModulusInterval, PressSequence};
+use crate::estimate::{
+    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval, PressSequence,
+};
 use crate::explain::{self, Explainer, Facts, Measured, location_words};
 use crate::frames::TactileFrame;
 use crate::geometry::Pose;
@@ -61,6 +63,8 @@ pub enum PipelineError {
     Camera(String),
     #[error(transparent)]
     Detect(#[from] DetectError),
+    #[error("hardness: {0}")]
+    Estimator(String),
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -220,6 +224,12 @@ struct Press {
     evidence: ContactEvidence,
 }
 
+/// What the pipeline keeps of a press once its sequence is handed to the hardness reader.
+struct PressTaken {
+    search_mm: f64,
+    evidence: ContactEvidence,
+}
+
 pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     prompt: &str,
     catalog: &FruitCatalog,
@@ -302,28 +312,63 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
         .cloned()
         .collect();
 
-    let t = start("press", arm);
-    let mut presses = Vec::new();
-    for (index, target) in targets.iter().enumerate() {
-        on_progress(Progress::Pressing {
-            index,
-            of: targets.len(),
-            label: target.label.clone(),
+    // Each press is read on a second thread as soon as it is taken, while the arm goes on to
+    // the next object (the real arm's travel hides it the same way): the hardness stage's
+    // wall time is what remains after the last press.
+    let spec = tactile.spec().clone();
+    let (estimated, presses) = std::thread::scope(|scope| {
+        let (to_reader, pressed_rx) = std::sync::mpsc::channel::<(usize, PressSequence)>();
+        let reader = scope.spawn(move || {
+            pressed_rx
+                .into_iter()
+                .map(|(index, sequence)| {
+                    let estimate = estimator.estimate(&sequence, &spec);
+                    (index, sequence, estimate)
+                })
+                .collect::<Vec<_>>()
         });
-        let pressed = press(target, tactile, arm, config)?;
-        on_progress(Progress::Pressed {
-            index,
-            label: target.label.clone(),
-            frames: pressed.as_ref().map_or(0, |p| p.sequence.frames.len()),
-            not_measured: pressed.as_ref().err().cloned(),
-        });
-        presses.push(pressed);
+        let t = start("press", arm);
+        let mut presses: Vec<Result<PressTaken, NotMeasured>> = Vec::new();
+        for (index, target) in targets.iter().enumerate() {
+            on_progress(Progress::Pressing {
+                index,
+                of: targets.len(),
+                label: target.label.clone(),
+            });
+            let pressed = press(target, tactile, arm, config)?;
+            on_progress(Progress::Pressed {
+                index,
+                label: target.label.clone(),
+                frames: pressed.as_ref().map_or(0, |p| p.sequence.frames.len()),
+                not_measured: pressed.as_ref().err().cloned(),
+            });
+            presses.push(pressed.map(|p| {
+                // The reader outlives this loop, so the send cannot fail.
+                let _ = to_reader.send((index, p.sequence));
+                PressTaken {
+                    search_mm: p.search_mm,
+                    evidence: p.evidence,
+                }
+            }));
+        }
+        lap("press", arm, t);
+        drop(to_reader);
+        let t = start("hardness", arm);
+        let estimated = reader
+            .join()
+            .map_err(|_| PipelineError::Estimator("the hardness reader panicked".into()))?;
+        Ok::<_, PipelineError>(((estimated, t), presses))
+    })?;
+    let (estimated, t) = estimated;
+    let mut sequences: Vec<Option<PressSequence>> = vec![None; targets.len()];
+    let mut estimates: Vec<Option<Result<HardnessEstimate, EstimateError>>> =
+        (0..targets.len()).map(|_| None).collect();
+    for (index, sequence, estimate) in estimated {
+        sequences[index] = Some(sequence);
+        estimates[index] = Some(estimate);
     }
-    lap("press", arm, t);
-
-    let t = start("hardness", arm);
     let mut objects = Vec::new();
-    for (target, pressed) in targets.iter().zip(&presses) {
+    for ((target, pressed), estimate) in targets.iter().zip(&presses).zip(estimates) {
         let mut report = ObjectReport {
             label: target.label.clone(),
             detection_score: target.score,
@@ -339,11 +384,11 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
             not_measured: None,
             warnings: Vec::new(),
         };
-        match pressed {
-            Ok(p) => {
+        match (pressed, estimate) {
+            (Ok(p), Some(estimate)) => {
                 report.contact_search_mm = Some(p.search_mm);
                 report.contact = Some(p.evidence.clone());
-                match estimator.estimate(&p.sequence, tactile.spec()) {
+                match estimate {
                     Ok(est) => {
                         report.hardness = Some(est.hardness.into());
                         report.interval = Some(est.interval);
@@ -361,7 +406,13 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
                     }
                 }
             }
-            Err(why) => report.not_measured = Some(why.clone()),
+            (Ok(_), None) => {
+                return Err(PipelineError::Estimator(format!(
+                    "the {}'s press was never read",
+                    target.label
+                )));
+            }
+            (Err(why), _) => report.not_measured = Some(why.clone()),
         }
         objects.push(report);
     }
@@ -403,10 +454,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
         explainer: explanation.explainer,
         explain_notice: explanation.notice,
         timing,
-        presses: presses
-            .into_iter()
-            .map(|p| p.ok().map(|p| p.sequence))
-            .collect(),
+        presses: sequences,
     })
 }
 

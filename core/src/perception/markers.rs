@@ -2,10 +2,9 @@
 //! tracking against a reference frame, and the displacement statistic of the contact test.
 
 use super::circle_fit::fit_circle;
+use super::closing::{close_binary_with_square, close_with_disk};
 use image::{GrayImage, Luma, RgbImage};
-use imageproc::distance_transform::Norm;
 use imageproc::geometry::convex_hull;
-use imageproc::morphology::{Mask, close, grayscale_dilate, grayscale_erode};
 use imageproc::point::Point;
 use imageproc::region_labelling::{Connectivity, connected_components};
 
@@ -24,8 +23,7 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
         let p = img.get_pixel(x, y);
         Luma([((p[0] as u32 * 54 + p[1] as u32 * 183 + p[2] as u32 * 19) >> 8) as u8])
     });
-    let disk = Mask::disk(BACKGROUND_RADIUS_PX);
-    let background = grayscale_erode(&grayscale_dilate(&lum, &disk), &disk);
+    let background = close_with_disk(&lum, BACKGROUND_RADIUS_PX);
     let darkness =
         |x: u32, y: u32| background.get_pixel(x, y)[0] as f64 - lum.get_pixel(x, y)[0] as f64;
     let dark = GrayImage::from_fn(w, h, |x, y| {
@@ -33,7 +31,7 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
         Luma([if darkness(x, y) > 0.45 * b { 255 } else { 0 }])
     });
     // Closing fills specular specks and notches inside a dot so they do not pull its centroid.
-    let dark = close(&dark, Norm::LInf, 2);
+    let dark = close_binary_with_square(&dark, 2);
     let labels = connected_components(&dark, Connectivity::Eight, Luma([0u8]));
     let n = labels.pixels().map(|p| p[0]).max().unwrap_or(0) as usize;
     let mut blobs: Vec<Vec<Point<i32>>> = vec![Vec::new(); n + 1];

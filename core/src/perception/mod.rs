@@ -4,6 +4,7 @@
 
 pub mod centroid;
 pub mod circle_fit;
+mod closing;
 pub mod colour_name;
 pub mod contact;
 pub mod contact_circle;
