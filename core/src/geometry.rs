@@ -50,6 +50,15 @@ impl Pose {
         }
     }
 
+    /// `tool_down`, turned `yaw_rad` about the world's vertical.
+    pub fn tool_down_turned(position: DVec3, yaw_rad: f64) -> Self {
+        Self {
+            position,
+            rotation: DQuat::from_rotation_z(yaw_rad)
+                * DQuat::from_rotation_x(std::f64::consts::PI),
+        }
+    }
+
     pub fn transform_point(&self, p: DVec3) -> DVec3 {
         self.rotation * p + self.position
     }

@@ -15,6 +15,7 @@ use crate::perception::colour_name::{colour_name, mean_colour};
 use crate::perception::contact::ContactEvidence;
 use crate::perception::detect::{DetectError, Detector, RgbdView};
 use crate::perception::grounding::locate;
+use crate::perception::press_site::{HeightMap, PadClearance, PressSite, press_site};
 use crate::press::{Look, PressOutcome, PressProbe, PressProtocol, run_press};
 use crate::query::{self, Query, QueryError};
 use glam::DVec3;
@@ -216,6 +217,8 @@ struct Target {
     centre: DVec3,
     surface: DVec3,
     touch: DVec3,
+    /// The pad's turn about the vertical for this press (see `press_site`).
+    pad_yaw_rad: f64,
 }
 
 struct Press {
@@ -292,7 +295,12 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
     lap("parse", arm, t);
 
     let t = start("ground", arm);
-    let targets = ground(&query, camera, detector, config)?;
+    let pad = {
+        let spec = tactile.spec();
+        let mm = |px: u32| f64::from(px) * spec.mm_per_px;
+        PadClearance::for_pad_mm([mm(spec.width_px), mm(spec.height_px)])
+    };
+    let targets = ground(&query, camera, detector, &pad, config)?;
     on_progress(Progress::Detected {
         objects: targets
             .iter()
@@ -463,6 +471,7 @@ fn ground<C: RgbdCamera>(
     query: &Query,
     camera: &mut C,
     detector: &dyn Detector,
+    pad: &PadClearance,
     config: &PipelineConfig,
 ) -> Result<Vec<Target>, PipelineError> {
     let frames = (0..config.depth_frames.max(1))
@@ -479,10 +488,21 @@ fn ground<C: RgbdCamera>(
         intrinsics: &k,
         pose: &pose,
     };
-    let candidates: Vec<Target> = detector
-        .detect_for(&view, query)?
-        .into_iter()
-        .filter_map(|d| {
+    let detections = detector.detect_for(&view, query)?;
+    // Every pixel's point once: each target's press site looks at all the others.
+    let (w, h) = depth.dimensions();
+    let cloud: Vec<Option<DVec3>> = (0..h)
+        .flat_map(|v| (0..w).map(move |u| (u, v)))
+        .map(|(u, v)| {
+            let z = f64::from(depth.get_pixel(u, v)[0]);
+            (z > 0.0 && z.is_finite())
+                .then(|| pose.transform_point(k.back_project(f64::from(u), f64::from(v), z)))
+        })
+        .collect();
+    let candidates: Vec<Target> = detections
+        .iter()
+        .enumerate()
+        .filter_map(|(i, d)| {
             let at = locate(&d.mask, true, &depth, &k, &pose)?;
             if query.filters.color.is_some() {
                 let colour = mean_colour(&frames[0].color, &at.mask).map_or("grey", colour_name);
@@ -490,13 +510,18 @@ fn ground<C: RgbdCamera>(
                     return None;
                 }
             }
+            let site = clear_touch(at.touch, i, &detections, &cloud, pad).unwrap_or(PressSite {
+                at: at.touch,
+                yaw_rad: 0.0,
+            });
             Some(Target {
-                label: d.label,
+                label: d.label.clone(),
                 score: d.score,
                 bbox: d.bbox,
                 centre: at.centre,
                 surface: at.surface,
-                touch: at.touch,
+                touch: site.at,
+                pad_yaw_rad: site.yaw_rad,
             })
         })
         .collect();
@@ -508,6 +533,73 @@ fn ground<C: RgbdCamera>(
             .unwrap_or(std::cmp::Ordering::Equal)
     });
     Ok(targets)
+}
+
+/// Where the pad can press detection `index` without meeting anything else first (see
+/// `press_site`); None when nowhere is clear, and the crest is pressed for the arm to judge.
+/// The object's own points are its mask's; everything else is the other detections' and
+/// whatever lies more than a few pixels outside its mask (its own flank just outside the mask
+/// is not an obstacle).
+fn clear_touch(
+    crest: DVec3,
+    index: usize,
+    detections: &[crate::perception::detect::Detection],
+    cloud: &[Option<DVec3>],
+    pad: &PadClearance,
+) -> Option<PressSite> {
+    let mask = &detections[index].mask;
+    // Holes in the mask (a highlight, a dropout) are the object's own, not obstacles.
+    let near = imageproc::morphology::dilate(
+        &fill_holes(mask),
+        imageproc::distance_transform::Norm::LInf,
+        4,
+    );
+    let in_other = |at: usize| {
+        detections
+            .iter()
+            .enumerate()
+            .any(|(j, d)| j != index && d.mask.as_raw().get(at).is_some_and(|m| *m > 0))
+    };
+    let (mut own, mut others) = (Vec::new(), Vec::new());
+    for (at, p) in cloud.iter().enumerate() {
+        let Some(p) = p else { continue };
+        if mask.as_raw().get(at).is_some_and(|m| *m > 0) {
+            own.push(*p);
+        } else if near.as_raw().get(at).is_none_or(|m| *m == 0) || in_other(at) {
+            others.push(*p);
+        }
+    }
+    const CELL_M: f64 = 0.002;
+    press_site(
+        crest,
+        &HeightMap::new(&own, CELL_M)?,
+        &HeightMap::new(&others, CELL_M)?,
+        pad,
+    )
+}
+
+/// `mask` with every background region that does not reach the image's border filled.
+fn fill_holes(mask: &image::GrayImage) -> image::GrayImage {
+    use imageproc::region_labelling::{Connectivity, connected_components};
+    let background = image::GrayImage::from_fn(mask.width(), mask.height(), |x, y| {
+        image::Luma([if mask.get_pixel(x, y)[0] > 0 { 0 } else { 255 }])
+    });
+    let regions = connected_components(&background, Connectivity::Four, image::Luma([0u8]));
+    let (w, h) = mask.dimensions();
+    let mut outside = std::collections::HashSet::new();
+    for (x, y, l) in regions.enumerate_pixels() {
+        if l[0] > 0 && (x == 0 || y == 0 || x + 1 == w || y + 1 == h) {
+            outside.insert(l[0]);
+        }
+    }
+    image::GrayImage::from_fn(w, h, |x, y| {
+        let l = regions.get_pixel(x, y)[0];
+        image::Luma([if l == 0 || !outside.contains(&l) {
+            255
+        } else {
+            0
+        }])
+    })
 }
 
 /// Targets whose location matches the query's position filter. When none does ("the fruit
@@ -549,13 +641,14 @@ struct ArmProbe<'d, T: TactileSensor, A: Arm> {
     tactile: &'d mut T,
     arm: &'d mut A,
     touch: DVec3,
+    pad_yaw_rad: f64,
     start_z_m: f64,
     config: &'d PipelineConfig,
 }
 
 impl<T: TactileSensor, A: Arm> ArmProbe<'_, T, A> {
     fn above(&self, z: f64) -> Pose {
-        Pose::tool_down(DVec3::new(self.touch.x, self.touch.y, z))
+        Pose::tool_down_turned(DVec3::new(self.touch.x, self.touch.y, z), self.pad_yaw_rad)
     }
 
     /// The frame with the pad `k` steps down, and where the arm says the pad is (m).
@@ -634,7 +727,12 @@ fn press<T: TactileSensor, A: Arm>(
         DeviceError::UnsafeMove { reason, .. } => Ok(NotMeasured::arm_refused(&reason)),
         e => Err(PipelineError::Device(e)),
     };
-    let above = |z: f64| Pose::tool_down(DVec3::new(target.touch.x, target.touch.y, z));
+    let above = |z: f64| {
+        Pose::tool_down_turned(
+            DVec3::new(target.touch.x, target.touch.y, z),
+            target.pad_yaw_rad,
+        )
+    };
     let safe = above(target.touch.z + config.safe_height_m);
     let start_z_m = target.touch.z + config.approach_clearance_mm * 1e-3;
     let approach = arm
@@ -651,6 +749,7 @@ fn press<T: TactileSensor, A: Arm>(
         tactile,
         arm,
         touch: target.touch,
+        pad_yaw_rad: target.pad_yaw_rad,
         start_z_m,
         config,
     };

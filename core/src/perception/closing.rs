@@ -97,7 +97,7 @@ mod tests {
     use super::*;
     use image::Luma;
     use imageproc::distance_transform::Norm;
-    use imageproc::morphology::{Mask, close, grayscale_dilate, grayscale_erode};
+    use imageproc::morphology::{Mask, close, dilate, grayscale_dilate, grayscale_erode};
     use proptest::prelude::*;
 
     fn reference(img: &GrayImage, radius: u8) -> GrayImage {
@@ -134,6 +134,9 @@ mod tests {
                 s ^= s << 13; s ^= s >> 7; s ^= s << 17;
                 Luma([if s % 3 == 0 { 0 } else { 255 }])
             });
+            // imageproc erodes an image with no background left at all to nothing; a closing
+            // leaves it whole. Marker frames always have background.
+            prop_assume!(dilate(&img, Norm::LInf, k).pixels().any(|p| p[0] == 0));
             let (got, want) = (close_binary_with_square(&img, k), close(&img, Norm::LInf, k));
             prop_assert_eq!(got.as_raw(), want.as_raw());
         }

@@ -14,6 +14,7 @@ pub mod grounding;
 pub mod height_split;
 pub mod markers;
 pub mod mask;
+pub mod press_site;
 pub mod slopes;
 pub mod ssim;
 pub mod yolo_seg;
