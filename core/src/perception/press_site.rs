@@ -63,18 +63,17 @@ impl HeightMap {
 
     /// Each occupied cell under the rectangle, with its centre and its highest point.
     fn under(&self, centre: DVec2, half: DVec2) -> impl Iterator<Item = (DVec2, f64)> + '_ {
-        let (columns, rows) = self.cells_under(centre, half).unwrap_or((1..=0, 1..=0));
-        rows.flat_map(move |j| {
-            columns.clone().filter_map(move |i| {
-                let t = self.top[j * self.nx + i];
-                t.is_finite().then(|| {
-                    (
-                        self.origin + (DVec2::new(i as f64, j as f64) + 0.5) * self.cell_m,
-                        t,
-                    )
-                })
+        self.cells_under(centre, half)
+            .into_iter()
+            .flat_map(|(columns, rows)| {
+                rows.flat_map(move |j| columns.clone().map(move |i| (i, j)))
             })
-        })
+            .map(|(i, j)| (self.cell_centre(i, j), self.top[j * self.nx + i]))
+            .filter(|(_, t)| t.is_finite())
+    }
+
+    fn cell_centre(&self, i: usize, j: usize) -> DVec2 {
+        self.origin + (DVec2::new(i as f64, j as f64) + 0.5) * self.cell_m
     }
 
     /// The highest point in the cells the rectangle `centre ± half` overlaps; -inf if none.
@@ -97,13 +96,10 @@ impl HeightMap {
 
     /// Centres of the cells that hold a point.
     fn occupied(&self) -> impl Iterator<Item = DVec2> + '_ {
-        (0..self.ny).flat_map(move |j| {
-            (0..self.nx).filter_map(move |i| {
-                self.top[j * self.nx + i]
-                    .is_finite()
-                    .then(|| self.origin + (DVec2::new(i as f64, j as f64) + 0.5) * self.cell_m)
-            })
-        })
+        (0..self.ny)
+            .flat_map(move |j| (0..self.nx).map(move |i| (i, j)))
+            .filter(|&(i, j)| self.top[j * self.nx + i].is_finite())
+            .map(|(i, j)| self.cell_centre(i, j))
     }
 }
 
