@@ -225,12 +225,15 @@ struct Press {
     sequence: PressSequence,
     search_mm: f64,
     evidence: ContactEvidence,
+    /// How far the pad was moved for a second press after the first imprint lay at its edge.
+    recentred_mm: Option<f64>,
 }
 
 /// What the pipeline keeps of a press once its sequence is handed to the hardness reader.
 struct PressTaken {
     search_mm: f64,
     evidence: ContactEvidence,
+    recentred_mm: Option<f64>,
 }
 
 pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
@@ -356,6 +359,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
                 PressTaken {
                     search_mm: p.search_mm,
                     evidence: p.evidence,
+                    recentred_mm: p.recentred_mm,
                 }
             }));
         }
@@ -396,6 +400,11 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
             (Ok(p), Some(estimate)) => {
                 report.contact_search_mm = Some(p.search_mm);
                 report.contact = Some(p.evidence.clone());
+                if let Some(mm) = p.recentred_mm {
+                    report.warnings.push(format!(
+                        "the first imprint lay at the pad's edge; pressed again with the pad moved {mm:.1} mm over it"
+                    ));
+                }
                 match estimate {
                     Ok(est) => {
                         report.hardness = Some(est.hardness.into());
@@ -680,16 +689,17 @@ impl<T: TactileSensor, A: Arm> PressProbe for ArmProbe<'_, T, A> {
     }
 }
 
-/// Whether the imprint of the first contact frame lies at the frame's edge: the middle of
-/// its colour change against `reference` (where the change, smoothed over a few pixels
-/// against noise and marker dots, exceeds half its largest value) falls in the outer eighth
-/// of the frame. At first contact the imprint is small and a press centred on the object
-/// has it in the middle, a long ridge across the pad included; deeper frames of a large
-/// fruit reach the edge and are still read.
-fn imprint_cut(first_contact: &TactileFrame, reference: &TactileFrame) -> bool {
+/// Where the imprint of the first contact frame lies, as a fraction of the frame's width and
+/// height: the middle of its colour change against `reference` (where the change, smoothed
+/// over a few pixels against noise and marker dots, exceeds half its largest value); None
+/// when nothing changed. A press is cut when the middle falls in the frame's outer eighth: at
+/// first contact the imprint is small and a press centred on the object has it in the middle,
+/// a long ridge across the pad included; deeper frames of a large fruit reach the edge and are
+/// still read.
+fn imprint_middle(first_contact: &TactileFrame, reference: &TactileFrame) -> Option<glam::DVec2> {
     let (a, b) = (&first_contact.image, &reference.image);
     if a.dimensions() != b.dimensions() {
-        return false;
+        return None;
     }
     let (w, h) = a.dimensions();
     let change = image::ImageBuffer::<image::Luma<f32>, Vec<f32>>::from_fn(w, h, |x, y| {
@@ -699,7 +709,7 @@ fn imprint_cut(first_contact: &TactileFrame, reference: &TactileFrame) -> bool {
     let smooth = imageproc::filter::gaussian_blur_f32(&change, 4.0);
     let peak = smooth.pixels().map(|p| p[0]).fold(0.0, f32::max);
     if peak <= 0.0 {
-        return false;
+        return None;
     }
     let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
     for (x, y, p) in smooth.enumerate_pixels() {
@@ -709,8 +719,7 @@ fn imprint_cut(first_contact: &TactileFrame, reference: &TactileFrame) -> bool {
             n += 1.0;
         }
     }
-    let (cx, cy) = (sx / n / w as f64, sy / n / h as f64);
-    !((0.125..=0.875).contains(&cx) && (0.125..=0.875).contains(&cy))
+    Some(glam::DVec2::new(sx / n / w as f64, sy / n / h as f64))
 }
 
 /// Above the target, run the press protocol from `approach_clearance_mm` above the surface
@@ -723,23 +732,67 @@ fn press<T: TactileSensor, A: Arm>(
     arm: &mut A,
     config: &PipelineConfig,
 ) -> Result<Result<Press, NotMeasured>, PipelineError> {
+    let offset_m = match press_at(target.touch, target, tactile, arm, config)? {
+        Attempt::Pressed(p) => return Ok(Ok(p)),
+        Attempt::NotMeasured(why) => return Ok(Err(why)),
+        Attempt::Cut { offset_m } => offset_m,
+    };
+    // The imprint lay at the pad's edge: the object is off to that side. Press once more with
+    // the pad moved over the imprint's middle, as an operator would.
+    let moved_mm = offset_m.length() * 1e3;
+    let moved = target.touch + offset_m.extend(0.0);
+    Ok(match press_at(moved, target, tactile, arm, config)? {
+        Attempt::Pressed(mut p) => {
+            p.recentred_mm = Some(moved_mm);
+            Ok(p)
+        }
+        Attempt::NotMeasured(why) => Err(why),
+        Attempt::Cut { .. } => Err(NotMeasured {
+            reason: NotMeasuredReason::ImprintCut,
+            detail: format!(
+                "the imprint was cut by the pad's edge, again with the pad moved {moved_mm:.1} mm over it: the pad came down beside the object"
+            ),
+        }),
+    })
+}
+
+/// What one press came to.
+enum Attempt {
+    Pressed(Press),
+    NotMeasured(NotMeasured),
+    /// The first imprint lay at the pad's edge; the pad's centre lies `offset_m` (world x, y)
+    /// from the imprint's middle.
+    Cut {
+        offset_m: glam::DVec2,
+    },
+}
+
+/// One press with the pad over `touch`.
+fn press_at<T: TactileSensor, A: Arm>(
+    touch: DVec3,
+    target: &Target,
+    tactile: &mut T,
+    arm: &mut A,
+    config: &PipelineConfig,
+) -> Result<Attempt, PipelineError> {
+    // The frame's size in pixels and its scale, for where an imprint lies on the pad.
+    let probe_spec = {
+        let spec = tactile.spec();
+        (spec.width_px, spec.height_px, spec.mm_per_px)
+    };
     let refused = |e: DeviceError| match e {
         DeviceError::UnsafeMove { reason, .. } => Ok(NotMeasured::arm_refused(&reason)),
         e => Err(PipelineError::Device(e)),
     };
-    let above = |z: f64| {
-        Pose::tool_down_turned(
-            DVec3::new(target.touch.x, target.touch.y, z),
-            target.pad_yaw_rad,
-        )
-    };
-    let safe = above(target.touch.z + config.safe_height_m);
-    let start_z_m = target.touch.z + config.approach_clearance_mm * 1e-3;
+    let above =
+        |z: f64| Pose::tool_down_turned(DVec3::new(touch.x, touch.y, z), target.pad_yaw_rad);
+    let safe = above(touch.z + config.safe_height_m);
+    let start_z_m = touch.z + config.approach_clearance_mm * 1e-3;
     let approach = arm
         .move_linear(&safe, config.travel_speed_m_s)
         .and_then(|()| arm.move_linear(&above(start_z_m), config.travel_speed_m_s));
     if let Err(e) = approach {
-        return Ok(Err(refused(e)?));
+        return Ok(Attempt::NotMeasured(refused(e)?));
     }
     let protocol = PressProtocol {
         max_search_steps: (config.max_search_mm / config.press.step_mm).ceil() as usize,
@@ -748,7 +801,7 @@ fn press<T: TactileSensor, A: Arm>(
     let mut probe = ArmProbe {
         tactile,
         arm,
-        touch: target.touch,
+        touch,
         pad_yaw_rad: target.pad_yaw_rad,
         start_z_m,
         config,
@@ -759,9 +812,9 @@ fn press<T: TactileSensor, A: Arm>(
     let pressed = match outcome {
         Ok(PressOutcome::Pressed(p)) => p,
         Ok(PressOutcome::NoContact { travel_mm, .. }) => {
-            return Ok(Err(NotMeasured::no_contact(travel_mm)));
+            return Ok(Attempt::NotMeasured(NotMeasured::no_contact(travel_mm)));
         }
-        Err(crate::press::PressError::Probe(e)) => return Ok(Err(refused(e)?)),
+        Err(crate::press::PressError::Probe(e)) => return Ok(Attempt::NotMeasured(refused(e)?)),
         Err(crate::press::PressError::Invalid(m)) => {
             return Err(PipelineError::Camera(format!("tactile sensor: {m}")));
         }
@@ -774,14 +827,22 @@ fn press<T: TactileSensor, A: Arm>(
         .map(|(_, z)| (contact_z - z) * 1e3)
         .collect();
     let frames: Vec<TactileFrame> = pressed.frames.into_iter().map(|(f, _)| f).collect();
-    if imprint_cut(&frames[0], &reference) {
-        return Ok(Err(NotMeasured {
-            reason: NotMeasuredReason::ImprintCut,
-            detail: "the imprint was cut by the pad's edge: the pad came down beside the object"
-                .into(),
-        }));
+    if let Some(middle) = imprint_middle(&frames[0], &reference)
+        && !((0.125..=0.875).contains(&middle.x) && (0.125..=0.875).contains(&middle.y))
+    {
+        // From the frame's middle to the imprint's, in the pad's frame, then the world's.
+        let spec = probe_spec;
+        let in_pad_mm = DVec3::new(
+            (middle.x - 0.5) * f64::from(spec.0),
+            (middle.y - 0.5) * f64::from(spec.1),
+            0.0,
+        ) * spec.2;
+        let in_world = above(0.0).rotation * in_pad_mm * 1e-3;
+        return Ok(Attempt::Cut {
+            offset_m: in_world.truncate(),
+        });
     }
-    Ok(Ok(Press {
+    Ok(Attempt::Pressed(Press {
         sequence: PressSequence {
             reference,
             frames,
@@ -789,6 +850,7 @@ fn press<T: TactileSensor, A: Arm>(
         },
         search_mm: pressed.first_contact_step as f64 * config.press.step_mm,
         evidence: pressed.evidence,
+        recentred_mm: None,
     }))
 }
 
@@ -871,10 +933,15 @@ mod tests {
     }
 
     /// The gel shows a dark disc at `centre` growing with the pad's depth below the apple's
-    /// top (never, when `shows` is false).
+    /// top (never, when `shows` is false). With `object_m` the disc is instead where a point
+    /// that far (world x, y) from the pad's first place lies under the pad, wherever the arm
+    /// has put the pad since.
     struct Gel {
         z: Rc<Cell<f64>>,
+        xy: Rc<Cell<(f64, f64)>>,
+        first_xy: Cell<Option<(f64, f64)>>,
         centre: (f64, f64),
+        object_m: Option<(f64, f64)>,
         shows: bool,
         spec: TactileSpec,
     }
@@ -892,10 +959,22 @@ mod tests {
             } else {
                 0.0
             };
+            // The pad's x along the world's, its y against it (`Pose::tool_down`).
+            let first = *self.first_xy.get().get_or_insert(self.xy.get());
+            self.first_xy.set(Some(first));
+            let centre = self.object_m.map_or(self.centre, |(dx, dy)| {
+                let (ox, oy) = (first.0 + dx, first.1 + dy);
+                let (px, py) = self.xy.get();
+                let mm_per_px = f64::from(self.spec.width_px) * self.spec.mm_per_px / 96.0;
+                (
+                    48.0 + (ox - px) * 1e3 / mm_per_px,
+                    40.0 - (oy - py) * 1e3 / mm_per_px,
+                )
+            });
             Ok(TactileFrame {
                 image: RgbImage::from_fn(96, 80, |x, y| {
                     let base = 120 + ((x * 7 + y * 13) % 17) as u8;
-                    let r = (x as f64 - self.centre.0).hypot(y as f64 - self.centre.1);
+                    let r = (x as f64 - centre.0).hypot(y as f64 - centre.1);
                     if r < radius {
                         Rgb([base / 3, base / 2, base])
                     } else {
@@ -909,6 +988,7 @@ mod tests {
 
     struct FakeArm {
         z: Rc<Cell<f64>>,
+        xy: Rc<Cell<(f64, f64)>>,
         refuse_below_m: f64,
     }
     impl Arm for FakeArm {
@@ -916,7 +996,8 @@ mod tests {
             "fake-arm"
         }
         fn pose(&self) -> Result<Pose, DeviceError> {
-            Ok(Pose::tool_down(DVec3::new(0.0, 0.0, self.z.get())))
+            let (x, y) = self.xy.get();
+            Ok(Pose::tool_down(DVec3::new(x, y, self.z.get())))
         }
         fn move_linear(&mut self, target: &Pose, _: f64) -> Result<(), DeviceError> {
             if target.position.z < self.refuse_below_m {
@@ -926,6 +1007,7 @@ mod tests {
                 });
             }
             self.z.set(target.position.z);
+            self.xy.set((target.position.x, target.position.y));
             Ok(())
         }
         fn stop(&mut self) -> Result<(), DeviceError> {
@@ -966,14 +1048,31 @@ mod tests {
     }
 
     fn ask(centre: (f64, f64), shows: bool, refuse_below_m: f64) -> Answer {
+        ask_on(centre, None, shows, refuse_below_m)
+    }
+
+    fn ask_on(
+        centre: (f64, f64),
+        object_m: Option<(f64, f64)>,
+        shows: bool,
+        refuse_below_m: f64,
+    ) -> Answer {
         let z = Rc::new(Cell::new(0.3));
+        let xy = Rc::new(Cell::new((0.0, 0.0)));
         let mut gel = Gel {
             z: z.clone(),
+            xy: xy.clone(),
+            first_xy: Cell::new(None),
             centre,
+            object_m,
             shows,
             spec: TactileSpec::gelsight_mini(),
         };
-        let mut arm = FakeArm { z, refuse_below_m };
+        let mut arm = FakeArm {
+            z,
+            xy,
+            refuse_below_m,
+        };
         answer(
             "How hard is the apple?",
             &FruitCatalog::builtin(),
@@ -1043,10 +1142,29 @@ mod tests {
     }
 
     #[test]
-    fn an_imprint_at_the_frames_edge_is_reported_as_cut() {
+    fn an_imprint_at_the_frames_edge_wherever_the_pad_goes_is_reported_as_cut() {
         let a = ask((4.0, 40.0), true, 0.0);
         let why = a.objects[0].not_measured.as_ref().unwrap();
         assert_eq!(why.reason, NotMeasuredReason::ImprintCut);
+        assert!(
+            why.detail.contains("again with the pad moved"),
+            "{}",
+            why.detail
+        );
         assert!(a.objects[0].hardness.is_none());
+    }
+
+    #[test]
+    fn an_imprint_at_the_frames_edge_is_pressed_again_with_the_pad_over_it() {
+        // The pad's first contact lies 44 px (of 96) left of the frame's middle: the object
+        // is 9.3 mm off along the world's -x. The second press, moved there, is centred.
+        let mm_per_px = 320.0 * 0.0634 / 96.0;
+        let object = (-44.0 * mm_per_px * 1e-3, 0.0);
+        let a = ask_on((0.0, 0.0), Some(object), true, 0.0);
+        let o = &a.objects[0];
+        assert!(o.not_measured.is_none(), "{:?}", o.not_measured);
+        assert_eq!(o.hardness.unwrap().modulus_mpa, Some(2.0));
+        assert_eq!(o.warnings.len(), 1, "{:?}", o.warnings);
+        assert!(o.warnings[0].contains("moved 9."), "{}", o.warnings[0]);
     }
 }
