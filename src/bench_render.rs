@@ -67,7 +67,9 @@ pub struct RenderBench {
 const DEPTHS_MM: [f64; 8] = [0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0];
 
 pub fn run(args: &RenderBenchArgs) -> Result<()> {
-    let reps = args.reps.max(1);
+    anyhow::ensure!(args.reps >= 1, "--reps: must be at least 1");
+    anyhow::ensure!(args.batch >= 1, "--batch: must be at least 1");
+    let reps = args.reps;
     let spec = TactileSpec::gelsight_mini();
     let optics = SensorOptics::for_spec(&spec);
     let surface = ObjectSurface::Sphere {
@@ -153,7 +155,7 @@ pub fn run(args: &RenderBenchArgs) -> Result<()> {
         Fidelity::Layer,
     )?;
     let fields = image_fields(&mut solver, &pressed, &spec.gel, &optics);
-    let batch = args.batch.max(1);
+    let batch = args.batch;
     let frames: Vec<PressFrame> = (0..batch as u32)
         .map(|seed| PressFrame {
             fields: &fields,

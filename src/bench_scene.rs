@@ -60,7 +60,8 @@ pub struct SceneBench {
 }
 
 pub fn run(args: &SceneBenchArgs) -> Result<()> {
-    let reps = args.reps.max(1);
+    anyhow::ensure!(args.reps >= 1, "--reps: must be at least 1");
+    let reps = args.reps;
     let path = args.scene.clone().unwrap_or_else(crate::default_scene);
     let scene = Scene::load(&path, &FruitCatalog::builtin())?;
     let mut sim = SimDevices::from_scene(&scene, 0)?;

@@ -375,8 +375,13 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
     );
     let e = fails(&["ask", "What is the weather like?"]);
     assert!(e.contains("prompt: names no known fruit"), "{e}");
-    let e = fails(&["bench", "ask", "--reps", "0"]);
-    assert!(e.contains("--reps: must be at least 1"), "{e}");
+    // Every bench refuses zero repetitions rather than quietly running one.
+    for bench in ["ask", "scene", "render", "contact"] {
+        let e = fails(&["bench", bench, "--reps", "0"]);
+        assert!(e.contains("--reps: must be at least 1"), "{bench}: {e}");
+    }
+    let e = fails(&["bench", "render", "--batch", "0"]);
+    assert!(e.contains("--batch: must be at least 1"), "{e}");
     let e = fails(&["bench", "ask", "--prompt", "What is the weather like?"]);
     assert!(e.contains("--prompt: prompt: names no known fruit"), "{e}");
 }
