@@ -298,11 +298,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
     lap("parse", arm, t);
 
     let t = start("ground", arm);
-    let pad = {
-        let spec = tactile.spec();
-        let mm = |px: u32| f64::from(px) * spec.mm_per_px;
-        PadClearance::for_pad_mm([mm(spec.width_px), mm(spec.height_px)])
-    };
+    let pad = PadClearance::for_pad_mm(tactile.spec().pad_size_mm());
     let targets = ground(&query, camera, detector, &pad, config)?;
     on_progress(Progress::Detected {
         objects: targets
@@ -775,11 +771,8 @@ fn press_at<T: TactileSensor, A: Arm>(
     arm: &mut A,
     config: &PipelineConfig,
 ) -> Result<Attempt, PipelineError> {
-    // The frame's size in pixels and its scale, for where an imprint lies on the pad.
-    let probe_spec = {
-        let spec = tactile.spec();
-        (spec.width_px, spec.height_px, spec.mm_per_px)
-    };
+    // The pad's size, for where on it an imprint lies.
+    let pad_mm = tactile.spec().pad_size_mm();
     let refused = |e: DeviceError| match e {
         DeviceError::UnsafeMove { reason, .. } => Ok(NotMeasured::arm_refused(&reason)),
         e => Err(PipelineError::Device(e)),
@@ -831,12 +824,11 @@ fn press_at<T: TactileSensor, A: Arm>(
         && !((0.125..=0.875).contains(&middle.x) && (0.125..=0.875).contains(&middle.y))
     {
         // From the frame's middle to the imprint's, in the pad's frame, then the world's.
-        let spec = probe_spec;
         let in_pad_mm = DVec3::new(
-            (middle.x - 0.5) * f64::from(spec.0),
-            (middle.y - 0.5) * f64::from(spec.1),
+            (middle.x - 0.5) * pad_mm[0],
+            (middle.y - 0.5) * pad_mm[1],
             0.0,
-        ) * spec.2;
+        );
         let in_world = above(0.0).rotation * in_pad_mm * 1e-3;
         return Ok(Attempt::Cut {
             offset_m: in_world.truncate(),

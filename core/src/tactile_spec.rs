@@ -58,6 +58,14 @@ impl TactileSpec {
     }
 
     /// Rest positions of the marker centres in pixels (x, y), row-major.
+    /// The pad the frame images (x along the frame's columns, y along its rows), mm.
+    pub fn pad_size_mm(&self) -> [f64; 2] {
+        [
+            f64::from(self.width_px) * self.mm_per_px,
+            f64::from(self.height_px) * self.mm_per_px,
+        ]
+    }
+
     pub fn marker_rest_px(&self) -> Vec<(f64, f64)> {
         let m = &self.markers;
         let pitch_px = m.pitch_mm / self.mm_per_px;
