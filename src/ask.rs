@@ -16,7 +16,7 @@ use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::perception::detect::Detector;
 use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig, Progress};
 use tactex_core::scene::Scene;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::sensor_profile::SensorProfile;
 use tactex_hw::devices_toml::DevicesConfig;
 use tactex_hw::session::{SessionRecorder, TwinRecord, open_session};
 use tactex_sim::SimDevices;
@@ -107,6 +107,11 @@ pub struct TwinOptions {
     /// and 95% intervals come from; unset: the one shipped for the estimator at --fidelity.
     #[arg(long)]
     pub intervals: Option<PathBuf>,
+    /// Sensor profile (TOML: `tactex calibrate` writes one, `tactex sensor show --toml`
+    /// prints the built-in one) the sim GelSight renders with; default the built-in GelSight
+    /// Mini.
+    #[arg(long)]
+    pub sensor: Option<PathBuf>,
 }
 
 /// The estimator `ask`, `serve`, `compare --session` and `eval scenarios` use unless told:
@@ -121,6 +126,7 @@ pub struct OpenedTwin {
     pub explainer: Box<dyn Explainer>,
     pub estimator: Box<dyn HardnessEstimator + Send + Sync>,
     pub fidelity: Fidelity,
+    pub sensor: SensorProfile,
 }
 
 impl TwinOptions {
@@ -135,7 +141,16 @@ impl TwinOptions {
                 self.intervals.as_deref(),
             )?,
             fidelity: self.fidelity,
+            sensor: load_sensor(self.sensor.as_deref())?,
         })
+    }
+}
+
+/// The profile at `path` (`--sensor`), or the built-in GelSight Mini.
+pub fn load_sensor(path: Option<&Path>) -> Result<SensorProfile> {
+    match path {
+        Some(p) => SensorProfile::load(p).map_err(|e| anyhow::anyhow!("--sensor: {e}")),
+        None => Ok(SensorProfile::gelsight_mini()),
     }
 }
 
@@ -167,8 +182,9 @@ pub struct TwinAnswer {
 pub struct Twin<'a> {
     pub scene: &'a Scene,
     pub seed: u64,
-    /// The sim tactile sensor (the stock GelSight Mini unless a what-if asks otherwise).
-    pub sensor: &'a TactileSpec,
+    /// The sim tactile sensor (the stock GelSight Mini unless a profile or a what-if asks
+    /// otherwise).
+    pub sensor: &'a SensorProfile,
     pub detector: &'a DetectorChoice,
     pub renderer: &'a Arc<dyn SceneRenderer>,
     pub explainer: &'a dyn Explainer,
@@ -241,6 +257,7 @@ impl<'a> Twin<'a> {
             on_progress,
         )?;
         answer.fidelity = Some(self.fidelity.name().into());
+        answer.sensor = Some(self.sensor.id());
         Ok(TwinAnswer {
             answer,
             true_centres_m,
@@ -274,6 +291,7 @@ impl<'a> Twin<'a> {
             explainer: self.explainer,
             config,
             fidelity: Some(self.fidelity),
+            sensor: Some(self.sensor.id()),
         };
         let scene_toml = std::fs::read_to_string(&self.scene.path).with_context(|| {
             format!("{}: cannot read the scene again", self.scene.path.display())
@@ -289,6 +307,7 @@ impl<'a> Twin<'a> {
                     scene_path: scene_path.display().to_string(),
                     seed: self.seed,
                     fidelity: Some(self.fidelity.name().into()),
+                    sensor: Some(self.sensor.id()),
                 }),
             }),
         )
@@ -313,6 +332,8 @@ pub struct Question<'q> {
     pub config: &'q PipelineConfig,
     /// The sim GelSight's contact physics, when the devices are the twin's.
     pub fidelity: Option<Fidelity>,
+    /// The tactile sensor's profile, when one is known.
+    pub sensor: Option<tactex_core::sensor_profile::ProfileId>,
 }
 
 impl Question<'_> {
@@ -357,6 +378,7 @@ impl Question<'_> {
             self.config,
         )?;
         answer.fidelity = self.fidelity.map(|f| f.name().into());
+        answer.sensor = self.sensor.clone();
         Ok(answer)
     }
 }
@@ -381,6 +403,7 @@ pub fn answer_on_replay(
         explainer,
         config,
         fidelity: None,
+        sensor: None,
     };
     let mut answer = question.ask(
         Devices {
@@ -391,7 +414,10 @@ pub fn answer_on_replay(
         None,
     )?;
     // A session recorded on the twin replays the twin's frames: it says at which fidelity.
-    answer.fidelity = manifest.twin.and_then(|t| t.fidelity);
+    if let Some(twin) = manifest.twin {
+        answer.fidelity = twin.fidelity;
+        answer.sensor = twin.sensor;
+    }
     Ok(answer)
 }
 
@@ -435,6 +461,7 @@ fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> R
         explainer: explainer.as_ref(),
         config,
         fidelity: None,
+        sensor: None,
     };
     question.ask(
         Devices {
@@ -474,7 +501,6 @@ pub fn run(args: &AskArgs) -> Result<()> {
     if args.gel_modulus_mpa.is_some() && args.backend != Backend::Sim {
         bail!("--gel-modulus-mpa: only with --backend sim (a real gel is what it is)");
     }
-    let sensor = sim_sensor(args.gel_modulus_mpa)?;
     let answer = match args.backend {
         Backend::Hw => {
             let Some(file) = &args.devices else {
@@ -499,6 +525,7 @@ pub fn run(args: &AskArgs) -> Result<()> {
             let path = args.scene.clone().unwrap_or_else(crate::default_scene);
             let scene = Scene::load(&path, &catalog)?;
             let opened = args.twin.open()?;
+            let sensor = with_gel_modulus(opened.sensor.clone(), args.gel_modulus_mpa)?;
             let twin = Twin {
                 scene: &scene,
                 seed: args.seed,
@@ -526,17 +553,19 @@ pub fn run(args: &AskArgs) -> Result<()> {
     Ok(())
 }
 
-/// The stock GelSight Mini, with its gel's modulus replaced when one is given.
-pub fn sim_sensor(gel_modulus_mpa: Option<f64>) -> Result<TactileSpec> {
-    let mut spec = TactileSpec::gelsight_mini();
+/// `sensor` with its gel's modulus replaced when one is given (`--gel-modulus-mpa`).
+pub fn with_gel_modulus(
+    mut sensor: SensorProfile,
+    gel_modulus_mpa: Option<f64>,
+) -> Result<SensorProfile> {
     if let Some(e) = gel_modulus_mpa {
         // Beyond these the gel is no gel: a foam or a rubber outside the layer model's range.
         if !(e.is_finite() && (0.01..=50.0).contains(&e)) {
             bail!("--gel-modulus-mpa: {e} is outside 0.01..50 MPa");
         }
-        spec.gel.modulus_mpa = e;
+        sensor.spec.gel.modulus_mpa = e;
     }
-    Ok(spec)
+    Ok(sensor)
 }
 
 fn print_answer(a: &Answer) {

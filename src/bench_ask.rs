@@ -4,7 +4,7 @@
 //! cost) beside the estimates' |ln(E_est/E_true)| against the scene's true moduli. All rows
 //! are measured in one run, so their ratios hold on a noisy machine.
 
-use crate::ask::{Twin, sim_sensor};
+use crate::ask::{Twin, load_sensor};
 use crate::bench_contact::median;
 use crate::estimator_choice::EstimatorChoice;
 use crate::output::{write_bytes_atomic, write_json_atomic};
@@ -37,6 +37,10 @@ pub struct AskBenchArgs {
     /// Hardness estimator: learned, indentation, hertz or FILE.onnx.
     #[arg(long, default_value = crate::ask::DEFAULT_ESTIMATOR)]
     estimator: EstimatorChoice,
+    /// Sensor profile the sim GelSight renders with (TOML); default the built-in GelSight
+    /// Mini.
+    #[arg(long)]
+    sensor: Option<PathBuf>,
     /// Timed questions at each fidelity (the median is reported); one more, untimed, warms up.
     #[arg(long, default_value_t = 5)]
     reps: usize,
@@ -89,7 +93,7 @@ pub fn run(args: &AskBenchArgs) -> Result<()> {
     tactex_core::query::parse(&args.prompt, &catalog).context("--prompt")?;
     let path = args.scene.clone().unwrap_or_else(crate::default_scene);
     let scene = Scene::load(&path, &catalog)?;
-    let sensor = sim_sensor(None)?;
+    let sensor = load_sensor(args.sensor.as_deref())?;
     let detector = DetectorChoice::parse("classical")?;
     let renderer: Arc<dyn SceneRenderer> = Arc::new(CpuSceneRenderer);
     let config = PipelineConfig::default();

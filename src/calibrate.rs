@@ -1,16 +1,17 @@
-//! `tactex calibrate`: fits the gradient -> colour table from annotated ball presses and
-//! writes a self-contained calibration file.
+//! `tactex calibrate`: fits the gradient -> colour table from annotated ball presses, measures
+//! the camera's noise, and writes a sensor profile (TOML + its background PNG beside it).
 
 use crate::ball_presses::{self, Split};
-use crate::output::write_bytes_atomic;
+use crate::output::write_profile_atomic;
 use crate::press::positive;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
-use tactex_core::ball_calibration::{SampleRule, samples_from_ball_press};
+use tactex_core::ball_calibration::{SampleRule, camera_noise_sigma, samples_from_ball_press};
+use tactex_core::perception::centroid::median;
+use tactex_core::sensor_profile::{CalibrationFit, SensorProfile};
 use tactex_core::shading_table::ShadingTable;
-use tactex_core::tactile_spec::TactileSpec;
-use tactex_sim::gel_render::{CALIBRATION_FORMAT, FitReport, GelCalibration};
+use tactex_core::tactile_spec::{GelSpec, TactileSpec};
 
 #[derive(Args, Debug)]
 #[command(allow_negative_numbers = true)]
@@ -28,8 +29,25 @@ pub struct CalibrateArgs {
     pub ball_radius_mm: f64,
     #[arg(long)]
     pub mm_per_px: f64,
+    /// The sensor profile to write (TOML; its background goes beside it as
+    /// NAME.background.png).
     #[arg(long)]
     pub out: PathBuf,
+    /// The profile's name (default: the output file's stem).
+    #[arg(long)]
+    pub name: Option<String>,
+    /// The gel's Young's modulus (MPa); default the GelSight Mini's.
+    #[arg(long)]
+    pub gel_modulus_mpa: Option<f64>,
+    /// The gel's thickness (mm); default the GelSight Mini's.
+    #[arg(long)]
+    pub gel_thickness_mm: Option<f64>,
+    /// The gel's Poisson ratio; default the GelSight Mini's.
+    #[arg(long)]
+    pub gel_poisson: Option<f64>,
+    /// The camera's frame rate (Hz); default the GelSight Mini's.
+    #[arg(long)]
+    pub frame_rate_hz: Option<f64>,
     /// Which presses to fit: calib (all but every third), eval, or all.
     #[arg(long, value_enum, default_value_t = Split::Calib)]
     pub split: Split,
@@ -62,6 +80,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
     )?;
     let rule = SampleRule::default();
     let mut samples = Vec::new();
+    let mut noise = Vec::new();
     for (press, img) in &presses {
         if press.contact_radius_px * scale >= radius {
             bail!(
@@ -79,6 +98,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
             scale,
             &rule,
         ));
+        noise.extend(camera_noise_sigma(img, &background, press, &rule));
     }
     let table = ShadingTable::fit(
         &samples,
@@ -96,24 +116,85 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         }
     }
     let rms = sq.map(|v| (v / samples.len() as f64).sqrt());
-    let calib = GelCalibration {
-        format: CALIBRATION_FORMAT.into(),
-        width: background.width(),
-        height: background.height(),
-        mm_per_px: scale,
-        gel: TactileSpec::gelsight_mini().gel,
-        table,
-        background_png: GelCalibration::encode_background(&background),
-        fit: FitReport {
+    // The presses' flat gel drifts from the recorded background (the same smooth change in
+    // every press: the table's zero-slope value); the profile's background is the flat gel
+    // as the presses saw it, so that its no-contact frame is its background.
+    let (w, h) = background.dimensions();
+    let flat_gel = image::RgbImage::from_fn(w, h, |x, y| {
+        let (u, v) = (
+            2.0 * ((x as f32 + 0.5) / w as f32 - 0.5),
+            2.0 * ((y as f32 + 0.5) / h as f32 - 0.5),
+        );
+        let drift = table.flat_change(u, v);
+        let b = background.get_pixel(x, y);
+        image::Rgb(std::array::from_fn(|c| {
+            (f32::from(b[c]) + drift[c]).round().clamp(0.0, 255.0) as u8
+        }))
+    });
+    let table = table.split_flat();
+    let stock = SensorProfile::gelsight_mini();
+    let gel = GelSpec {
+        modulus_mpa: match args.gel_modulus_mpa {
+            Some(e) => positive("gel-modulus-mpa", e)?,
+            None => stock.spec.gel.modulus_mpa,
+        },
+        poisson: match args.gel_poisson {
+            Some(nu) if nu.is_finite() && (0.0..=0.5).contains(&nu) => nu,
+            Some(nu) => bail!("--gel-poisson: must be in [0, 0.5], got {nu}"),
+            None => stock.spec.gel.poisson,
+        },
+        thickness_mm: match args.gel_thickness_mm {
+            Some(t) => positive("gel-thickness-mm", t)?,
+            None => stock.spec.gel.thickness_mm,
+        },
+    };
+    let frame_rate_hz = match args.frame_rate_hz {
+        Some(f) => positive("frame-rate-hz", f)?,
+        None => stock.spec.frame_rate_hz,
+    };
+    let name = match &args.name {
+        Some(n) => n.clone(),
+        None => args
+            .out
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "calibrated sensor".into()),
+    };
+    let noise_sigma_grey = median(&mut noise).unwrap_or(0.0);
+    let profile = SensorProfile {
+        source: args.source.clone(),
+        spec: TactileSpec {
+            model: name,
+            width_px: w,
+            height_px: h,
+            mm_per_px: scale,
+            gel,
+            // The ball presses carry no markers: a profile without a marker grid.
+            markers: tactex_core::tactile_spec::MarkerGrid {
+                cols: 0,
+                rows: 0,
+                ..stock.spec.markers
+            },
+            frame_rate_hz,
+            ..stock.spec.clone()
+        },
+        table: Some(table),
+        background: Some(flat_gel),
+        noise_sigma_grey,
+        // The real background carries the sensor's vignetting.
+        vignette: 0.0,
+        marker_darkness: stock.marker_darkness,
+        fit: Some(CalibrationFit {
             images: presses.iter().map(|(p, _)| p.image.clone()).collect(),
             samples: samples.len(),
             rms_grey: rms,
             ball_radius_mm: radius,
-        },
-        source: args.source.clone(),
+        }),
     };
-    let json = serde_json::to_vec_pretty(&calib)?;
-    write_bytes_atomic(&args.out, &json)?;
+    profile
+        .validate()
+        .map_err(|(field, message)| anyhow::anyhow!("the fitted profile: {field}: {message}"))?;
+    write_profile_atomic(&args.out, &profile)?;
     println!(
         "{}: fitted {} x {} bins to {} pixels of {} presses; rms residual R {:.2} G {:.2} B {:.2} grey levels",
         args.out.display(),
@@ -124,6 +205,10 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         rms[0],
         rms[1],
         rms[2]
+    );
+    println!(
+        "camera noise {noise_sigma_grey:.2} grey levels (1 sigma); profile {}",
+        profile.id()
     );
     Ok(())
 }

@@ -24,15 +24,17 @@ use tactex_core::perception::ssim::{gray, ssim};
 use tactex_core::tactile_spec::GelSpec;
 use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
 use tactex_sim::gel_render::{
-    DeviceChoice, GelCalibration, GelImageFields, PressFrame, SensorOptics, image_fields,
-    open_renderer, pad_rect, pixel_centre_mm,
+    DeviceChoice, GelImageFields, PressFrame, SensorOptics, image_fields, open_renderer, pad_rect,
+    pixel_centre_mm,
 };
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// Calibration file from `tactex calibrate`.
-    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
-    pub calib: Option<PathBuf>,
+    /// Sensor profile: for ball presses, the calibrated one (`tactex calibrate`) whose
+    /// background and table render the rebuilt presses; with --session, the twin's sensor
+    /// (default the built-in GelSight Mini).
+    #[arg(long, required_unless_present = "session")]
+    pub sensor: Option<PathBuf>,
     /// Folder of the real ball-press frames.
     #[arg(long, required_unless_present = "session", conflicts_with = "session")]
     pub images: Option<PathBuf>,
@@ -45,18 +47,18 @@ pub struct CompareArgs {
     pub session: Option<PathBuf>,
     /// With --session: the objects as they stood, for a session that carries no scene (one
     /// recorded on real devices).
-    #[arg(long, conflicts_with_all = ["calib", "images", "annotations"])]
+    #[arg(long, conflicts_with_all = ["images", "annotations"])]
     pub scene: Option<PathBuf>,
     /// With --session: the twin's seed (default: the session's).
-    #[arg(long, conflicts_with_all = ["calib", "images", "annotations"])]
+    #[arg(long, conflicts_with_all = ["images", "annotations"])]
     pub seed: Option<u64>,
     /// With --session: the twin's gel modulus (MPa) instead of the stock 0.3.
-    #[arg(long, conflicts_with_all = ["calib", "images", "annotations"])]
+    #[arg(long, conflicts_with_all = ["images", "annotations"])]
     pub gel_modulus_mpa: Option<f64>,
     /// Which presses to score: eval (every third, held out of calibration), calib, or all.
     /// With --session: the hardness estimator that reads both presses (learned,
     /// indentation, hertz or FILE.onnx).
-    #[arg(long, conflicts_with_all = ["calib", "images", "annotations"], default_value = crate::ask::DEFAULT_ESTIMATOR)]
+    #[arg(long, conflicts_with_all = ["images", "annotations"], default_value = crate::ask::DEFAULT_ESTIMATOR)]
     pub estimator: crate::estimator_choice::EstimatorChoice,
     #[arg(long, value_enum, default_value_t = Split::Eval)]
     pub split: Split,
@@ -101,7 +103,8 @@ pub struct PressComparison {
 
 #[derive(Serialize, Debug)]
 pub struct CompareReport {
-    pub calibration: String,
+    /// The calibrated profile the presses were rendered through.
+    pub sensor: tactex_core::sensor_profile::ProfileId,
     pub split: String,
     pub fidelity: String,
     pub device: String,
@@ -248,29 +251,43 @@ pub(crate) fn side_by_side(real: &RgbImage, rendered: &RgbImage) -> RgbImage {
 }
 
 pub fn run(args: &CompareArgs) -> Result<()> {
-    let (Some(calib_path), Some(images), Some(annotations)) =
-        (&args.calib, &args.images, &args.annotations)
+    let (Some(profile_path), Some(images), Some(annotations)) =
+        (&args.sensor, &args.images, &args.annotations)
     else {
         let Some(session) = &args.session else {
-            bail!("compare: needs --calib, --images and --annotations, or --session DIR");
+            bail!("compare: needs --sensor, --images and --annotations, or --session DIR");
         };
         return crate::compare_session::run(&SessionCompare {
             session,
             scene: args.scene.as_deref(),
             seed: args.seed,
             gel_modulus_mpa: args.gel_modulus_mpa,
+            sensor: args.sensor.as_deref(),
             fidelity: args.fidelity,
             estimator: &args.estimator,
             out: args.out.as_deref(),
             json: args.json,
         });
     };
-    let text = std::fs::read_to_string(calib_path)
-        .with_context(|| format!("{}: cannot read", calib_path.display()))?;
-    let calib = GelCalibration::from_json(&text)
-        .with_context(|| format!("{}: not a usable calibration", calib_path.display()))?;
-    let optics = calib.to_optics()?;
-    let presses = ball_presses::load(images, annotations, args.split, (calib.width, calib.height))?;
+    let profile = crate::ask::load_sensor(Some(profile_path))?;
+    let (Some(real_background), Some(fit)) = (&profile.background, &profile.fit) else {
+        bail!(
+            "--sensor {}: not a calibrated profile (no background frame or no ball-press fit); `tactex calibrate` writes one",
+            profile_path.display()
+        );
+    };
+    // The rebuilt presses are compared with single real frames: no added camera noise.
+    let optics = SensorOptics {
+        noise_sigma: 0.0,
+        ..SensorOptics::for_profile(&profile)
+    };
+    let spec = &profile.spec;
+    let presses = ball_presses::load(
+        images,
+        annotations,
+        args.split,
+        (spec.width_px, spec.height_px),
+    )?;
     let choice = open_renderer(args.device)?;
     if let Some(note) = &choice.note {
         eprintln!("note: {note}");
@@ -282,8 +299,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         rebuilt.push(rebuild(
             &mut solver,
             press,
-            calib.fit.ball_radius_mm,
-            &calib.gel,
+            fit.ball_radius_mm,
+            &spec.gel,
             &optics,
             args.fidelity,
         )?);
@@ -299,7 +316,6 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     });
     let mut images = renderer.render_batch(&optics, &frames)?;
     let background = images.pop().expect("the flat frame was rendered last");
-    let real_background = calib.background()?;
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create", dir.display()))?;
@@ -318,13 +334,13 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             force_n: *force,
             rendered: scores(real, rendered, press),
             background_only: scores(real, &background, press),
-            circle_real: score_circle(real, &real_background, press),
+            circle_real: score_circle(real, real_background, press),
             circle_rendered: score_circle(rendered, &background, press),
             warnings: warnings.clone(),
         });
     }
     let report = CompareReport {
-        calibration: calib_path.display().to_string(),
+        sensor: profile.id(),
         split: format!("{:?}", args.split).to_lowercase(),
         fidelity: args.fidelity.name().into(),
         device: renderer.name(),

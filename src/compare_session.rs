@@ -7,7 +7,7 @@
 //! the hardness the pipeline's estimator reads from either press, both read with the twin's
 //! sensor description, so that a gel that differs from the twin's shows as a hardness error.
 
-use crate::ask::sim_sensor;
+use crate::ask::{load_sensor, with_gel_modulus};
 use crate::compare::side_by_side;
 use crate::estimator_choice::EstimatorChoice;
 use crate::output::{write_json_atomic, write_png_atomic};
@@ -41,6 +41,8 @@ pub struct SessionCompare<'a> {
     pub scene: Option<&'a Path>,
     pub seed: Option<u64>,
     pub gel_modulus_mpa: Option<f64>,
+    /// The twin's sensor profile (default the built-in GelSight Mini).
+    pub sensor: Option<&'a Path>,
     /// The twin's contact physics for the rebuild.
     pub fidelity: Fidelity,
     pub estimator: &'a EstimatorChoice,
@@ -390,7 +392,8 @@ pub fn run(args: &SessionCompare) -> Result<()> {
         .seed
         .or(manifest.twin.as_ref().map(|t| t.seed))
         .unwrap_or(0);
-    let spec = sim_sensor(args.gel_modulus_mpa)?;
+    let sensor = with_gel_modulus(load_sensor(args.sensor)?, args.gel_modulus_mpa)?;
+    let spec = sensor.spec.clone();
     let recorded_spec = &manifest.tactile.spec;
     if (recorded_spec.width_px, recorded_spec.height_px) != (spec.width_px, spec.height_px) {
         bail!(
@@ -432,7 +435,7 @@ pub fn run(args: &SessionCompare) -> Result<()> {
     let estimator = args
         .estimator
         .open("--estimator", args.fidelity.name(), None)?;
-    let mut sim = SimDevices::with_sensor(&scene, seed, spec.clone(), args.fidelity)
+    let mut sim = SimDevices::with_sensor(&scene, seed, sensor.clone(), args.fidelity)
         .with_context(|| format!("{scene_name}: the twin cannot stand it up"))?;
     let rebuilt = rebuild_frames(&mut sim, &manifest)?;
 

@@ -33,7 +33,6 @@ use tactex_core::hardness::Hardness;
 use tactex_core::interval_calibration::IntervalCalibration;
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
-use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::elastic::Fidelity;
 use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_random::{RandomSceneError, Variation, random_scene};
@@ -65,6 +64,10 @@ pub struct FruitEvalArgs {
     /// Contact physics of the sim GelSight: rigid, hertz, halfspace or layer.
     #[arg(long, default_value = "layer")]
     pub fidelity: Fidelity,
+    /// Sensor profile the sim GelSight renders with (TOML); default the built-in GelSight
+    /// Mini.
+    #[arg(long)]
+    pub sensor: Option<PathBuf>,
     /// Hardness estimator: learned, indentation, hertz or FILE.onnx.
     #[arg(long, default_value = crate::ask::DEFAULT_ESTIMATOR)]
     pub estimator: EstimatorChoice,
@@ -153,6 +156,8 @@ pub struct FruitReport {
     pub protocol: String,
     pub estimator: String,
     pub fidelity: String,
+    /// The sim GelSight's profile.
+    pub sensor: tactex_core::sensor_profile::ProfileId,
     pub intervals: String,
     pub seed: u64,
     pub kinds: Vec<KindResult>,
@@ -552,7 +557,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
             .expect("a valid template"),
     );
     let config = PipelineConfig::default();
-    let sensor = TactileSpec::gelsight_mini();
+    let sensor = crate::ask::load_sensor(args.sensor.as_deref())?;
     let per_table: Vec<(Vec<FruitRow>, usize)> = tables
         .par_iter()
         .map(|t| -> Result<(Vec<FruitRow>, usize)> {
@@ -590,6 +595,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
         .sum();
     let rows: Vec<FruitRow> = per_table.into_iter().flat_map(|p| p.0).collect();
 
+    let sensor_id = sensor.id();
     let protocol = format!(
         "each catalog kind alone at {} random places and yaws (stages in turn, every other at a modulus between stages), and {} crowded tables of 10-12 fruits, {:.0}% of them put against a neighbour; prompt {PROMPT:?}; camera noise on, classical detector; located: a report of the kind touches the fruit; placed: its centre within {:.0} mm of the fruit's outline centre",
         args.placements,
@@ -632,6 +638,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
         protocol,
         estimator: estimator.name().into(),
         fidelity: fidelity.into(),
+        sensor: sensor_id,
         intervals: interval_source(&args.estimator, fidelity, args.intervals.as_ref())?,
         seed: args.seed,
         kinds: names

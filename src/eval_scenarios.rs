@@ -34,7 +34,6 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::explain::TemplateExplainer;
 use tactex_core::pipeline::{Answer, PipelineConfig};
 use tactex_core::scene::Scene;
-use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::elastic::Fidelity;
 use tactex_sim::render_device::DeviceChoice;
 use tactex_sim::scene_random::{Variation, random_scene};
@@ -74,6 +73,10 @@ pub struct ScenarioEvalArgs {
     /// Contact physics of the sim GelSight: rigid, hertz, halfspace or layer.
     #[arg(long, default_value = "layer")]
     pub fidelity: Fidelity,
+    /// Sensor profile the sim GelSight renders with (TOML); default the built-in GelSight
+    /// Mini.
+    #[arg(long)]
+    pub sensor: Option<PathBuf>,
     /// Hardness estimator: learned, indentation, hertz or FILE.onnx.
     #[arg(long, default_value = crate::ask::DEFAULT_ESTIMATOR)]
     pub estimator: EstimatorChoice,
@@ -590,6 +593,7 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
             .expect("a valid template"),
     );
     let config = PipelineConfig::default();
+    let sensor = crate::ask::load_sensor(args.sensor.as_deref())?;
     let scores: Vec<RunScore> = jobs
         .par_iter()
         .map(|&(s, d)| -> Result<RunScore> {
@@ -597,7 +601,7 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
             let twin = Twin {
                 scene: &sc.scene,
                 seed: sc.seed,
-                sensor: &TactileSpec::gelsight_mini(),
+                sensor: &sensor,
                 detector: &detectors[d],
                 renderer: &renderer,
                 explainer: &TemplateExplainer,
@@ -724,6 +728,7 @@ mod tests {
                 estimator: "test".into(),
                 contact_criterion: String::new(),
                 fidelity: None,
+                sensor: None,
                 explainer: "template".into(),
                 explain_notice: None,
                 timing: Vec::new(),

@@ -33,6 +33,7 @@ mod output;
 mod parse_prompt;
 mod plot;
 mod press;
+mod sensor_cli;
 mod serve;
 
 use anyhow::{Result, bail};
@@ -74,9 +75,15 @@ enum Command {
     Parse(parse_prompt::ParseArgs),
     /// Press the gel into one object and report force, contact and indentation.
     Press(press::PressArgs),
-    /// Fit a GelSight shading table from annotated presses of a ball of known radius.
+    /// Fit a sensor profile (shading table, background, camera noise) from annotated presses
+    /// of a ball of known radius.
     Calibrate(calibrate::CalibrateArgs),
-    /// Render annotated real presses through a calibration and score them against the real
+    /// Sensor profiles: print one, check one.
+    Sensor {
+        #[command(subcommand)]
+        command: sensor_cli::SensorCommand,
+    },
+    /// Render annotated real presses through a calibrated profile and score them against the real
     /// frames (SSIM, mean absolute intensity error); or, with --session, rebuild a recorded
     /// session's presses in the twin (SSIM, marker displacement error, hardness agreement).
     Compare(compare::CompareArgs),
@@ -254,6 +261,7 @@ fn main() -> ExitCode {
         Command::Parse(args) => parse_prompt::run(&args),
         Command::Press(args) => press::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
+        Command::Sensor { command } => sensor_cli::run(&command),
         Command::Compare(args) => compare::run(&args),
         Command::Markers(args) => markers::run(&args),
         Command::Contact(args) => contact_cli::run(&args),

@@ -60,3 +60,21 @@ pub fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>> {
 pub fn write_png_atomic(path: &Path, image: &image::RgbImage) -> Result<()> {
     write_bytes_atomic(path, &png_bytes(image)?)
 }
+
+/// A sensor profile: its background PNG beside it first, then the TOML, so that a profile
+/// file on disk always has its background.
+pub fn write_profile_atomic(
+    path: &Path,
+    profile: &tactex_core::sensor_profile::SensorProfile,
+) -> Result<()> {
+    use tactex_core::sensor_profile::SensorProfile;
+    let bg = SensorProfile::background_path(path);
+    let bg_name = bg
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if let Some(img) = &profile.background {
+        write_png_atomic(&bg, img)?;
+    }
+    write_bytes_atomic(path, profile.to_toml(&bg_name).as_bytes())
+}

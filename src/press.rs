@@ -9,7 +9,6 @@ use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::hardness::Hardness;
 use tactex_core::hertz::Elastic;
-use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::elastic::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
 };
@@ -82,13 +81,17 @@ pub struct PressArgs {
     /// CPU), gpu (any Vulkan adapter, software included) or cpu.
     #[arg(long, default_value = "auto")]
     device: DeviceChoice,
+    /// Sensor profile whose gel, frame and optics the press uses (TOML); default the
+    /// built-in GelSight Mini. The gel and marker flags override its values.
+    #[arg(long)]
+    sensor: Option<PathBuf>,
     /// Marker grid of the rendered frame, COLSxROWS (the Mini prints 9x7; 11x9 and others
-    /// are common on other gels); 0x0 for none.
-    #[arg(long, default_value = "9x7")]
-    marker_grid: String,
-    /// Marker pitch (mm).
-    #[arg(long, default_value_t = 2.0)]
-    marker_pitch_mm: f64,
+    /// are common on other gels); 0x0 for none. Default: the profile's.
+    #[arg(long)]
+    marker_grid: Option<String>,
+    /// Marker pitch (mm). Default: the profile's.
+    #[arg(long)]
+    marker_pitch_mm: Option<f64>,
     /// Seed of the rendered frame's camera noise.
     #[arg(long, default_value_t = 0)]
     seed: u32,
@@ -119,6 +122,8 @@ impl From<&Grid> for GridReport {
 #[derive(Serialize)]
 struct PressReport {
     fidelity: String,
+    /// The sensor profile (after the gel and marker flags) the press used.
+    sensor: tactex_core::sensor_profile::ProfileId,
     shape: String,
     depth_mm: f64,
     force_n: f64,
@@ -224,21 +229,22 @@ pub fn run(args: &PressArgs) -> Result<()> {
     }
     let hardness = object(args)?;
     let surface = surface(args)?;
-    let mut spec = TactileSpec::gelsight_mini();
-    let (cols, rows) = args
-        .marker_grid
-        .split_once(['x', 'X'])
-        .and_then(|(c, r)| Some((c.trim().parse::<u32>().ok()?, r.trim().parse::<u32>().ok()?)))
-        .filter(|(c, r)| c * r <= 10_000)
-        .with_context(|| {
-            format!(
-                "--marker-grid: '{}' is not COLSxROWS (e.g. 9x7, 11x9)",
-                args.marker_grid
-            )
-        })?;
-    spec.markers.cols = cols;
-    spec.markers.rows = rows;
-    spec.markers.pitch_mm = positive("marker-pitch-mm", args.marker_pitch_mm)?;
+    let mut profile = crate::ask::load_sensor(args.sensor.as_deref())?;
+    let spec = &mut profile.spec;
+    if let Some(grid) = &args.marker_grid {
+        let (cols, rows) = grid
+            .split_once(['x', 'X'])
+            .and_then(|(c, r)| Some((c.trim().parse::<u32>().ok()?, r.trim().parse::<u32>().ok()?)))
+            .filter(|(c, r)| c * r <= 10_000)
+            .with_context(|| {
+                format!("--marker-grid: '{grid}' is not COLSxROWS (e.g. 9x7, 11x9)")
+            })?;
+        spec.markers.cols = cols;
+        spec.markers.rows = rows;
+    }
+    if let Some(pitch) = args.marker_pitch_mm {
+        spec.markers.pitch_mm = positive("marker-pitch-mm", pitch)?;
+    }
     let mut gel = spec.gel;
     if let Some(t) = args.gel_thickness_mm {
         gel.thickness_mm = positive("gel-thickness-mm", t)?;
@@ -246,9 +252,8 @@ pub fn run(args: &PressArgs) -> Result<()> {
     if let Some(e) = args.gel_modulus_mpa {
         gel.modulus_mpa = positive("gel-modulus-mpa", e)?;
     }
-    let pad = Rect::centred(
-        DVec2::new(spec.width_px as f64, spec.height_px as f64) * spec.mm_per_px / 2.0,
-    );
+    spec.gel = gel;
+    let pad = Rect::centred(DVec2::from(spec.pad_size_mm()) / 2.0);
     let problem = ContactProblem {
         surface: &surface,
         object: Elastic {
@@ -266,6 +271,7 @@ pub fn run(args: &PressArgs) -> Result<()> {
     let shown = tactex_core::hardness::HardnessReport::from(hardness);
     let report = PressReport {
         fidelity: fidelity.to_string(),
+        sensor: profile.id(),
         shape: format!("{:?}", args.shape).to_lowercase(),
         depth_mm: args.depth_mm,
         force_n: solution.force_n,
@@ -294,7 +300,7 @@ pub fn run(args: &PressArgs) -> Result<()> {
         }
         let mut renderer = choice.renderer;
         write_maps(dir, &mut solver, &solution, &pad, &report)?;
-        let optics = SensorOptics::for_spec(&spec);
+        let optics = SensorOptics::for_profile(&profile);
         let fields = image_fields(&mut solver, &solution, &gel, &optics);
         let flat = GelImageFields::flat(optics.width, optics.height);
         // The no-contact frame draws its own camera noise, as a real one taken before the

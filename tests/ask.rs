@@ -105,6 +105,8 @@ fn demo_scene_answers_the_softest_fruit_with_positions_hardness_and_latency() {
     }
     // The answer names what it ran on.
     assert_eq!(a["fidelity"], "layer");
+    assert_eq!(a["sensor"]["name"], "GelSight Mini");
+    assert_eq!(a["sensor"]["sha256"].as_str().unwrap().len(), 64);
     assert_eq!(a["estimator"], "onnx_small");
     assert!(
         a["contact_criterion"]

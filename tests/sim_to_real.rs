@@ -27,7 +27,7 @@ const MM_PER_PX: &str = "0.051072522982635343";
 fn calibrated_renderer_matches_held_out_real_presses() {
     let f = fixtures();
     let dir = tempfile::tempdir().unwrap();
-    let calib = dir.path().join("calib.json");
+    let calib = dir.path().join("fots.toml");
     let presses = f.join("ball-presses");
     let annotations = presses.join("annotations.csv");
     let out = tactex(&[
@@ -52,7 +52,7 @@ fn calibrated_renderer_matches_held_out_real_presses() {
     );
     let out = tactex(&[
         "compare",
-        "--calib",
+        "--sensor",
         calib.to_str().unwrap(),
         "--images",
         presses.to_str().unwrap(),
@@ -63,6 +63,8 @@ fn calibrated_renderer_matches_held_out_real_presses() {
         "--json",
     ]);
     let report = json(&out);
+    assert_eq!(report["sensor"]["name"], "fots");
+    assert_eq!(report["sensor"]["sha256"].as_str().unwrap().len(), 64);
     let n = report["presses"].as_array().unwrap().len();
     // Fixture annotations hold 9 presses; every third (3) is held out of the calibration.
     assert_eq!(n, 3);
@@ -83,15 +85,15 @@ fn calibrated_renderer_matches_held_out_real_presses() {
 }
 
 #[test]
-fn compare_rejects_a_bad_calibration_file_in_one_line() {
+fn compare_rejects_a_bad_sensor_profile_in_one_line() {
     let f = fixtures();
     let dir = tempfile::tempdir().unwrap();
-    let calib = dir.path().join("calib.json");
-    std::fs::write(&calib, "{\"format\": \"something else\"}").unwrap();
+    let calib = dir.path().join("calib.toml");
+    std::fs::write(&calib, "format = \"something else\"\n").unwrap();
     let presses = f.join("ball-presses");
     let out = tactex(&[
         "compare",
-        "--calib",
+        "--sensor",
         calib.to_str().unwrap(),
         "--images",
         presses.to_str().unwrap(),
@@ -101,7 +103,7 @@ fn compare_rejects_a_bad_calibration_file_in_one_line() {
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
-    assert!(err.contains("calib.json"), "{err}");
+    assert!(err.contains("calib.toml"), "{err}");
 }
 
 /// The full shared set where this checkout has it, else the fixtures.
@@ -294,7 +296,7 @@ fn markers_found_on_the_real_marker_frame_match_the_annotations() {
 fn calibrate_rejects_bad_input_in_one_line_and_writes_nothing() {
     let f = fixtures();
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("calib.json");
+    let out = dir.path().join("calib.toml");
     let bad_csv = dir.path().join("bad.csv");
     std::fs::write(
         &bad_csv,

@@ -174,6 +174,54 @@ pub fn samples_from_ball_press(
     out
 }
 
+/// The camera's noise (grey levels, 1 sigma per channel, all channels pooled) from one press
+/// frame and the no-contact frame, away from the contact (beyond `rule.flat_beyond` contact
+/// radii): neighbouring pixels' differences of the frame-to-background change cancel the
+/// smooth shading drift between shots and keep the two frames' independent noise, four times
+/// its variance; the odd edge or dust speck (beyond five robust deviations) is left out.
+pub fn camera_noise_sigma(
+    image: &RgbImage,
+    background: &RgbImage,
+    press: &BallPress,
+    rule: &SampleRule,
+) -> Option<f64> {
+    let (w, h) = image.dimensions();
+    if background.dimensions() != (w, h) || w < 2 {
+        return None;
+    }
+    let [cx, cy] = press.centre_px;
+    let far = rule.flat_beyond * press.contact_radius_px;
+    let change = |x: u32, y: u32, c: usize| {
+        f64::from(image.get_pixel(x, y)[c]) - f64::from(background.get_pixel(x, y)[c])
+    };
+    let mut steps = Vec::new();
+    for y in 0..h {
+        for x in 0..w - 1 {
+            if (x as f64 - cx).hypot(y as f64 - cy) <= far {
+                continue;
+            }
+            for c in 0..3 {
+                steps.push(change(x + 1, y, c) - change(x, y, c));
+            }
+        }
+    }
+    if steps.len() < 100 {
+        return None;
+    }
+    // Whole grey levels make the median absolute deviation jump in steps: it only sets the
+    // cut for the odd outlier; the spread is the standard deviation of what stays.
+    let mid = crate::perception::centroid::median(&mut steps.clone())?;
+    let mut dev: Vec<f64> = steps.iter().map(|e| (e - mid).abs()).collect();
+    let cut = 5.0 * (1.4826 * crate::perception::centroid::median(&mut dev)?).max(1.0);
+    let kept: Vec<f64> = steps
+        .into_iter()
+        .filter(|e| (e - mid).abs() <= cut)
+        .collect();
+    let mean = kept.iter().sum::<f64>() / kept.len() as f64;
+    let var = kept.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (kept.len() - 1) as f64;
+    Some(var.sqrt() / 2.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -184,6 +232,33 @@ mod tests {
         assert!((gx + 1.0 / 3f64.sqrt()).abs() < 1e-12 && gy == 0.0);
         assert!(ball_slope(0.0, 0.0, 2.0).unwrap() == (0.0, 0.0));
         assert!(ball_slope(2.0, 0.1, 2.0).is_none());
+    }
+
+    #[test]
+    fn camera_noise_is_read_through_a_smooth_drift() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let sigma = 2.0;
+        let noise = Normal::new(0.0, sigma).unwrap();
+        let mut frame = |drift: f64| {
+            RgbImage::from_fn(160, 120, |x, y| {
+                image::Rgb(std::array::from_fn(|c| {
+                    let v = 120.0 + 20.0 * c as f64 + drift * (x + y) as f64 / 280.0;
+                    (v + noise.sample(&mut rng)).round().clamp(0.0, 255.0) as u8
+                }))
+            })
+        };
+        let (bg, img) = (frame(0.0), frame(25.0));
+        let press = BallPress {
+            image: "p".into(),
+            centre_px: [80.0, 60.0],
+            contact_radius_px: 10.0,
+        };
+        let got = camera_noise_sigma(&img, &bg, &press, &SampleRule::default()).unwrap();
+        // Rounding to whole grey levels adds 1/12 of a level squared.
+        let want = (sigma * sigma + 1.0 / 12.0).sqrt();
+        assert!((got - want).abs() < 0.1 * want, "{got} vs {want}");
     }
 
     #[test]

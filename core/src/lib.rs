@@ -28,6 +28,7 @@ pub mod pipeline;
 pub mod press;
 pub mod query;
 pub mod scene;
+pub mod sensor_profile;
 pub mod shading_table;
 pub mod spectral;
 pub mod stats;

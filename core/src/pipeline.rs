@@ -192,6 +192,9 @@ pub struct Answer {
     /// The twin's contact physics (rigid, hertz, halfspace, layer); None on real or replayed
     /// devices.
     pub fidelity: Option<String>,
+    /// The tactile sensor's profile (name and content hash) the presses were rendered or
+    /// read through, when one is known.
+    pub sensor: Option<crate::sensor_profile::ProfileId>,
     /// "template", or "llm:<model>" when a model's grounded reply is the answer.
     pub explainer: String,
     /// Why a model's reply was not used, when the template stood in for it.
@@ -464,6 +467,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
         estimator: estimator.name().into(),
         contact_criterion: CONTACT_CRITERION.into(),
         fidelity: None,
+        sensor: None,
         explainer: explanation.explainer,
         explain_notice: explanation.notice,
         timing,

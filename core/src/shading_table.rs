@@ -148,6 +148,30 @@ impl ShadingTable {
         })
     }
 
+    /// The colour change of the flat gel at normalised position (u, v): zero for a sensor whose
+    /// no-contact frame is its background. Calibration presses taken some time after the
+    /// background show a smooth drift here, which `split_flat` moves into the background.
+    pub fn flat_change(&self, u: f32, v: f32) -> [f32; 3] {
+        self.change(0.0, 0.0, u, v)
+    }
+
+    /// The table less its flat change, and that change: every node's quadratic less the
+    /// magnitude-0 node's, so that, the interpolation weights summing to one, the new table
+    /// gives exactly `change - flat_change` at every slope and place.
+    pub fn split_flat(&self) -> ShadingTable {
+        let per_node = 3 * TERMS;
+        let flat: Vec<f32> = self.coefficients[..per_node].to_vec();
+        let coefficients = self
+            .coefficients
+            .chunks(per_node)
+            .flat_map(|node| node.iter().zip(&flat).map(|(c, f)| c - f))
+            .collect();
+        ShadingTable {
+            coefficients,
+            ..self.clone()
+        }
+    }
+
     /// Least-squares fit of the table to `samples`. Each sample constrains the four nodes
     /// around its slope with its bilinear weights; `smoothness` (grey levels^2 per unit
     /// difference) ties neighbouring nodes together and fills nodes without data. The
@@ -301,6 +325,40 @@ fn solve_spd(a: &mut [f64], n: usize, b: &[[f64; 3]]) -> Option<Vec<[f64; 3]>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn splitting_off_the_flat_change_keeps_every_change_less_it() {
+        let table = ShadingTable {
+            mag_bins: 4,
+            dir_bins: 6,
+            mag_max: 2.0,
+            coefficients: (0..4 * 6 * 3 * TERMS)
+                .map(|k| ((k * 37 % 101) as f32 - 50.0) * 0.1)
+                .collect(),
+        };
+        // A fitted table's magnitude-0 nodes are one node; make this one's so too.
+        let mut table = table;
+        let first: Vec<f32> = table.coefficients[..3 * TERMS].to_vec();
+        for d in 0..6 {
+            table.coefficients[d * 3 * TERMS..(d + 1) * 3 * TERMS].copy_from_slice(&first);
+        }
+        let split = table.split_flat();
+        for (gx, gy, u, v) in [
+            (0.0, 0.0, 0.3, -0.7),
+            (0.4, -1.1, -0.9, 0.2),
+            (3.0, 0.5, 0.0, 1.0),
+        ] {
+            let (a, f, b) = (
+                table.change(gx, gy, u, v),
+                table.flat_change(u, v),
+                split.change(gx, gy, u, v),
+            );
+            for c in 0..3 {
+                assert!((a[c] - f[c] - b[c]).abs() < 1e-4, "{a:?} - {f:?} vs {b:?}");
+            }
+        }
+        assert!(split.flat_change(0.5, 0.5).iter().all(|c| c.abs() < 1e-5));
+    }
 
     /// A shading law the table can represent only approximately: smooth in slope and in
     /// position, like coloured lights at the rim.

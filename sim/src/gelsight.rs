@@ -12,6 +12,7 @@ use crate::world::SharedWorld;
 use tactex_core::devices::{DeviceError, TactileSensor};
 use tactex_core::frames::TactileFrame;
 use tactex_core::hertz::Elastic;
+use tactex_core::sensor_profile::SensorProfile;
 use tactex_core::tactile_spec::TactileSpec;
 
 pub struct SimGelSight {
@@ -27,12 +28,11 @@ pub struct SimGelSight {
 }
 
 impl SimGelSight {
-    pub fn new(world: SharedWorld, spec: TactileSpec, fidelity: Fidelity, seed: u64) -> Self {
-        let optics = SensorOptics::for_spec(&spec);
+    pub fn new(world: SharedWorld, sensor: &SensorProfile, fidelity: Fidelity, seed: u64) -> Self {
         Self {
             world,
-            spec,
-            optics,
+            spec: sensor.spec.clone(),
+            optics: SensorOptics::for_profile(sensor),
             fidelity,
             solver: ContactSolver::new(),
             press: PressGrid::default(),

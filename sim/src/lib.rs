@@ -23,7 +23,7 @@ pub mod world;
 
 use elastic::Fidelity;
 use tactex_core::scene::Scene;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::sensor_profile::SensorProfile;
 
 /// The three sim devices over one shared world.
 pub struct SimDevices {
@@ -36,22 +36,23 @@ pub struct SimDevices {
 impl SimDevices {
     /// The devices with the stock GelSight Mini, its contact solved at the `layer` level.
     pub fn from_scene(scene: &Scene, seed: u64) -> Result<Self, world::WorldError> {
-        Self::with_sensor(scene, seed, TactileSpec::gelsight_mini(), Fidelity::Layer)
+        Self::with_sensor(scene, seed, SensorProfile::gelsight_mini(), Fidelity::Layer)
     }
 
-    /// The devices with another tactile sensor than the stock GelSight Mini (a softer gel,
-    /// another marker grid: what-if runs, and sessions recorded with such a sensor), its
-    /// contact solved at `fidelity`.
+    /// The devices with another tactile sensor than the stock GelSight Mini (a user's
+    /// calibrated profile, a softer gel, another marker grid: what-if runs, and sessions
+    /// recorded with such a sensor), its contact solved at `fidelity`.
     pub fn with_sensor(
         scene: &Scene,
         seed: u64,
-        spec: TactileSpec,
+        sensor: SensorProfile,
         fidelity: Fidelity,
     ) -> Result<Self, world::WorldError> {
         let shared = world::SimWorld::from_scene(scene)?.shared();
+        let spec = sensor.spec.clone();
         Ok(Self {
             camera: camera::SimCamera::new(shared.clone(), seed),
-            tactile: gelsight::SimGelSight::new(shared.clone(), spec.clone(), fidelity, seed),
+            tactile: gelsight::SimGelSight::new(shared.clone(), &sensor, fidelity, seed),
             arm: arm::SimArm::new(shared.clone(), spec),
             world: shared,
         })

@@ -28,7 +28,7 @@ use tactex_core::estimate::HardnessEstimator;
 use tactex_core::explain::Explainer;
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::sensor_profile::SensorProfile;
 use tactex_sim::SimDevices;
 use tactex_sim::camera::SimCamera;
 use tactex_sim::elastic::Fidelity;
@@ -70,6 +70,7 @@ struct Served {
     explainer: Box<dyn Explainer>,
     estimator: Box<dyn HardnessEstimator + Send + Sync>,
     fidelity: Fidelity,
+    sensor: SensorProfile,
     seed: u64,
     /// The live view's camera: the twin's camera on its own noise stream.
     live: Mutex<SimCamera>,
@@ -94,6 +95,7 @@ pub fn run(args: &ServeArgs) -> Result<()> {
         explainer,
         estimator,
         fidelity,
+        sensor,
     } = args.twin.open()?;
     let mut live = SimDevices::from_scene(&scene, args.seed.wrapping_add(1))?.camera;
     live.set_renderer(renderer.clone());
@@ -106,6 +108,7 @@ pub fn run(args: &ServeArgs) -> Result<()> {
         explainer,
         estimator,
         fidelity,
+        sensor,
         seed: args.seed,
         live: Mutex::new(live),
         queries: Mutex::default(),
@@ -302,7 +305,7 @@ fn answer_question(s: &Served, run: &QueryRun, prompt: &str) {
     let twin = Twin {
         scene: &s.scene,
         seed: s.seed,
-        sensor: &TactileSpec::gelsight_mini(),
+        sensor: &s.sensor,
         detector: &s.detector,
         renderer: &s.renderer,
         explainer: s.explainer.as_ref(),

@@ -71,6 +71,9 @@ pub struct TwinRecord {
     /// The sim GelSight's contact physics (rigid, hertz, halfspace, layer).
     #[serde(default)]
     pub fidelity: Option<String>,
+    /// The sim GelSight's sensor profile.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<tactex_core::sensor_profile::ProfileId>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

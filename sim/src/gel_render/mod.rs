@@ -7,7 +7,6 @@
 //! shaders) and `GpuRenderer` (the WGSL compute stages in `shaders/` through wgpu). Both
 //! render batches of presses; the GPU renders a whole batch per dispatch.
 
-mod calibration;
 mod cpu;
 mod device;
 mod fields;
@@ -15,7 +14,6 @@ mod gpu;
 mod noise;
 
 pub use crate::render_device::{DeviceChoice, RenderError, adapters};
-pub use calibration::{CALIBRATION_FORMAT, FitReport, GelCalibration};
 pub use cpu::CpuRenderer;
 pub use device::{RendererChoice, open_renderer};
 pub use fields::image_fields;
@@ -24,18 +22,9 @@ pub use gpu::{GpuRenderer, SHADER_SOURCES, shader_source};
 pub use noise::gaussian3;
 
 use image::RgbImage;
-use tactex_core::photometric::PhotometricModel;
-use tactex_core::shading_table::ShadingTable;
+use tactex_core::sensor_profile::SensorProfile;
+pub use tactex_core::sensor_profile::Shading;
 use tactex_core::tactile_spec::TactileSpec;
-
-/// How slopes become colour.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Shading {
-    /// Analytic: each colour channel lit by one light; gain over the background.
-    Lights(PhotometricModel),
-    /// Calibrated from real ball presses: colour change added to the background.
-    Table(ShadingTable),
-}
 
 /// Everything about the sensor's optics that stays fixed from frame to frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -122,23 +111,35 @@ pub fn synthetic_background(width: u32, height: u32) -> Vec<[f32; 3]> {
 }
 
 impl SensorOptics {
-    /// The spec's sensor with a synthetic background, analytic lights and its marker grid.
+    /// The spec's sensor with the stock optics (synthetic background, analytic lights, its
+    /// marker grid): `SensorProfile::stock`.
     pub fn for_spec(spec: &TactileSpec) -> Self {
+        Self::for_profile(&SensorProfile::stock(spec.clone()))
+    }
+
+    /// What the profile's sensor renders with: its background (or the synthetic one), its
+    /// shading, marker grid, vignetting and camera noise.
+    pub fn for_profile(profile: &SensorProfile) -> Self {
+        let spec = &profile.spec;
+        let background = match &profile.background {
+            Some(img) => img.pixels().map(|p| p.0.map(f32::from)).collect(),
+            None => synthetic_background(spec.width_px, spec.height_px),
+        };
         Self {
             width: spec.width_px,
             height: spec.height_px,
             mm_per_px: spec.mm_per_px,
-            background: synthetic_background(spec.width_px, spec.height_px),
-            shading: Shading::Lights(spec.photometric),
+            background,
+            shading: profile.shading(),
             markers: spec
                 .marker_rest_px()
                 .into_iter()
                 .map(|(x, y)| [x as f32, y as f32])
                 .collect(),
             marker_radius_px: (spec.markers.radius_mm / spec.mm_per_px) as f32,
-            marker_darkness: 0.82,
-            vignette: 0.55,
-            noise_sigma: 0.5,
+            marker_darkness: profile.marker_darkness as f32,
+            vignette: profile.vignette as f32,
+            noise_sigma: profile.noise_sigma_grey as f32,
         }
     }
 

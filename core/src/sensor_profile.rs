@@ -1,0 +1,637 @@
+//! A sensor profile: one file that describes a vision-based tactile sensor completely, so that
+//! the twin renders with it, data generation draws around it, and the estimators read its
+//! frames through it. The format is TOML (`tactex-sensor-profile/1`, documented in
+//! `docs/sensor_profile.md`) with the no-contact frame as an adjacent PNG; `tactex calibrate`
+//! writes one from ball presses, and the built-in GelSight Mini profile is the default.
+//!
+//! A profile is named in every output that depends on it by its name and the SHA-256 of its
+//! contents (the canonical TOML, without the background's file name, then the background's
+//! pixels), so two profiles that render alike hash alike wherever their files live.
+
+use crate::photometric::PhotometricModel;
+use crate::shading_table::ShadingTable;
+use crate::tactile_spec::{GelSpec, MarkerGrid, TactileSpec};
+use image::RgbImage;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+
+pub const PROFILE_FORMAT: &str = "tactex-sensor-profile/1";
+
+/// How gel surface slopes become colour.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shading {
+    /// Analytic: each colour channel lit by one light; gain over the background.
+    Lights(PhotometricModel),
+    /// Calibrated from real ball presses: colour change added to the background.
+    Table(ShadingTable),
+}
+
+/// How the calibration that produced a profile went (`tactex calibrate`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrationFit {
+    /// The ball presses the table was fitted to.
+    pub images: Vec<String>,
+    pub samples: usize,
+    /// Root mean square residual of the fit per channel (grey levels).
+    pub rms_grey: [f64; 3],
+    pub ball_radius_mm: f64,
+}
+
+/// Everything about one sensor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensorProfile {
+    /// Where the calibration images came from (attribution travels with the profile).
+    pub source: String,
+    /// Frame geometry, gel, marker grid and frame rate; its `model` is the profile's name.
+    pub spec: TactileSpec,
+    /// The calibrated gradient -> colour table; None: the analytic lights of
+    /// `spec.photometric`.
+    pub table: Option<ShadingTable>,
+    /// The no-contact frame; None: the twin's synthetic one.
+    pub background: Option<RgbImage>,
+    /// Camera noise per channel (grey levels, 1 sigma).
+    pub noise_sigma_grey: f64,
+    /// Relative darkening at the frame's corners (0 when the background is a real frame: it
+    /// carries its own).
+    pub vignette: f64,
+    /// Fraction of the light a marker dot's centre blocks.
+    pub marker_darkness: f64,
+    pub fit: Option<CalibrationFit>,
+}
+
+/// A profile as outputs name it.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ProfileId {
+    pub name: String,
+    pub sha256: String,
+}
+
+impl std::fmt::Display for ProfileId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} ({})",
+            self.name,
+            &self.sha256[..12.min(self.sha256.len())]
+        )
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}: {field}: {message}")]
+pub struct ProfileError {
+    /// The profile file (or "built-in").
+    pub file: String,
+    /// The field, as a TOML path (`camera.mm_per_px`), or "toml" for a parse error.
+    pub field: String,
+    pub message: String,
+}
+
+// The file's layout. Kept apart from `SensorProfile` so that the file can stay stable while
+// the types behind it change.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProfileFile {
+    format: String,
+    name: String,
+    #[serde(default)]
+    source: String,
+    camera: CameraSection,
+    gel: GelSection,
+    optics: OpticsSection,
+    markers: MarkersSection,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    fit: Option<CalibrationFit>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraSection {
+    width_px: u32,
+    height_px: u32,
+    mm_per_px: f64,
+    frame_rate_hz: f64,
+    noise_sigma_grey: f64,
+    vignette: f64,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GelSection {
+    modulus_mpa: f64,
+    poisson: f64,
+    thickness_mm: f64,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OpticsSection {
+    /// "synthetic", or a PNG file relative to the profile.
+    background: String,
+    /// "lights" or "table".
+    shading: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    lights: Option<LightsSection>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    table: Option<ShadingTable>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightsSection {
+    /// Unit directions from the surface towards the red, green and blue light (x along the
+    /// frame's columns, y along its rows, z towards the camera).
+    directions: [[f64; 3]; 3],
+    ambient: f64,
+    gain: f64,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MarkersSection {
+    cols: u32,
+    rows: u32,
+    pitch_mm: f64,
+    radius_mm: f64,
+    darkness: f64,
+}
+
+const SYNTHETIC: &str = "synthetic";
+
+impl SensorProfile {
+    /// The stock GelSight Mini: its spec, analytic lights over the twin's synthetic
+    /// background, vignetting and camera noise as the twin has always rendered it.
+    pub fn gelsight_mini() -> Self {
+        Self::stock(TactileSpec::gelsight_mini())
+    }
+
+    /// A profile for `spec` with the stock optics (a what-if sensor: another gel, another
+    /// marker grid).
+    pub fn stock(spec: TactileSpec) -> Self {
+        Self {
+            source: String::new(),
+            spec,
+            table: None,
+            background: None,
+            noise_sigma_grey: 0.5,
+            vignette: 0.55,
+            marker_darkness: 0.82,
+            fit: None,
+        }
+    }
+
+    /// Reads and checks a profile file (its background PNG beside it); errors name the file
+    /// and the field.
+    pub fn load(path: &Path) -> Result<Self, ProfileError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| ProfileError {
+            file: file.clone(),
+            field: "file".into(),
+            message: format!("cannot read: {e}"),
+        })?;
+        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::from_toml(&text, &file, &dir)
+    }
+
+    /// Parses and checks a profile's text; a background file is looked for in `dir`.
+    pub fn from_toml(text: &str, file: &str, dir: &Path) -> Result<Self, ProfileError> {
+        let err = |field: &str, message: String| ProfileError {
+            file: file.into(),
+            field: field.into(),
+            message,
+        };
+        let raw: ProfileFile = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+            let message = e.message().replace('\n', " ");
+            match line {
+                Some(l) => err("toml", format!("line {l}: {message}")),
+                None => err("toml", message),
+            }
+        })?;
+        if raw.format != PROFILE_FORMAT {
+            return Err(err(
+                "format",
+                format!("'{}', expected '{PROFILE_FORMAT}'", raw.format),
+            ));
+        }
+        let shading = match raw.optics.shading.as_str() {
+            "lights" => {
+                let l = raw.optics.lights.as_ref().ok_or_else(|| {
+                    err(
+                        "optics.lights",
+                        "missing: shading = \"lights\" needs an [optics.lights] table".into(),
+                    )
+                })?;
+                Shading::Lights(PhotometricModel {
+                    lights: l.directions.map(glam::DVec3::from_array),
+                    ambient: l.ambient,
+                    gain: l.gain,
+                })
+            }
+            "table" => Shading::Table(raw.optics.table.clone().ok_or_else(|| {
+                err(
+                    "optics.table",
+                    "missing: shading = \"table\" needs an [optics.table] table".into(),
+                )
+            })?),
+            other => {
+                return Err(err(
+                    "optics.shading",
+                    format!("'{other}', expected 'lights' or 'table'"),
+                ));
+            }
+        };
+        let background = match raw.optics.background.as_str() {
+            SYNTHETIC => None,
+            name => {
+                let at = dir.join(name);
+                let img = image::open(&at)
+                    .map_err(|e| {
+                        err(
+                            "optics.background",
+                            format!("{}: not a readable image: {e}", at.display()),
+                        )
+                    })?
+                    .to_rgb8();
+                Some(img)
+            }
+        };
+        let c = &raw.camera;
+        let m = &raw.markers;
+        let (photometric, table) = match shading {
+            Shading::Lights(l) => (l, None),
+            Shading::Table(t) => (PhotometricModel::default(), Some(t)),
+        };
+        let profile = SensorProfile {
+            source: raw.source.clone(),
+            spec: TactileSpec {
+                model: raw.name.clone(),
+                width_px: c.width_px,
+                height_px: c.height_px,
+                mm_per_px: c.mm_per_px,
+                gel: GelSpec {
+                    modulus_mpa: raw.gel.modulus_mpa,
+                    poisson: raw.gel.poisson,
+                    thickness_mm: raw.gel.thickness_mm,
+                },
+                photometric,
+                markers: MarkerGrid {
+                    cols: m.cols,
+                    rows: m.rows,
+                    pitch_mm: m.pitch_mm,
+                    radius_mm: m.radius_mm,
+                },
+                frame_rate_hz: c.frame_rate_hz,
+            },
+            table,
+            background,
+            noise_sigma_grey: c.noise_sigma_grey,
+            vignette: c.vignette,
+            marker_darkness: m.darkness,
+            fit: raw.fit,
+        };
+        profile
+            .validate()
+            .map_err(|(field, message)| err(&field, message))?;
+        Ok(profile)
+    }
+
+    /// Checks every field's range and that the parts agree; Err names the field.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        let bad = |field: &str, message: String| Err((field.to_string(), message));
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if self.name().trim().is_empty() {
+            return bad("name", "must not be empty".into());
+        }
+        let s = &self.spec;
+        for (field, v) in [
+            ("camera.width_px", s.width_px),
+            ("camera.height_px", s.height_px),
+        ] {
+            if !(8..=4096).contains(&v) {
+                return bad(field, format!("{v} px, expected 8..=4096"));
+            }
+        }
+        if !(positive(s.mm_per_px) && s.mm_per_px <= 1.0) {
+            return bad(
+                "camera.mm_per_px",
+                format!("{}, expected a scale in (0, 1] mm per pixel", s.mm_per_px),
+            );
+        }
+        if !(positive(s.frame_rate_hz) && s.frame_rate_hz <= 10_000.0) {
+            return bad(
+                "camera.frame_rate_hz",
+                format!("{}, expected a rate in (0, 10000] Hz", s.frame_rate_hz),
+            );
+        }
+        if !(self.noise_sigma_grey.is_finite() && (0.0..=64.0).contains(&self.noise_sigma_grey)) {
+            return bad(
+                "camera.noise_sigma_grey",
+                format!("{}, expected 0..=64 grey levels", self.noise_sigma_grey),
+            );
+        }
+        if !(self.vignette.is_finite() && (0.0..=1.0).contains(&self.vignette)) {
+            return bad(
+                "camera.vignette",
+                format!("{}, expected 0..=1", self.vignette),
+            );
+        }
+        let g = &s.gel;
+        if !(positive(g.modulus_mpa) && g.modulus_mpa <= 1000.0) {
+            return bad(
+                "gel.modulus_mpa",
+                format!("{}, expected (0, 1000] MPa", g.modulus_mpa),
+            );
+        }
+        if !(g.poisson.is_finite() && (0.0..=0.5).contains(&g.poisson)) {
+            return bad("gel.poisson", format!("{}, expected 0..=0.5", g.poisson));
+        }
+        if !(positive(g.thickness_mm) && g.thickness_mm <= 50.0) {
+            return bad(
+                "gel.thickness_mm",
+                format!("{}, expected (0, 50] mm", g.thickness_mm),
+            );
+        }
+        match &self.shading() {
+            Shading::Lights(l) => {
+                if !l
+                    .lights
+                    .iter()
+                    .all(|d| d.is_finite() && (d.length() - 1.0).abs() < 1e-3)
+                {
+                    return bad("optics.lights.directions", "must be unit vectors".into());
+                }
+                if !(l.ambient.is_finite() && l.ambient >= 0.0) {
+                    return bad(
+                        "optics.lights.ambient",
+                        format!("{}, expected >= 0", l.ambient),
+                    );
+                }
+                if !positive(l.gain) {
+                    return bad("optics.lights.gain", format!("{}, expected > 0", l.gain));
+                }
+                if !l.lights.iter().all(|d| d.z > 0.0) {
+                    return bad(
+                        "optics.lights.directions",
+                        "every light must shine on the flat gel (z > 0)".into(),
+                    );
+                }
+                let det =
+                    glam::DMat3::from_cols(l.lights[0], l.lights[1], l.lights[2]).determinant();
+                if det.abs() < 1e-3 {
+                    return bad(
+                        "optics.lights.directions",
+                        "the three lights must not lie in one plane (slopes could not be read back)"
+                            .into(),
+                    );
+                }
+            }
+            Shading::Table(t) => {
+                if let Err(e) = t.validate() {
+                    return bad("optics.table", e.to_string());
+                }
+            }
+        }
+        if let Some(bg) = &self.background
+            && bg.dimensions() != (s.width_px, s.height_px)
+        {
+            return bad(
+                "optics.background",
+                format!(
+                    "the image is {} x {} px, the camera {} x {}",
+                    bg.width(),
+                    bg.height(),
+                    s.width_px,
+                    s.height_px
+                ),
+            );
+        }
+        let m = &s.markers;
+        if u64::from(m.cols) * u64::from(m.rows) > 10_000 {
+            return bad(
+                "markers",
+                format!("{} x {} markers, at most 10000", m.cols, m.rows),
+            );
+        }
+        if !(positive(m.pitch_mm)) {
+            return bad("markers.pitch_mm", format!("{}, expected > 0", m.pitch_mm));
+        }
+        if !(m.radius_mm.is_finite() && m.radius_mm >= 0.0 && m.radius_mm < m.pitch_mm / 2.0) {
+            return bad(
+                "markers.radius_mm",
+                format!(
+                    "{}, expected 0 or more and under half the pitch ({} mm)",
+                    m.radius_mm, m.pitch_mm
+                ),
+            );
+        }
+        if !(self.marker_darkness.is_finite() && (0.0..=1.0).contains(&self.marker_darkness)) {
+            return bad(
+                "markers.darkness",
+                format!("{}, expected 0..=1", self.marker_darkness),
+            );
+        }
+        if let Some(fit) = &self.fit
+            && !(positive(fit.ball_radius_mm) && fit.rms_grey.iter().all(|v| v.is_finite()))
+        {
+            return bad(
+                "fit",
+                "ball_radius_mm must be > 0 and rms_grey finite".into(),
+            );
+        }
+        Ok(())
+    }
+
+    fn to_file(&self, background: &str) -> ProfileFile {
+        let s = &self.spec;
+        let (shading, lights, table) = match &self.shading() {
+            Shading::Lights(l) => (
+                "lights",
+                Some(LightsSection {
+                    directions: l.lights.map(|d| d.to_array()),
+                    ambient: l.ambient,
+                    gain: l.gain,
+                }),
+                None,
+            ),
+            Shading::Table(t) => ("table", None, Some(t.clone())),
+        };
+        ProfileFile {
+            format: PROFILE_FORMAT.into(),
+            name: self.name().into(),
+            source: self.source.clone(),
+            camera: CameraSection {
+                width_px: s.width_px,
+                height_px: s.height_px,
+                mm_per_px: s.mm_per_px,
+                frame_rate_hz: s.frame_rate_hz,
+                noise_sigma_grey: self.noise_sigma_grey,
+                vignette: self.vignette,
+            },
+            gel: GelSection {
+                modulus_mpa: s.gel.modulus_mpa,
+                poisson: s.gel.poisson,
+                thickness_mm: s.gel.thickness_mm,
+            },
+            optics: OpticsSection {
+                background: background.into(),
+                shading: shading.into(),
+                lights,
+                table,
+            },
+            markers: MarkersSection {
+                cols: s.markers.cols,
+                rows: s.markers.rows,
+                pitch_mm: s.markers.pitch_mm,
+                radius_mm: s.markers.radius_mm,
+                darkness: self.marker_darkness,
+            },
+            fit: self.fit.clone(),
+        }
+    }
+
+    /// The profile's TOML, its background (if any) named `background_file`.
+    pub fn to_toml(&self, background_file: &str) -> String {
+        let name = if self.background.is_some() {
+            background_file
+        } else {
+            SYNTHETIC
+        };
+        toml::to_string(&self.to_file(name)).expect("a profile serialises to TOML")
+    }
+
+    /// The background's file name beside a profile written to `path`: `NAME.background.png`.
+    pub fn background_path(path: &Path) -> PathBuf {
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "sensor".into());
+        path.with_file_name(format!("{stem}.background.png"))
+    }
+
+    /// Its name and the SHA-256 of its contents.
+    pub fn id(&self) -> ProfileId {
+        let mut h = Sha256::new();
+        h.update(self.to_toml("").as_bytes());
+        if let Some(bg) = &self.background {
+            h.update(bg.width().to_le_bytes());
+            h.update(bg.height().to_le_bytes());
+            h.update(bg.as_raw());
+        }
+        let digest = h.finalize();
+        ProfileId {
+            name: self.name().into(),
+            sha256: digest.iter().map(|b| format!("{b:02x}")).collect(),
+        }
+    }
+
+    pub fn name(&self) -> &str {
+        &self.spec.model
+    }
+
+    /// How its gel's slopes become colour.
+    pub fn shading(&self) -> Shading {
+        match &self.table {
+            Some(t) => Shading::Table(t.clone()),
+            None => Shading::Lights(self.spec.photometric),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<SensorProfile, ProfileError> {
+        SensorProfile::from_toml(text, "p.toml", Path::new("."))
+    }
+
+    #[test]
+    fn the_stock_profile_round_trips_through_its_toml() {
+        let stock = SensorProfile::gelsight_mini();
+        let back = parse(&stock.to_toml("")).unwrap();
+        assert_eq!(back, stock);
+        assert_eq!(back.id(), stock.id());
+        assert_eq!(stock.id().sha256.len(), 64);
+    }
+
+    #[test]
+    fn a_calibrated_profile_round_trips_with_its_background() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut p = SensorProfile::gelsight_mini();
+        p.spec.model = "bench sensor".into();
+        p.table = Some(ShadingTable {
+            mag_bins: 2,
+            dir_bins: 3,
+            mag_max: 1.5,
+            coefficients: (0..2 * 3 * 3 * 6).map(|k| k as f32 * 0.37 - 3.1).collect(),
+        });
+        p.background = Some(RgbImage::from_fn(320, 240, |x, y| {
+            image::Rgb([(x % 251) as u8, (y % 241) as u8, 90])
+        }));
+        let path = dir.path().join("bench.toml");
+        let bg = SensorProfile::background_path(&path);
+        p.background.as_ref().unwrap().save(&bg).unwrap();
+        std::fs::write(&path, p.to_toml("bench.background.png")).unwrap();
+        let back = SensorProfile::load(&path).unwrap();
+        assert_eq!(back, p);
+        assert_eq!(back.id(), p.id());
+        assert_ne!(back.id(), SensorProfile::gelsight_mini().id());
+    }
+
+    #[test]
+    fn any_change_of_contents_changes_the_hash() {
+        let stock = SensorProfile::gelsight_mini();
+        let mut softer = stock.clone();
+        softer.spec.gel.modulus_mpa = 0.2;
+        assert_ne!(softer.id().sha256, stock.id().sha256);
+    }
+
+    #[test]
+    fn bad_fields_are_named() {
+        let stock = SensorProfile::gelsight_mini().to_toml("");
+        for (from, to, field) in [
+            ("mm_per_px = 0.0634", "mm_per_px = -1.0", "camera.mm_per_px"),
+            ("poisson = 0.49", "poisson = 0.7", "gel.poisson"),
+            (
+                "thickness_mm = 4.0",
+                "thickness_mm = nan",
+                "gel.thickness_mm",
+            ),
+            ("vignette = 0.55", "vignette = 2.0", "camera.vignette"),
+            ("darkness = 0.82", "darkness = -0.1", "markers.darkness"),
+            ("radius_mm = 0.25", "radius_mm = 1.5", "markers.radius_mm"),
+            (
+                "shading = \"lights\"",
+                "shading = \"magic\"",
+                "optics.shading",
+            ),
+            (
+                "background = \"synthetic\"",
+                "background = \"nowhere.png\"",
+                "optics.background",
+            ),
+            (
+                "format = \"tactex-sensor-profile/1\"",
+                "format = \"tactex-sensor-profile/9\"",
+                "format",
+            ),
+        ] {
+            assert!(stock.contains(from), "{from} not in\n{stock}");
+            let e = match parse(&stock.replacen(from, to, 1)) {
+                Ok(_) => panic!("{to}: accepted"),
+                Err(e) => e,
+            };
+            assert_eq!(e.field, field, "{to}: {e}");
+            assert!(!e.to_string().contains('\n'), "{e}");
+        }
+        let e = parse("format = 3").unwrap_err();
+        assert_eq!(e.field, "toml");
+        let e = parse(&stock.replacen("[gel]", "[gel]\nshore = 3", 1)).unwrap_err();
+        assert!(e.message.contains("shore"), "{e}");
+    }
+}

@@ -1,0 +1,186 @@
+//! Sensor profiles end to end: `calibrate` writes one from real ball presses (FOTS fixtures,
+//! with their attribution in tests/fixtures/fots), `sensor show|check` read it, `press
+//! --sensor` renders with it, and bad profiles fail in one line naming the field.
+
+use std::path::{Path, PathBuf};
+mod cli;
+
+use cli::{json, one_line_error, tactex};
+use tactex_core::perception::ssim::ssim_rgb;
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fots")
+}
+
+/// `calibrate` on the fixtures' ball presses into `dir/fots.toml`.
+fn calibrated(dir: &Path) -> PathBuf {
+    let f = fixtures();
+    let presses = f.join("ball-presses");
+    let profile = dir.join("fots.toml");
+    let out = tactex(&[
+        "calibrate",
+        "--images",
+        presses.to_str().unwrap(),
+        "--annotations",
+        presses.join("annotations.csv").to_str().unwrap(),
+        "--background",
+        f.join("background.png").to_str().unwrap(),
+        "--ball-radius-mm",
+        "2.35",
+        "--mm-per-px",
+        "0.051072522982635343",
+        "--out",
+        profile.to_str().unwrap(),
+        "--source",
+        "FOTS (Zhao et al., RA-L 2024), MIT",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    profile
+}
+
+#[test]
+fn a_calibrated_profile_renders_its_background_when_nothing_touches() {
+    let dir = tempfile::tempdir().unwrap();
+    let profile = calibrated(dir.path());
+    let background = dir.path().join("fots.background.png");
+    assert!(background.is_file());
+    let shown = json(&tactex(&[
+        "sensor",
+        "show",
+        profile.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(shown["sensor"]["name"], "fots");
+    assert_eq!(shown["width_px"], 240);
+    assert_eq!(shown["height_px"], 320);
+    assert!(shown["shading"].as_str().unwrap().contains("table"));
+    // A real camera: a grey level of noise or so.
+    let noise = shown["noise_sigma_grey"].as_f64().unwrap();
+    assert!((0.2..3.0).contains(&noise), "{noise}");
+
+    let out = dir.path().join("press");
+    let report = json(&tactex(&[
+        "press",
+        "--shape",
+        "sphere",
+        "--radius-mm",
+        "2.35",
+        "--hardness",
+        "rigid",
+        "--depth-mm",
+        "0.4",
+        "--sensor",
+        profile.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(report["sensor"], shown["sensor"]);
+    let open = |p: &Path| image::open(p).unwrap().to_rgb8();
+    let (reference, tactile, bg) = (
+        open(&out.join("reference.png")),
+        open(&out.join("tactile.png")),
+        open(&background),
+    );
+    assert_eq!(reference.dimensions(), (240, 320));
+    let at_rest = ssim_rgb(&reference, &bg).unwrap();
+    assert!(
+        at_rest >= 0.95,
+        "no-contact frame vs background: SSIM {at_rest}"
+    );
+    // The press shows where the ball is: tens of grey levels, against a few of noise.
+    let changed = tactile
+        .pixels()
+        .zip(reference.pixels())
+        .map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap())
+        .max()
+        .unwrap();
+    assert!(changed > 30, "largest change {changed} grey levels");
+}
+
+#[test]
+fn the_built_in_profile_prints_as_a_profile_that_loads_to_the_same_hash() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = tactex(&["sensor", "show", "--toml"]);
+    assert!(toml.status.success());
+    let path = dir.path().join("mini.toml");
+    std::fs::write(&path, &toml.stdout).unwrap();
+    let builtin = json(&tactex(&["sensor", "show", "--json"]));
+    let loaded = json(&tactex(&[
+        "sensor",
+        "show",
+        path.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(builtin["sensor"], loaded["sensor"]);
+    let checked = json(&tactex(&[
+        "sensor",
+        "check",
+        path.to_str().unwrap(),
+        "--json",
+    ]));
+    assert!(
+        checked["no_contact_ssim"].as_f64().unwrap() > 0.5,
+        "{checked}"
+    );
+}
+
+#[test]
+fn bad_profiles_fail_in_one_line_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let stock = String::from_utf8(tactex(&["sensor", "show", "--toml"]).stdout).unwrap();
+    for (from, to, field) in [
+        ("mm_per_px = 0.0634", "mm_per_px = 0.0", "camera.mm_per_px"),
+        ("modulus_mpa = 0.3", "modulus_mpa = -2.0", "gel.modulus_mpa"),
+        (
+            "noise_sigma_grey = 0.5",
+            "noise_sigma_grey = inf",
+            "camera.noise_sigma_grey",
+        ),
+        ("width_px = 320", "width_px = 0", "camera.width_px"),
+        (
+            "background = \"synthetic\"",
+            "background = \"gone.png\"",
+            "optics.background",
+        ),
+        (
+            "shading = \"lights\"",
+            "shading = \"table\"",
+            "optics.table",
+        ),
+        ("cols = 9", "cols = \"nine\"", "line"),
+    ] {
+        assert!(stock.contains(from), "{from}");
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, stock.replacen(from, to, 1)).unwrap();
+        for args in [
+            vec!["sensor", "check", path.to_str().unwrap()],
+            vec![
+                "press",
+                "--shape",
+                "sphere",
+                "--hardness",
+                "rigid",
+                "--depth-mm",
+                "0.2",
+                "--sensor",
+                path.to_str().unwrap(),
+            ],
+        ] {
+            let err = one_line_error(&tactex(&args));
+            assert!(
+                err.contains("bad.toml") && err.contains(field),
+                "{to}: {err}"
+            );
+        }
+    }
+    let missing = dir.path().join("missing.toml");
+    let err = one_line_error(&tactex(&["sensor", "check", missing.to_str().unwrap()]));
+    assert!(err.contains("missing.toml"), "{err}");
+}
