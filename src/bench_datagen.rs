@@ -101,6 +101,7 @@ pub fn run(args: &DatagenBenchArgs) -> Result<()> {
             fidelity: fidelity.clone(),
             shapes: args.shapes.clone(),
             device: DeviceChoice::Cpu,
+            sensor: None,
         };
         let start = Instant::now();
         let summary = generate(&run_args, false)?;

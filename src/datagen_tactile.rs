@@ -27,6 +27,7 @@ use std::path::{Path, PathBuf};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::perception::contact::ContactEvidence;
 use tactex_core::press::PressProtocol;
+use tactex_core::sensor_profile::ProfileId;
 use tactex_sim::elastic::{ContactSolver, Fidelity};
 use tactex_sim::gel_render::{CpuRenderer, DeviceChoice, GelRenderer, open_renderer};
 use tactex_sim::press_protocol::PlannedPress;
@@ -71,6 +72,11 @@ pub struct TactileDatagenArgs {
     /// renders on the CPU so that the data never depends on the device.
     #[arg(long, default_value = "cpu")]
     pub(crate) device: DeviceChoice,
+    /// Sensor profile (TOML) the presses are drawn around: its background, shading, marker
+    /// grid and camera, each sample with its gel, lights, exposure, noise and markers
+    /// jittered; default the built-in GelSight Mini. A data set keeps one profile.
+    #[arg(long)]
+    pub(crate) sensor: Option<PathBuf>,
 }
 
 /// Settings that every shard of one data set shares.
@@ -87,6 +93,8 @@ struct DatasetInfo {
     width: u32,
     height: u32,
     mm_per_px: f64,
+    /// The profile the samples are drawn around.
+    sensor: ProfileId,
 }
 
 #[derive(Serialize)]
@@ -295,6 +303,18 @@ fn prepare_dir(dir: &Path, info: &DatasetInfo) -> Result<()> {
         let old: serde_json::Value = serde_json::from_str(&text)
             .with_context(|| format!("{}: not valid JSON", path.display()))?;
         let new = serde_json::to_value(info)?;
+        if old.get("sensor") != new.get("sensor") {
+            let shown = |v: Option<&serde_json::Value>| {
+                v.and_then(|v| serde_json::from_value::<ProfileId>(v.clone()).ok())
+                    .map_or("no recorded sensor".into(), |id| id.to_string())
+            };
+            bail!(
+                "{}: sensor: the data set is drawn around {}, this run around {}; a data set keeps one profile (use another --out)",
+                path.display(),
+                shown(old.get("sensor")),
+                shown(new.get("sensor"))
+            );
+        }
         for (key, value) in new.as_object().expect("a struct") {
             if old.get(key) != Some(value) {
                 bail!(
@@ -328,12 +348,15 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
     if args.count == 0 {
         bail!("--count: must be at least 1");
     }
-    let space = sample_space(&args.fidelity, &args.shapes)?;
+    let profile = crate::ask::load_sensor(args.sensor.as_deref())?;
+    let sensor = profile.id();
+    let space = match args.sensor {
+        Some(_) => sample_space(&args.fidelity, &args.shapes)?.around(profile),
+        None => sample_space(&args.fidelity, &args.shapes)?,
+    };
     let catalog = FruitCatalog::builtin();
     let protocol = PressProtocol::default();
-    let optics = tactex_sim::gel_render::SensorOptics::for_spec(
-        &tactex_core::tactile_spec::TactileSpec::gelsight_mini(),
-    );
+    let optics = tactex_sim::gel_render::SensorOptics::for_profile(&space.sensor);
     let info = DatasetInfo {
         format: FORMAT.into(),
         count: args.count,
@@ -346,6 +369,7 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
         width: optics.width,
         height: optics.height,
         mm_per_px: optics.mm_per_px,
+        sensor,
     };
     // The renderer first: a missing device fails before anything is written.
     let choice = open_renderer(args.device)?;

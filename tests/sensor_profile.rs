@@ -184,3 +184,61 @@ fn bad_profiles_fail_in_one_line_naming_the_field() {
     let err = one_line_error(&tactex(&["sensor", "check", missing.to_str().unwrap()]));
     assert!(err.contains("missing.toml"), "{err}");
 }
+
+#[test]
+fn datagen_draws_around_a_profile_and_keeps_one_profile_per_data_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let profile = calibrated(dir.path());
+    let bg = image::open(dir.path().join("fots.background.png"))
+        .unwrap()
+        .to_rgb8();
+    let data = dir.path().join("data");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "datagen",
+            "tactile",
+            "--count",
+            "3",
+            "--shapes",
+            "sphere,box",
+            "--out",
+            data.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        tactex(&args)
+    };
+    let out = run(&["--sensor", profile.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let shown = json(&tactex(&[
+        "sensor",
+        "show",
+        profile.to_str().unwrap(),
+        "--json",
+    ]));
+    let info: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(data.join("dataset.json")).unwrap()).unwrap();
+    assert_eq!(info["sensor"], shown["sensor"]);
+    assert_eq!(
+        (info["width"].as_u64(), info["height"].as_u64()),
+        (Some(240), Some(320))
+    );
+    for k in 0..3 {
+        let reference = image::open(data.join(format!("samples/{k:07}/reference.png")))
+            .unwrap()
+            .to_rgb8();
+        // The profile's background under a few percent of exposure jitter and its noise.
+        let s = ssim_rgb(&reference, &bg).unwrap();
+        eprintln!("sample {k}: no-contact frame vs the profile's background SSIM {s:.4}");
+        assert!(s >= 0.9, "sample {k}: SSIM {s}");
+    }
+    // Resuming the data set with another sensor is refused, naming the field.
+    let err = one_line_error(&run(&[]));
+    assert!(
+        err.contains("dataset.json") && err.contains("sensor"),
+        "{err}"
+    );
+}

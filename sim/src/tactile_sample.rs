@@ -5,7 +5,7 @@
 //! any shard of a data set can be generated anywhere, in any order.
 
 use crate::elastic::{ContactSolver, Fidelity, ObjectSurface};
-use crate::gel_render::{SensorOptics, Shading, synthetic_background};
+use crate::gel_render::SensorOptics;
 use crate::mesh::{self, Lobe};
 use crate::press_protocol::{PlannedPress, PressError, PressSetup, plan_press};
 use glam::{DQuat, DVec2, DVec3};
@@ -14,12 +14,14 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 use std::fmt;
 use std::str::FromStr;
+use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::hardness::shore_a_to_modulus_mpa;
 use tactex_core::hardness::{modulus_to_shore_00, modulus_to_shore_a, shore_00_to_modulus_mpa};
 use tactex_core::hertz::Elastic;
 use tactex_core::photometric::PhotometricModel;
 use tactex_core::press::PressProtocol;
+use tactex_core::sensor_profile::SensorProfile;
 use tactex_core::tactile_spec::{GelSpec, TactileSpec};
 
 /// The kinds of object a data set draws from.
@@ -95,12 +97,16 @@ pub enum ShapeDraw {
     },
 }
 
-/// The randomised sensor.
+/// The randomised sensor: the data set's profile with its gel, lights, markers, exposure,
+/// noise and vignetting jittered.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SensorDraw {
+    /// The profile drawn around (its name and hash are the data set's).
+    #[serde(skip)]
+    pub base: Arc<SensorProfile>,
     pub gel: GelSpec,
     pub lighting: PhotometricModel,
-    /// Per-channel scale of the synthetic background.
+    /// Per-channel scale of the background (exposure and white balance).
     pub background_gain: [f64; 3],
     pub marker_grid: [u32; 2],
     pub marker_pitch_mm: f64,
@@ -112,8 +118,12 @@ pub struct SensorDraw {
 impl SensorDraw {
     /// The nominal GelSight Mini, unrandomised: the sensor of a lab's validation run.
     pub fn nominal() -> Self {
-        let spec = TactileSpec::gelsight_mini();
-        let optics = SensorOptics::for_spec(&spec);
+        Self::of(Arc::new(SensorProfile::gelsight_mini()))
+    }
+
+    /// `profile` itself, unrandomised.
+    pub fn of(profile: Arc<SensorProfile>) -> Self {
+        let spec = &profile.spec;
         Self {
             gel: spec.gel,
             lighting: spec.photometric,
@@ -121,8 +131,9 @@ impl SensorDraw {
             marker_grid: [spec.markers.cols, spec.markers.rows],
             marker_pitch_mm: spec.markers.pitch_mm,
             marker_radius_mm: spec.markers.radius_mm,
-            noise_sigma: optics.noise_sigma as f64,
-            vignette: optics.vignette as f64,
+            noise_sigma: profile.noise_sigma_grey,
+            vignette: profile.vignette,
+            base: profile,
         }
     }
 }
@@ -160,6 +171,11 @@ pub struct SampleSpace {
     pub offset_mm: f64,
     pub yaw_max_deg: f64,
     pub step_mm: f64,
+    /// The sensor the draws jitter around.
+    pub sensor: Arc<SensorProfile>,
+    /// Marker grids drawn from (cols, rows): the profile's own for a user's sensor; the
+    /// stock data sets also print 11 x 9, common on other gels.
+    pub marker_grids: Vec<[u32; 2]>,
 }
 
 impl Default for SampleSpace {
@@ -176,6 +192,20 @@ impl Default for SampleSpace {
             offset_mm: 5.0,
             yaw_max_deg: 45.0,
             step_mm: 0.25,
+            sensor: Arc::new(SensorProfile::gelsight_mini()),
+            marker_grids: vec![[9, 7], [11, 9]],
+        }
+    }
+}
+
+impl SampleSpace {
+    /// Draws around `profile`: its marker grid only.
+    pub fn around(self, profile: SensorProfile) -> Self {
+        let grid = [profile.spec.markers.cols, profile.spec.markers.rows];
+        Self {
+            sensor: Arc::new(profile),
+            marker_grids: vec![grid],
+            ..self
         }
     }
 }
@@ -299,41 +329,58 @@ impl SampleSpace {
         ];
         let yaw_deg = rng.random_range(0.0..=self.yaw_max_deg);
 
-        // The GelSight Mini's gel: E ~ 0.15-0.45 MPa, ~4 mm thick.
+        // Around the profile's gel (the GelSight Mini's: E ~ 0.15-0.45 MPa, ~4 mm thick).
+        let base = &self.sensor;
+        let g = base.spec.gel;
         let gel = GelSpec {
-            modulus_mpa: rng.random_range(0.15..0.45),
-            poisson: 0.49,
+            modulus_mpa: rng.random_range(0.5 * g.modulus_mpa..1.5 * g.modulus_mpa),
+            poisson: g.poisson,
             // On a 0.05 mm ladder: the layer model's tables are cached per thickness.
-            thickness_mm: (rng.random_range(3.5f64..4.5) / 0.05).round() * 0.05,
+            thickness_mm: (rng.random_range(g.thickness_mm - 0.5..g.thickness_mm + 0.5) / 0.05)
+                .round()
+                .max(1.0)
+                * 0.05,
         };
-        let elevation = rng.random_range(25f64..45.0).to_radians();
-        let turn = rng.random_range(-15.0..15.0);
-        let light = |azimuth_deg: f64| {
-            let a = (azimuth_deg + turn).to_radians();
-            DVec3::new(
-                a.cos() * elevation.cos(),
-                a.sin() * elevation.cos(),
-                elevation.sin(),
-            )
-        };
+        // The lights turned together and raised or lowered together.
+        let lift = rng.random_range(-10f64..10.0).to_radians();
+        let turn = rng.random_range(-15f64..15.0).to_radians();
+        let l = base.spec.photometric;
         let lighting = PhotometricModel {
-            lights: [light(90.0), light(210.0), light(330.0)],
-            ambient: rng.random_range(0.35..0.55),
-            gain: rng.random_range(0.8..1.2),
+            lights: l.lights.map(|d| {
+                let azimuth = d.y.atan2(d.x) + turn;
+                let elevation = (d.z.clamp(-1.0, 1.0).asin() + lift)
+                    .clamp(5f64.to_radians(), 85f64.to_radians());
+                DVec3::new(
+                    azimuth.cos() * elevation.cos(),
+                    azimuth.sin() * elevation.cos(),
+                    elevation.sin(),
+                )
+            }),
+            ambient: (l.ambient + rng.random_range(-0.1..0.1)).max(0.0),
+            gain: l.gain * rng.random_range(0.8..1.2),
         };
+        let m = base.spec.markers;
+        let grid = self
+            .marker_grids
+            .get(rng.random_range(0..self.marker_grids.len().max(1)))
+            .copied()
+            .unwrap_or([m.cols, m.rows]);
+        let vignette = rng.random_range(-0.15..0.15);
         let sensor = SensorDraw {
+            base: base.clone(),
             gel,
             lighting,
             background_gain: std::array::from_fn(|_| rng.random_range(0.9..1.1)),
-            marker_grid: if rng.random_bool(0.5) {
-                [9, 7]
+            marker_grid: grid,
+            marker_pitch_mm: m.pitch_mm * rng.random_range(0.8..1.1),
+            marker_radius_mm: m.radius_mm * rng.random_range(0.8..1.2),
+            noise_sigma: base.noise_sigma_grey * rng.random_range(0.6..3.0),
+            // A real background carries its own vignetting: none is added to it.
+            vignette: if base.vignette > 0.0 {
+                (base.vignette + vignette).clamp(0.0, 1.0)
             } else {
-                [11, 9]
+                0.0
             },
-            marker_pitch_mm: rng.random_range(1.6..2.2),
-            marker_radius_mm: rng.random_range(0.2..0.3),
-            noise_sigma: rng.random_range(0.3..1.5),
-            vignette: rng.random_range(0.4..0.7),
         };
         SampleDraw {
             index,
@@ -360,10 +407,8 @@ const REACH_MM: f64 = 12.0;
 
 /// The triangles the pad can touch: those with a corner above the pad (plus a margin) and
 /// within its reach. Rasterising the rest on every solve would only cost time.
-fn near_the_pad(mesh: &mesh::TriMesh) -> mesh::TriMesh {
-    let spec = TactileSpec::gelsight_mini();
-    let half = DVec2::new(spec.width_px as f64, spec.height_px as f64) * spec.mm_per_px / 2.0
-        + DVec2::splat(REACH_MM);
+fn near_the_pad(mesh: &mesh::TriMesh, pad_mm: [f64; 2]) -> mesh::TriMesh {
+    let half = DVec2::from(pad_mm) / 2.0 + DVec2::splat(REACH_MM);
     let keep: Vec<[u32; 3]> = mesh
         .triangles
         .iter()
@@ -439,7 +484,7 @@ impl SampleDraw {
                     DQuat::IDENTITY,
                     -(DQuat::from_rotation_z(yaw_rad) * apex.extend(0.0)),
                 );
-            ObjectSurface::Mesh(near_the_pad(&placed))
+            ObjectSurface::Mesh(near_the_pad(&placed, self.sensor.base.spec.pad_size_mm()))
         };
         match &self.shape {
             ShapeDraw::Sphere { radius_mm } => ObjectSurface::Sphere {
@@ -487,28 +532,34 @@ impl SampleDraw {
         }
     }
 
-    /// The sensor as drawn: GelSight Mini geometry with the randomised gel and optics.
+    /// The sensor as drawn: the profile's geometry with the randomised gel, lights and
+    /// markers.
     pub fn spec(&self) -> TactileSpec {
-        let mut spec = TactileSpec::gelsight_mini();
-        spec.gel = self.sensor.gel;
-        spec.photometric = self.sensor.lighting;
-        spec.markers.cols = self.sensor.marker_grid[0];
-        spec.markers.rows = self.sensor.marker_grid[1];
-        spec.markers.pitch_mm = self.sensor.marker_pitch_mm;
-        spec.markers.radius_mm = self.sensor.marker_radius_mm;
+        let d = &self.sensor;
+        let mut spec = d.base.spec.clone();
+        spec.gel = d.gel;
+        spec.photometric = d.lighting;
+        spec.markers.cols = d.marker_grid[0];
+        spec.markers.rows = d.marker_grid[1];
+        spec.markers.pitch_mm = d.marker_pitch_mm;
+        spec.markers.radius_mm = d.marker_radius_mm;
         spec
     }
 
+    /// The drawn sensor's optics: the profile's background (scaled per channel) and shading
+    /// (its calibrated table, or the drawn lights), the drawn markers, noise and vignetting.
     pub fn optics(&self) -> SensorOptics {
-        let spec = self.spec();
-        let mut optics = SensorOptics::for_spec(&spec);
-        optics.background = synthetic_background(spec.width_px, spec.height_px)
-            .into_iter()
-            .map(|p| std::array::from_fn(|c| p[c] * self.sensor.background_gain[c] as f32))
-            .collect();
-        optics.shading = Shading::Lights(self.sensor.lighting);
-        optics.noise_sigma = self.sensor.noise_sigma as f32;
-        optics.vignette = self.sensor.vignette as f32;
+        let d = &self.sensor;
+        let drawn = SensorProfile {
+            spec: self.spec(),
+            noise_sigma_grey: d.noise_sigma,
+            vignette: d.vignette,
+            ..(*d.base).clone()
+        };
+        let mut optics = SensorOptics::for_profile(&drawn);
+        for p in &mut optics.background {
+            *p = std::array::from_fn(|c| p[c] * d.background_gain[c] as f32);
+        }
         optics
     }
 }
