@@ -176,9 +176,9 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
                 ..stock.spec.markers
             },
             frame_rate_hz,
+            table: Some(table),
             ..stock.spec.clone()
         },
-        table: Some(table),
         background: Some(flat_gel),
         noise_sigma_grey,
         // The real background carries the sensor's vignetting.

@@ -33,6 +33,10 @@ pub struct HardnessEvalArgs {
     /// Fidelity level of the presses.
     #[arg(long, default_value = "layer")]
     fidelity: String,
+    /// Sensor profile the presses are rendered with and read through (TOML); default the
+    /// built-in GelSight Mini.
+    #[arg(long)]
+    sensor: Option<PathBuf>,
     /// Print the scores as JSON.
     #[arg(long)]
     json: bool,
@@ -55,10 +59,13 @@ const SHORE_A_RANGE: [f64; 2] = [5.0, 90.0];
 struct EstimatorScore {
     name: String,
     n: usize,
-    rmse: f64,
-    r2: f64,
-    spearman: f64,
+    rmse: Option<f64>,
+    r2: Option<f64>,
+    spearman: Option<f64>,
     failures: usize,
+    /// Why the estimator is not scored (fewer than 3 presses read: e.g. a model trained on
+    /// another frame size than the sensor's), with its first error.
+    unscored: Option<String>,
 }
 
 #[derive(Serialize)]
@@ -68,6 +75,8 @@ struct HardnessEval {
     seed: u64,
     shapes: Vec<String>,
     fidelity: String,
+    /// The sensor the presses were rendered with and read through.
+    sensor: tactex_core::sensor_profile::ProfileId,
     estimators: Vec<EstimatorScore>,
 }
 
@@ -99,6 +108,10 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
         );
     }
     let mut space = crate::datagen_tactile::sample_space(&args.fidelity, &args.shapes)?;
+    if args.sensor.is_some() {
+        space = space.around(crate::ask::load_sensor(args.sensor.as_deref())?);
+    }
+    let sensor_id = space.sensor.id();
     space.modulus_mpa = SHORE_A_RANGE.map(|s| shore_a_to_modulus_mpa(s).expect("below 100"));
     let catalog = FruitCatalog::builtin();
     let mut estimators: Vec<Box<dyn HardnessEstimator + Sync>> = vec![
@@ -176,24 +189,36 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
                 .iter()
                 .find_map(|r| r.predictions[k].error.as_deref())
                 .unwrap_or("none");
-            bail!(
-                "estimator {name}: only {} of {} presses estimated (first error: {first_error})",
-                pairs.len(),
-                records.len()
-            );
+            scores.push(EstimatorScore {
+                name,
+                n: pairs.len(),
+                rmse: None,
+                r2: None,
+                spearman: None,
+                failures: records.len() - pairs.len(),
+                unscored: Some(format!(
+                    "only {} of {} presses estimated (first error: {first_error})",
+                    pairs.len(),
+                    records.len()
+                )),
+            });
+            continue;
         }
         let score = EstimatorScore {
             name: name.clone(),
             n: pairs.len(),
-            rmse: rmse(&truth, &pred)?,
-            r2: r_squared(&truth, &pred)?,
-            spearman: spearman(&truth, &pred)?.statistic,
+            rmse: Some(rmse(&truth, &pred)?),
+            r2: Some(r_squared(&truth, &pred)?),
+            spearman: Some(spearman(&truth, &pred)?.statistic),
             failures: records.len() - pairs.len(),
+            unscored: None,
         };
         series.push(ScatterSeries {
             name: format!(
                 "{name}: RMSE {:.1}, R2 {:.2}, Spearman {:.2}",
-                score.rmse, score.r2, score.spearman
+                score.rmse.unwrap_or(f64::NAN),
+                score.r2.unwrap_or(f64::NAN),
+                score.spearman.unwrap_or(f64::NAN)
             ),
             points: pairs,
         });
@@ -205,6 +230,7 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
         seed: args.seed,
         shapes: args.shapes.clone(),
         fidelity: args.fidelity.clone(),
+        sensor: sensor_id,
         estimators: scores,
     };
     if let Some(dir) = &args.out {
@@ -241,10 +267,18 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
         );
         println!("estimator     n   RMSE (Shore A)    R2   Spearman  failures");
         for s in &report.estimators {
-            println!(
-                "{:<12} {:>3}  {:>14.2}  {:>5.2}  {:>8.3}  {:>8}",
-                s.name, s.n, s.rmse, s.r2, s.spearman, s.failures
-            );
+            match (s.rmse, s.r2, s.spearman) {
+                (Some(rmse), Some(r2), Some(rho)) => println!(
+                    "{:<12} {:>3}  {:>14.2}  {:>5.2}  {:>8.3}  {:>8}",
+                    s.name, s.n, rmse, r2, rho, s.failures
+                ),
+                _ => println!(
+                    "{:<12} {:>3}  not scored: {}",
+                    s.name,
+                    s.n,
+                    s.unscored.as_deref().unwrap_or("")
+                ),
+            }
         }
         if let Some(dir) = &args.out {
             println!("wrote {}", dir.join("hardness.png").display());

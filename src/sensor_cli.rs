@@ -89,7 +89,7 @@ fn summary(p: &SensorProfile) -> Summary {
             Some(_) => "a real no-contact frame".into(),
             None => "synthetic".into(),
         },
-        shading: match &p.table {
+        shading: match &p.spec.table {
             Some(t) => format!(
                 "calibrated table, {} x {} bins up to slope {}",
                 t.mag_bins, t.dir_bins, t.mag_max

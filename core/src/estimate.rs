@@ -212,7 +212,7 @@ impl HardnessEstimator for HertzSlopeEstimator {
         let fields: Vec<SlopeField> = press
             .frames
             .iter()
-            .map(|f| recover_slopes(&f.image, &press.reference.image, &spec.photometric))
+            .map(|f| recover_slopes(&f.image, &press.reference.image, spec))
             .collect::<Option<_>>()
             .ok_or_else(|| EstimateError::BadSequence("frame and reference sizes differ".into()))?;
         let last = fields.last().expect("at least two frames");

@@ -80,8 +80,8 @@ impl HardnessEstimator for IndentationEstimator {
         let mut within_frame = Vec::with_capacity(n);
         let pixel_area = spec.mm_per_px * spec.mm_per_px;
         for frame in &press.frames {
-            let slopes = recover_slopes(&frame.image, &press.reference.image, &spec.photometric)
-                .ok_or_else(|| {
+            let slopes =
+                recover_slopes(&frame.image, &press.reference.image, spec).ok_or_else(|| {
                     EstimateError::BadSequence("frame and reference sizes differ".into())
                 })?;
             let depth = integrate_slopes(&slopes, spec.mm_per_px);

@@ -44,11 +44,9 @@ pub struct CalibrationFit {
 pub struct SensorProfile {
     /// Where the calibration images came from (attribution travels with the profile).
     pub source: String,
-    /// Frame geometry, gel, marker grid and frame rate; its `model` is the profile's name.
+    /// Frame geometry, gel, shading (lights or calibrated table), marker grid and frame
+    /// rate; its `model` is the profile's name.
     pub spec: TactileSpec,
-    /// The calibrated gradient -> colour table; None: the analytic lights of
-    /// `spec.photometric`.
-    pub table: Option<ShadingTable>,
     /// The no-contact frame; None: the twin's synthetic one.
     pub background: Option<RgbImage>,
     /// Camera noise per channel (grey levels, 1 sigma).
@@ -173,7 +171,6 @@ impl SensorProfile {
         Self {
             source: String::new(),
             spec,
-            table: None,
             background: None,
             noise_sigma_grey: 0.5,
             vignette: 0.55,
@@ -279,6 +276,7 @@ impl SensorProfile {
                     thickness_mm: raw.gel.thickness_mm,
                 },
                 photometric,
+                table,
                 markers: MarkerGrid {
                     cols: m.cols,
                     rows: m.rows,
@@ -287,7 +285,6 @@ impl SensorProfile {
                 },
                 frame_rate_hz: c.frame_rate_hz,
             },
-            table,
             background,
             noise_sigma_grey: c.noise_sigma_grey,
             vignette: c.vignette,
@@ -535,7 +532,7 @@ impl SensorProfile {
 
     /// How its gel's slopes become colour.
     pub fn shading(&self) -> Shading {
-        match &self.table {
+        match &self.spec.table {
             Some(t) => Shading::Table(t.clone()),
             None => Shading::Lights(self.spec.photometric),
         }
@@ -564,7 +561,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let mut p = SensorProfile::gelsight_mini();
         p.spec.model = "bench sensor".into();
-        p.table = Some(ShadingTable {
+        p.spec.table = Some(ShadingTable {
             mag_bins: 2,
             dir_bins: 3,
             mag_max: 1.5,

@@ -172,6 +172,81 @@ impl ShadingTable {
         }
     }
 
+    /// The slope (gx, gy) whose colour change at (u, v) is nearest `change` (least squares
+    /// over the three channels): the table read backwards, as the estimators read a
+    /// calibrated sensor's frames. The best of a coarse ring of slopes starts a damped
+    /// Gauss-Newton descent. None where no slope comes within `max_rms` grey levels
+    /// (saturation, dust, a marker's edge).
+    pub fn slope_for_change(
+        &self,
+        change: [f32; 3],
+        u: f32,
+        v: f32,
+        max_rms: f32,
+    ) -> Option<(f32, f32)> {
+        let residual = |gx: f32, gy: f32| {
+            let c = self.change(gx, gy, u, v);
+            [c[0] - change[0], c[1] - change[1], c[2] - change[2]]
+        };
+        let norm2 = |r: [f32; 3]| r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        let mut best = (0.0f32, 0.0f32, norm2(residual(0.0, 0.0)));
+        // A flat gel shows no change: most of a press frame ends here.
+        if best.2 <= 3.0 * 0.25 {
+            return Some((0.0, 0.0));
+        }
+        for mag in [0.1f32, 0.3, 0.6, 1.0, 1.6] {
+            let mag = mag * self.mag_max / 2.5;
+            for k in 0..12 {
+                let a = k as f32 * TAU / 12.0;
+                let (gx, gy) = (mag * a.cos(), mag * a.sin());
+                let e = norm2(residual(gx, gy));
+                if e < best.2 {
+                    best = (gx, gy, e);
+                }
+            }
+        }
+        let (mut gx, mut gy, mut err) = best;
+        let mut damping = 1e-2f32;
+        let h = 1e-3f32 * self.mag_max;
+        for _ in 0..20 {
+            let r = residual(gx, gy);
+            let dx = residual(gx + h, gy);
+            let dxm = residual(gx - h, gy);
+            let dy = residual(gx, gy + h);
+            let dym = residual(gx, gy - h);
+            let jx: [f32; 3] = std::array::from_fn(|c| (dx[c] - dxm[c]) / (2.0 * h));
+            let jy: [f32; 3] = std::array::from_fn(|c| (dy[c] - dym[c]) / (2.0 * h));
+            let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            let (a, b, d) = (dot(jx, jx), dot(jx, jy), dot(jy, jy));
+            let (ex, ey) = (-dot(jx, r), -dot(jy, r));
+            let mut stepped = false;
+            for _ in 0..6 {
+                let (a2, d2) = (a * (1.0 + damping) + 1e-6, d * (1.0 + damping) + 1e-6);
+                let det = a2 * d2 - b * b;
+                if det.abs() < 1e-12 {
+                    damping *= 4.0;
+                    continue;
+                }
+                let (sx, sy) = ((d2 * ex - b * ey) / det, (a2 * ey - b * ex) / det);
+                let e = norm2(residual(gx + sx, gy + sy));
+                if e < err {
+                    gx += sx;
+                    gy += sy;
+                    let converged = (sx * sx + sy * sy).sqrt() < 1e-4 || err - e < 1e-6 * err;
+                    err = e;
+                    damping = (damping / 3.0).max(1e-6);
+                    stepped = !converged;
+                    break;
+                }
+                damping *= 4.0;
+            }
+            if !stepped {
+                break;
+            }
+        }
+        ((err / 3.0).sqrt() <= max_rms).then_some((gx, gy))
+    }
+
     /// Least-squares fit of the table to `samples`. Each sample constrains the four nodes
     /// around its slope with its bilinear weights; `smoothness` (grey levels^2 per unit
     /// difference) ties neighbouring nodes together and fills nodes without data. The
@@ -325,6 +400,55 @@ fn solve_spd(a: &mut [f64], n: usize, b: &[[f64; 3]]) -> Option<Vec<[f64; 3]>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A table fitted to the analytic lights over a flat grey background: its changes are
+    /// the lights' gains times the background, less the background.
+    fn lights_table() -> ShadingTable {
+        let lights = crate::photometric::PhotometricModel::default();
+        let bg = 140.0f32;
+        let mut samples = Vec::new();
+        for i in 0..=40 {
+            for j in 0..=40 {
+                let (gx, gy) = (i as f32 * 0.1 - 2.0, j as f32 * 0.1 - 2.0);
+                for (u, v) in [(-0.8f32, -0.6f32), (0.0, 0.0), (0.7, 0.5), (-0.4, 0.9)] {
+                    let g = lights.gain_for_slope(gx as f64, gy as f64);
+                    samples.push(ShadingSample {
+                        gx,
+                        gy,
+                        u,
+                        v,
+                        change: std::array::from_fn(|c| bg * (g[c] as f32 - 1.0)),
+                    });
+                }
+            }
+        }
+        ShadingTable::fit(&samples, 12, 24, 2.5, 1.0).unwrap()
+    }
+
+    #[test]
+    fn read_backwards_the_table_gives_the_slope_that_made_the_colour() {
+        let table = lights_table();
+        for (gx, gy) in [
+            (0.0f32, 0.0f32),
+            (0.05, -0.02),
+            (0.3, 0.1),
+            (-0.6, 0.4),
+            (1.2, -0.9),
+            (0.0, 1.8),
+        ] {
+            for (u, v) in [(0.0f32, 0.0f32), (0.5, -0.3)] {
+                let change = table.change(gx, gy, u, v);
+                let (rx, ry) = table.slope_for_change(change, u, v, 1.0).unwrap();
+                let tol = 0.02 + 0.03 * (gx * gx + gy * gy).sqrt();
+                assert!(
+                    (rx - gx).abs() < tol && (ry - gy).abs() < tol,
+                    "({gx}, {gy}) at ({u}, {v}) read back as ({rx}, {ry})"
+                );
+            }
+        }
+        // No slope makes every channel 80 grey levels brighter.
+        assert!(table.slope_for_change([80.0; 3], 0.0, 0.0, 6.0).is_none());
+    }
 
     #[test]
     fn splitting_off_the_flat_change_keeps_every_change_less_it() {

@@ -1,6 +1,7 @@
 //! What a vision-based tactile sensor is: image geometry, gel, optics and marker grid.
 
 use crate::photometric::PhotometricModel;
+use crate::shading_table::ShadingTable;
 use serde::{Deserialize, Serialize};
 
 /// The elastomer layer bonded to the sensor's rigid acrylic window.
@@ -27,7 +28,12 @@ pub struct TactileSpec {
     pub height_px: u32,
     pub mm_per_px: f64,
     pub gel: GelSpec,
+    /// The analytic lights; the shading unless a calibrated table is given.
     pub photometric: PhotometricModel,
+    /// The calibrated gradient -> colour table of a real sensor (`tactex calibrate`): frames
+    /// are rendered and read through it instead of the lights.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub table: Option<ShadingTable>,
     pub markers: MarkerGrid,
     pub frame_rate_hz: f64,
 }
@@ -47,6 +53,7 @@ impl TactileSpec {
                 thickness_mm: 4.0,
             },
             photometric: PhotometricModel::default(),
+            table: None,
             markers: MarkerGrid {
                 cols: 9,
                 rows: 7,

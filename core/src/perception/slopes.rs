@@ -1,8 +1,10 @@
-//! Gel surface slopes from a tactile frame: the photometric model inverted per pixel against
-//! the no-contact reference frame. Marker dots and saturated pixels carry no shading and are
-//! left out.
+//! Gel surface slopes from a tactile frame: the sensor's shading inverted per pixel against
+//! the no-contact reference frame (its analytic lights, or the calibrated table of a real
+//! sensor's profile read backwards). Marker dots and saturated pixels carry no shading and
+//! are left out.
 
 use crate::photometric::PhotometricModel;
+use crate::tactile_spec::TactileSpec;
 use image::RgbImage;
 
 /// Slopes dw/dx and dw/dy (mm per mm) per pixel, in image axes (x along columns, y down).
@@ -20,12 +22,17 @@ pub(crate) fn is_dark(p: &image::Rgb<u8>) -> bool {
     (p[0] as u32 + p[1] as u32 + p[2] as u32) < 3 * 70
 }
 
-/// Inverts `model` against `reference`. Pixels dark in either frame (markers) are invalid, and
-/// so is a 2 px ring around them where the dot's soft edge mixes with the shading.
+/// A calibrated table's colour change further than this (rms grey levels) from every slope's
+/// is not gel shading: a table fits real presses to about 5-9 grey levels.
+const TABLE_MAX_RMS: f32 = 25.0;
+
+/// Inverts the sensor's shading against `reference`. Pixels dark in either frame (markers) are
+/// invalid, and so is a 2 px ring around them where the dot's soft edge mixes with the
+/// shading.
 pub fn recover_slopes(
     frame: &RgbImage,
     reference: &RgbImage,
-    model: &PhotometricModel,
+    spec: &TactileSpec,
 ) -> Option<SlopeField> {
     if frame.dimensions() != reference.dimensions() {
         return None;
@@ -53,8 +60,19 @@ pub fn recover_slopes(
         if !valid[i] {
             continue;
         }
-        let gain = std::array::from_fn(|c| p[c] as f64 / (r[c] as f64).max(1.0));
-        match model.slope_for_gain(gain) {
+        let slope = match &spec.table {
+            Some(table) => {
+                let (x, y) = (i % w, i / w);
+                let u = 2.0 * ((x as f32 + 0.5) / w as f32 - 0.5);
+                let v = 2.0 * ((y as f32 + 0.5) / h as f32 - 0.5);
+                let change = std::array::from_fn(|c| f32::from(p[c]) - f32::from(r[c]));
+                table
+                    .slope_for_change(change, u, v, TABLE_MAX_RMS)
+                    .map(|(sx, sy)| (f64::from(sx), f64::from(sy)))
+            }
+            None => lit_slope(&spec.photometric, p, r),
+        };
+        match slope {
             Some((sx, sy)) => {
                 gx[i] = sx as f32;
                 gy[i] = sy as f32;
@@ -71,6 +89,15 @@ pub fn recover_slopes(
     })
 }
 
+fn lit_slope(
+    model: &PhotometricModel,
+    p: &image::Rgb<u8>,
+    r: &image::Rgb<u8>,
+) -> Option<(f64, f64)> {
+    let gain = std::array::from_fn(|c| p[c] as f64 / (r[c] as f64).max(1.0));
+    model.slope_for_gain(gain)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -78,7 +105,8 @@ mod tests {
 
     #[test]
     fn recovers_a_uniform_tilt() {
-        let model = PhotometricModel::default();
+        let spec = TactileSpec::gelsight_mini();
+        let model = spec.photometric;
         let reference = RgbImage::from_pixel(16, 12, Rgb([150, 140, 130]));
         let g = model.gain_for_slope(0.2, -0.1);
         let frame = RgbImage::from_fn(16, 12, |_, _| {
@@ -86,7 +114,7 @@ mod tests {
                 (reference.get_pixel(0, 0)[c] as f64 * g[c]).round() as u8
             }))
         });
-        let s = recover_slopes(&frame, &reference, &model).unwrap();
+        let s = recover_slopes(&frame, &reference, &spec).unwrap();
         let i = 6 * 16 + 8;
         assert!(s.valid[i]);
         // 8-bit quantisation of ~150 levels limits the slope to about 1/100.
