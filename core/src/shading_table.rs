@@ -173,15 +173,19 @@ impl ShadingTable {
     }
 
     /// The slope (gx, gy) whose colour change at (u, v) is nearest `change` (least squares
-    /// over the three channels): the table read backwards, as the estimators read a
-    /// calibrated sensor's frames. The best of a coarse ring of slopes starts a damped
-    /// Gauss-Newton descent. None where no slope comes within `max_rms` grey levels
-    /// (saturation, dust, a marker's edge).
+    /// over the three channels, plus `prior` grey levels^2 per unit slope^2 of |g|^2): the
+    /// table read backwards, as the estimators read a calibrated sensor's frames. A real
+    /// table can colour a steep slope almost like the flat gel (its steep nodes are fitted
+    /// from few pixels), so without the prior the camera's noise on a flat pixel can pick a
+    /// steep slope. The best of a coarse ring of slopes starts a damped Gauss-Newton descent.
+    /// None where no slope comes within `max_rms` grey levels (saturation, dust, a marker's
+    /// edge).
     pub fn slope_for_change(
         &self,
         change: [f32; 3],
         u: f32,
         v: f32,
+        prior: f32,
         max_rms: f32,
     ) -> Option<(f32, f32)> {
         let residual = |gx: f32, gy: f32| {
@@ -189,7 +193,8 @@ impl ShadingTable {
             [c[0] - change[0], c[1] - change[1], c[2] - change[2]]
         };
         let norm2 = |r: [f32; 3]| r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        let mut best = (0.0f32, 0.0f32, norm2(residual(0.0, 0.0)));
+        let cost = |gx: f32, gy: f32| norm2(residual(gx, gy)) + prior * (gx * gx + gy * gy);
+        let mut best = (0.0f32, 0.0f32, cost(0.0, 0.0));
         // A flat gel shows no change: most of a press frame ends here.
         if best.2 <= 3.0 * 0.25 {
             return Some((0.0, 0.0));
@@ -199,7 +204,7 @@ impl ShadingTable {
             for k in 0..12 {
                 let a = k as f32 * TAU / 12.0;
                 let (gx, gy) = (mag * a.cos(), mag * a.sin());
-                let e = norm2(residual(gx, gy));
+                let e = cost(gx, gy);
                 if e < best.2 {
                     best = (gx, gy, e);
                 }
@@ -217,8 +222,8 @@ impl ShadingTable {
             let jx: [f32; 3] = std::array::from_fn(|c| (dx[c] - dxm[c]) / (2.0 * h));
             let jy: [f32; 3] = std::array::from_fn(|c| (dy[c] - dym[c]) / (2.0 * h));
             let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-            let (a, b, d) = (dot(jx, jx), dot(jx, jy), dot(jy, jy));
-            let (ex, ey) = (-dot(jx, r), -dot(jy, r));
+            let (a, b, d) = (dot(jx, jx) + prior, dot(jx, jy), dot(jy, jy) + prior);
+            let (ex, ey) = (-dot(jx, r) - prior * gx, -dot(jy, r) - prior * gy);
             let mut stepped = false;
             for _ in 0..6 {
                 let (a2, d2) = (a * (1.0 + damping) + 1e-6, d * (1.0 + damping) + 1e-6);
@@ -228,7 +233,7 @@ impl ShadingTable {
                     continue;
                 }
                 let (sx, sy) = ((d2 * ex - b * ey) / det, (a2 * ey - b * ex) / det);
-                let e = norm2(residual(gx + sx, gy + sy));
+                let e = cost(gx + sx, gy + sy);
                 if e < err {
                     gx += sx;
                     gy += sy;
@@ -244,7 +249,7 @@ impl ShadingTable {
                 break;
             }
         }
-        ((err / 3.0).sqrt() <= max_rms).then_some((gx, gy))
+        ((norm2(residual(gx, gy)) / 3.0).sqrt() <= max_rms).then_some((gx, gy))
     }
 
     /// Least-squares fit of the table to `samples`. Each sample constrains the four nodes
@@ -438,7 +443,7 @@ mod tests {
         ] {
             for (u, v) in [(0.0f32, 0.0f32), (0.5, -0.3)] {
                 let change = table.change(gx, gy, u, v);
-                let (rx, ry) = table.slope_for_change(change, u, v, 1.0).unwrap();
+                let (rx, ry) = table.slope_for_change(change, u, v, 0.0, 1.0).unwrap();
                 let tol = 0.02 + 0.03 * (gx * gx + gy * gy).sqrt();
                 assert!(
                     (rx - gx).abs() < tol && (ry - gy).abs() < tol,
@@ -447,7 +452,11 @@ mod tests {
             }
         }
         // No slope makes every channel 80 grey levels brighter.
-        assert!(table.slope_for_change([80.0; 3], 0.0, 0.0, 6.0).is_none());
+        assert!(
+            table
+                .slope_for_change([80.0; 3], 0.0, 0.0, 0.0, 6.0)
+                .is_none()
+        );
     }
 
     #[test]

@@ -25,6 +25,10 @@ pub(crate) fn is_dark(p: &image::Rgb<u8>) -> bool {
 /// A calibrated table's colour change further than this (rms grey levels) from every slope's
 /// is not gel shading: a table fits real presses to about 5-9 grey levels.
 const TABLE_MAX_RMS: f32 = 25.0;
+/// How much a calibrated table's reading prefers gentle slopes (grey levels^2 per unit
+/// slope^2; see `ShadingTable::slope_for_change`): a unit of slope must buy back about 3
+/// grey levels of residual.
+const TABLE_SLOPE_PRIOR: f32 = 40.0;
 
 /// Inverts the sensor's shading against `reference`. Pixels dark in either frame (markers) are
 /// invalid, and so is a 2 px ring around them where the dot's soft edge mixes with the
@@ -67,7 +71,7 @@ pub fn recover_slopes(
                 let v = 2.0 * ((y as f32 + 0.5) / h as f32 - 0.5);
                 let change = std::array::from_fn(|c| f32::from(p[c]) - f32::from(r[c]));
                 table
-                    .slope_for_change(change, u, v, TABLE_MAX_RMS)
+                    .slope_for_change(change, u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS)
                     .map(|(sx, sy)| (f64::from(sx), f64::from(sy)))
             }
             None => lit_slope(&spec.photometric, p, r),
