@@ -440,6 +440,7 @@ fn detector_without_truth<'a>(
 fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> Result<Answer> {
     let catalog = FruitCatalog::builtin();
     let devices = DevicesConfig::load(file)?;
+    let sensor = hardware_sensor(args)?;
     let choice = DetectorChoice::parse(&args.twin.detector)?;
     let detector = detector_without_truth(&choice, &catalog)?;
     let explainer = explainer(args.twin.explainer, args.twin.llm_config.as_ref())?;
@@ -451,7 +452,7 @@ fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> R
     )?;
     // The sensors first, so that a missing camera never leaves the arm enabled.
     let mut camera = devices.open_camera()?;
-    let mut tactile = devices.open_tactile()?;
+    let mut tactile = devices.open_tactile(sensor.spec.clone())?;
     let mut arm = devices.open_arm()?;
     let question = Question {
         prompt: &args.prompt,
@@ -461,7 +462,7 @@ fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> R
         explainer: explainer.as_ref(),
         config,
         fidelity: None,
-        sensor: None,
+        sensor: Some(sensor.id()),
     };
     question.ask(
         Devices {
@@ -478,13 +479,34 @@ fn answer_on_hardware(file: &Path, args: &AskArgs, config: &PipelineConfig) -> R
 }
 
 #[cfg(not(all(target_os = "linux", feature = "v4l2")))]
-fn answer_on_hardware(file: &Path, _: &AskArgs, _: &PipelineConfig) -> Result<Answer> {
-    // The file is still checked, so a bad devices.toml is named before the missing feature.
+fn answer_on_hardware(file: &Path, args: &AskArgs, _: &PipelineConfig) -> Result<Answer> {
+    // The file and the profile are still checked, so that they are named before the missing
+    // feature.
     DevicesConfig::load(file)?;
+    hardware_sensor(args)?;
     bail!(
         "--backend hw: this tactex was built without V4L2, which reads the cameras; \
          on Linux rebuild with `cargo build --release --features v4l2` (needs libclang-dev)"
     );
+}
+
+/// The real GelSight's profile: required, since a real sensor's frames read through the
+/// twin's analytic lights would give wrong slopes however good the physics.
+fn hardware_sensor(args: &AskArgs) -> Result<SensorProfile> {
+    let Some(path) = &args.twin.sensor else {
+        bail!(
+            "--sensor: --backend hw reads the real GelSight through its calibrated profile; give one (`tactex calibrate` writes it)"
+        );
+    };
+    let sensor = load_sensor(Some(path))?;
+    let (w, h) = (sensor.spec.width_px, sensor.spec.height_px);
+    if (w, h) != (320, 240) {
+        bail!(
+            "--sensor {}: a {w} x {h} px profile; the GelSight Mini's frames are 320 x 240",
+            path.display()
+        );
+    }
+    Ok(sensor)
 }
 
 pub fn run(args: &AskArgs) -> Result<()> {

@@ -1,6 +1,6 @@
 //! `ask --backend hw` on a machine without the devices: a bad devices.toml names its file
-//! and field, a missing camera is named and the arm is not enabled, and misused flags are
-//! one-line errors.
+//! and field, the real sensor's profile is required, a missing camera is named and the arm is
+//! not enabled, and misused flags are one-line errors.
 
 mod cli;
 use cli::one_line_error;
@@ -15,6 +15,19 @@ fn ask(args: &[&str]) -> Output {
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .expect("runs tactex")
+}
+
+/// The built-in GelSight Mini profile written to `dir/mini.toml` (what a user edits or
+/// `tactex calibrate` replaces).
+fn mini_profile(dir: &std::path::Path) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args(["sensor", "show", "--toml"])
+        .output()
+        .expect("runs tactex");
+    assert!(out.status.success());
+    let path = dir.join("mini.toml");
+    std::fs::write(&path, out.stdout).unwrap();
+    path.to_str().unwrap().to_string()
 }
 
 fn devices_toml(addr: &str, extra: &str) -> String {
@@ -43,11 +56,22 @@ fn a_missing_camera_is_named_and_the_arm_is_left_alone() {
     let tmp = tempfile::tempdir().unwrap();
     let file = tmp.path().join("devices.toml");
     std::fs::write(&file, devices_toml(&f.addr.to_string(), "")).unwrap();
+    // Without the sensor's profile the real frames cannot be read: said before anything opens.
     let stderr = one_line_error(&ask(&[
         "--backend",
         "hw",
         "--devices",
         file.to_str().unwrap(),
+    ]));
+    assert!(stderr.contains("--sensor"), "{stderr}");
+    let profile = mini_profile(tmp.path());
+    let stderr = one_line_error(&ask(&[
+        "--backend",
+        "hw",
+        "--devices",
+        file.to_str().unwrap(),
+        "--sensor",
+        &profile,
     ]));
     // Built without the V4L2 feature there are no cameras to open: that is said instead.
     let says = if cfg!(feature = "v4l2") {

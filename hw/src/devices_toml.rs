@@ -156,9 +156,14 @@ impl DevicesConfig {
     }
 
     #[cfg(all(target_os = "linux", feature = "v4l2"))]
-    pub fn open_tactile(&self) -> Result<crate::gelsight_mini::GelSightMini, DevicesError> {
+    /// The GelSight, its frames read through `profile` (the sensor's calibrated spec).
+    pub fn open_tactile(
+        &self,
+        profile: tactex_core::tactile_spec::TactileSpec,
+    ) -> Result<crate::gelsight_mini::GelSightMini, DevicesError> {
         Ok(crate::gelsight_mini::GelSightMini::open(
             &self.tactile.device,
+            profile,
         )?)
     }
 }

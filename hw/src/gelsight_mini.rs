@@ -99,8 +99,12 @@ pub struct GelSightMini {
 
 #[cfg(all(target_os = "linux", feature = "v4l2"))]
 impl GelSightMini {
-    /// Opens the sensor by path or name ("GelSight Mini") at its native MJPG stream.
-    pub fn open(spec: &str) -> Result<GelSightMini, tactex_core::devices::DeviceError> {
+    /// Opens the sensor by path or name ("GelSight Mini") at its native MJPG stream; its
+    /// frames are read through `profile` (its calibrated table and gel).
+    pub fn open(
+        spec: &str,
+        profile: tactex_core::tactile_spec::TactileSpec,
+    ) -> Result<GelSightMini, tactex_core::devices::DeviceError> {
         let capture = crate::v4l2_capture::V4l2Capture::open(
             "gelsight mini",
             spec,
@@ -112,7 +116,7 @@ impl GelSightMini {
         let name = format!("gelsight mini {}", capture.path().display());
         Ok(GelSightMini {
             capture,
-            spec: tactex_core::tactile_spec::TactileSpec::gelsight_mini(),
+            spec: profile,
             name,
             opened: std::time::Instant::now(),
         })

@@ -3,12 +3,13 @@
 #![cfg(all(target_os = "linux", feature = "v4l2"))]
 
 use tactex_core::geometry::{CameraIntrinsics, Pose};
+use tactex_core::tactile_spec::TactileSpec;
 use tactex_hw::gelsight_mini::GelSightMini;
 use tactex_hw::realsense::RealSense;
 
 #[test]
 fn a_missing_gelsight_is_an_error_naming_it() {
-    let e = GelSightMini::open("/dev/video-tactex-none")
+    let e = GelSightMini::open("/dev/video-tactex-none", TactileSpec::gelsight_mini())
         .err()
         .expect("no device");
     let text = e.to_string();
@@ -16,7 +17,7 @@ fn a_missing_gelsight_is_an_error_naming_it() {
         text.starts_with("gelsight mini: /dev/video-tactex-none"),
         "{text}"
     );
-    let e = GelSightMini::open("No Such Sensor 9000")
+    let e = GelSightMini::open("No Such Sensor 9000", TactileSpec::gelsight_mini())
         .err()
         .expect("no device");
     assert!(
