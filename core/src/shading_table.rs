@@ -199,7 +199,11 @@ impl ShadingTable {
         if best.2 <= 3.0 * 0.25 {
             return Some((0.0, 0.0));
         }
-        for mag in [0.1f32, 0.3, 0.6, 1.0, 1.6] {
+        // A change within a few grey levels is a gentle slope, found by descending from the
+        // flat gel; only a clear change needs the ring's global start (most of a press
+        // frame is the former, and the ring is most of the cost).
+        let ring = best.2 > 3.0 * 4.0 * 4.0;
+        for mag in [0.1f32, 0.3, 0.6, 1.0, 1.6].into_iter().filter(|_| ring) {
             let mag = mag * self.mag_max / 2.5;
             for k in 0..12 {
                 let a = k as f32 * TAU / 12.0;
