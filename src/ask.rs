@@ -499,10 +499,11 @@ fn hardware_sensor(args: &AskArgs) -> Result<SensorProfile> {
         );
     };
     let sensor = load_sensor(Some(path))?;
+    use tactex_hw::gelsight_mini::{HEIGHT, WIDTH};
     let (w, h) = (sensor.spec.width_px, sensor.spec.height_px);
-    if (w, h) != (320, 240) {
+    if (w, h) != (WIDTH, HEIGHT) {
         bail!(
-            "--sensor {}: a {w} x {h} px profile; the GelSight Mini's frames are 320 x 240",
+            "--sensor {}: a {w} x {h} px profile; the GelSight Mini's frames are {WIDTH} x {HEIGHT}",
             path.display()
         );
     }

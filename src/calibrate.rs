@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use tactex_core::ball_calibration::{SampleRule, camera_noise_sigma, samples_from_ball_press};
 use tactex_core::perception::centroid::median;
 use tactex_core::sensor_profile::{CalibrationFit, SensorProfile};
-use tactex_core::shading_table::ShadingTable;
+use tactex_core::shading_table::{ShadingTable, frame_position};
 use tactex_core::tactile_spec::{GelSpec, TactileSpec};
 
 #[derive(Args, Debug)]
@@ -121,10 +121,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
     // as the presses saw it, so that its no-contact frame is its background.
     let (w, h) = background.dimensions();
     let flat_gel = image::RgbImage::from_fn(w, h, |x, y| {
-        let (u, v) = (
-            2.0 * ((x as f32 + 0.5) / w as f32 - 0.5),
-            2.0 * ((y as f32 + 0.5) / h as f32 - 0.5),
-        );
+        let (u, v) = frame_position(x, y, w, h);
         let drift = table.flat_change(u, v);
         let b = background.get_pixel(x, y);
         image::Rgb(std::array::from_fn(|c| {

@@ -348,12 +348,13 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
     if args.count == 0 {
         bail!("--count: must be at least 1");
     }
-    let profile = crate::ask::load_sensor(args.sensor.as_deref())?;
-    let sensor = profile.id();
+    // The stock data sets keep their own marker grids; a profile draws around its own.
     let space = match args.sensor {
-        Some(_) => sample_space(&args.fidelity, &args.shapes)?.around(profile),
+        Some(_) => sample_space(&args.fidelity, &args.shapes)?
+            .around(crate::ask::load_sensor(args.sensor.as_deref())?),
         None => sample_space(&args.fidelity, &args.shapes)?,
     };
+    let sensor = space.sensor.id();
     let catalog = FruitCatalog::builtin();
     let protocol = PressProtocol::default();
     let optics = tactex_sim::gel_render::SensorOptics::for_profile(&space.sensor);

@@ -235,9 +235,9 @@ pub fn run(args: &PressArgs) -> Result<()> {
         let (cols, rows) = grid
             .split_once(['x', 'X'])
             .and_then(|(c, r)| Some((c.trim().parse::<u32>().ok()?, r.trim().parse::<u32>().ok()?)))
-            .filter(|(c, r)| c * r <= 10_000)
+            .filter(|(c, r)| u64::from(*c) * u64::from(*r) <= 10_000)
             .with_context(|| {
-                format!("--marker-grid: '{grid}' is not COLSxROWS (e.g. 9x7, 11x9)")
+                format!("--marker-grid: '{grid}' is not COLSxROWS with at most 10000 markers (e.g. 9x7, 11x9)")
             })?;
         spec.markers.cols = cols;
         spec.markers.rows = rows;

@@ -3,7 +3,7 @@
 //! so every pixel there has a known slope; far from the contact the gel is flat. Each such
 //! pixel is a `ShadingSample` of its colour change over the no-contact frame.
 
-use crate::shading_table::ShadingSample;
+use crate::shading_table::{ShadingSample, frame_position};
 use image::RgbImage;
 use std::path::Path;
 
@@ -162,11 +162,12 @@ pub fn samples_from_ball_press(
             };
             let Some((gx, gy)) = slope else { continue };
             let (p, b) = (image.get_pixel(x, y), background.get_pixel(x, y));
+            let (u, v) = frame_position(x, y, w, h);
             out.push(ShadingSample {
                 gx: gx as f32,
                 gy: gy as f32,
-                u: 2.0 * ((x as f32 + 0.5) / w as f32 - 0.5),
-                v: 2.0 * ((y as f32 + 0.5) / h as f32 - 0.5),
+                u,
+                v,
                 change: std::array::from_fn(|c| p[c] as f32 - b[c] as f32),
             });
         }

@@ -199,7 +199,7 @@ impl SensorProfile {
             field: field.into(),
             message,
         };
-        let raw: ProfileFile = toml::from_str(text).map_err(|e| {
+        let mut raw: ProfileFile = toml::from_str(text).map_err(|e| {
             let line = e
                 .span()
                 .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
@@ -215,7 +215,8 @@ impl SensorProfile {
                 format!("'{}', expected '{PROFILE_FORMAT}'", raw.format),
             ));
         }
-        let shading = match raw.optics.shading.as_str() {
+        // A table profile's lights are the stock ones: nothing reads them.
+        let (photometric, table) = match raw.optics.shading.as_str() {
             "lights" => {
                 let l = raw.optics.lights.as_ref().ok_or_else(|| {
                     err(
@@ -223,18 +224,22 @@ impl SensorProfile {
                         "missing: shading = \"lights\" needs an [optics.lights] table".into(),
                     )
                 })?;
-                Shading::Lights(PhotometricModel {
+                let lights = PhotometricModel {
                     lights: l.directions.map(glam::DVec3::from_array),
                     ambient: l.ambient,
                     gain: l.gain,
-                })
+                };
+                (lights, None)
             }
-            "table" => Shading::Table(raw.optics.table.clone().ok_or_else(|| {
-                err(
-                    "optics.table",
-                    "missing: shading = \"table\" needs an [optics.table] table".into(),
-                )
-            })?),
+            "table" => {
+                let table = raw.optics.table.take().ok_or_else(|| {
+                    err(
+                        "optics.table",
+                        "missing: shading = \"table\" needs an [optics.table] table".into(),
+                    )
+                })?;
+                (PhotometricModel::default(), Some(table))
+            }
             other => {
                 return Err(err(
                     "optics.shading",
@@ -259,10 +264,6 @@ impl SensorProfile {
         };
         let c = &raw.camera;
         let m = &raw.markers;
-        let (photometric, table) = match shading {
-            Shading::Lights(l) => (l, None),
-            Shading::Table(t) => (PhotometricModel::default(), Some(t)),
-        };
         let profile = SensorProfile {
             source: raw.source.clone(),
             spec: TactileSpec {
@@ -353,8 +354,9 @@ impl SensorProfile {
                 format!("{}, expected (0, 50] mm", g.thickness_mm),
             );
         }
-        match &self.shading() {
-            Shading::Lights(l) => {
+        match &s.table {
+            None => {
+                let l = &s.photometric;
                 if !l
                     .lights
                     .iter()
@@ -387,7 +389,7 @@ impl SensorProfile {
                     );
                 }
             }
-            Shading::Table(t) => {
+            Some(t) => {
                 if let Err(e) = t.validate() {
                     return bad("optics.table", e.to_string());
                 }
@@ -445,17 +447,17 @@ impl SensorProfile {
 
     fn to_file(&self, background: &str) -> ProfileFile {
         let s = &self.spec;
-        let (shading, lights, table) = match &self.shading() {
-            Shading::Lights(l) => (
+        let (shading, lights, table) = match &s.table {
+            None => (
                 "lights",
                 Some(LightsSection {
-                    directions: l.lights.map(|d| d.to_array()),
-                    ambient: l.ambient,
-                    gain: l.gain,
+                    directions: s.photometric.lights.map(|d| d.to_array()),
+                    ambient: s.photometric.ambient,
+                    gain: s.photometric.gain,
                 }),
                 None,
             ),
-            Shading::Table(t) => ("table", None, Some(t.clone())),
+            Some(t) => ("table", None, Some(t.clone())),
         };
         ProfileFile {
             format: PROFILE_FORMAT.into(),

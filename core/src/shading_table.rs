@@ -95,6 +95,14 @@ fn nodes(mag_bins: u32, dir_bins: u32, mag_max: f32, gx: f32, gy: f32) -> [(u32,
     ]
 }
 
+/// Pixel (x, y)'s centre as the table's position (u, v), each in [-1, 1] across a w x h frame.
+pub fn frame_position(x: u32, y: u32, w: u32, h: u32) -> (f32, f32) {
+    (
+        2.0 * ((x as f32 + 0.5) / w as f32 - 0.5),
+        2.0 * ((y as f32 + 0.5) / h as f32 - 0.5),
+    )
+}
+
 fn basis(u: f32, v: f32) -> [f32; TERMS] {
     [1.0, u, v, u * u, u * v, v * v]
 }

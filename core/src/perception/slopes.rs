@@ -4,6 +4,7 @@
 //! are left out.
 
 use crate::photometric::PhotometricModel;
+use crate::shading_table::frame_position;
 use crate::tactile_spec::TactileSpec;
 use image::RgbImage;
 
@@ -67,9 +68,7 @@ pub fn recover_slopes(
         }
         let slope = match &spec.table {
             Some(table) => {
-                let (x, y) = (i % w, i / w);
-                let u = 2.0 * ((x as f32 + 0.5) / w as f32 - 0.5);
-                let v = 2.0 * ((y as f32 + 0.5) / h as f32 - 0.5);
+                let (u, v) = frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
                 let change = std::array::from_fn(|c| f32::from(p[c]) - f32::from(r[c]));
                 table
                     .slope_for_change(change, u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS)
