@@ -24,6 +24,18 @@ struct RenderParams {
 
 @group(0) @binding(0) var<uniform> params: RenderParams;
 
+// One glow term as the glow stages read it (the Rust `GlowTermBlock`, 64 bytes).
+struct GlowTerm {
+    // Rows of the 3x3 mix into the output (w unused).
+    mix: array<vec4<f32>, 3>,
+    // Where the term's kernel starts in the stages' kernel array, and its radius (taps -r..=r).
+    offset: u32,
+    radius: u32,
+    // 1: the source is the change's magnitude (in channel 0).
+    magnitude: u32,
+    padding: u32,
+}
+
 fn pixel_count() -> u32 {
     return params.width * params.height;
 }

@@ -14,7 +14,6 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
 use tactex_core::hertz::Elastic;
-use tactex_core::tactile_spec::TactileSpec;
 use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
 use tactex_sim::gel_render::{
     CpuRenderer, GelImageFields, GelRenderer, GpuRenderer, PressFrame, SensorOptics, adapters,
@@ -35,6 +34,9 @@ pub struct RenderBenchArgs {
     /// Frames per GPU dispatch for the batch row (data generation renders many at once).
     #[arg(long, default_value_t = 64)]
     batch: usize,
+    /// Sensor profile to render with (default: the built-in GelSight Mini).
+    #[arg(long)]
+    sensor: Option<PathBuf>,
 }
 
 #[derive(Serialize, Clone)]
@@ -54,6 +56,8 @@ pub struct RenderRow {
 
 #[derive(Serialize)]
 pub struct RenderBench {
+    /// The sensor rendered.
+    pub sensor: tactex_core::sensor_profile::ProfileId,
     pub width: u32,
     pub height: u32,
     pub rows: Vec<RenderRow>,
@@ -70,8 +74,9 @@ pub fn run(args: &RenderBenchArgs) -> Result<()> {
     anyhow::ensure!(args.reps >= 1, "--reps: must be at least 1");
     anyhow::ensure!(args.batch >= 1, "--batch: must be at least 1");
     let reps = args.reps;
-    let spec = TactileSpec::gelsight_mini();
-    let optics = SensorOptics::for_spec(&spec);
+    let profile = crate::ask::load_sensor(args.sensor.as_deref())?;
+    let spec = profile.spec.clone();
+    let optics = SensorOptics::for_profile(&profile);
     let surface = ObjectSurface::Sphere {
         radius_mm: 10.0,
         centre_mm: DVec2::ZERO,
@@ -190,6 +195,7 @@ pub fn run(args: &RenderBenchArgs) -> Result<()> {
     bar.inc(1);
     bar.finish_and_clear();
     let report = RenderBench {
+        sensor: profile.id(),
         width: optics.width,
         height: optics.height,
         rows,
@@ -235,8 +241,8 @@ fn csv(r: &RenderBench) -> String {
 
 fn markdown(r: &RenderBench) -> String {
     let mut out = format!(
-        "Full {}x{} frame: contact solve + gel fields + render, median ms per frame of an 8-frame press.\n\n",
-        r.width, r.height
+        "Full {}x{} frame of {}: contact solve + gel fields + render, median ms per frame of an 8-frame press.\n\n",
+        r.width, r.height, r.sensor
     );
     out += "| fidelity | device | solve ms | fields ms | render ms | frame ms | fps |\n";
     out += "|---|---|---:|---:|---:|---:|---:|\n";

@@ -1,17 +1,24 @@
-//! `tactex calibrate`: fits the gradient -> colour table from annotated ball presses, measures
-//! the camera's noise, and writes a sensor profile (TOML + its background PNG beside it).
+//! `tactex calibrate`: fits the gradient -> colour table from annotated ball presses, then the
+//! glow round a contact from the same presses rebuilt in the twin, measures the camera's
+//! noise, and writes a sensor profile (TOML + its background PNG beside it).
 
-use crate::ball_presses::{self, Split};
+use crate::ball_presses::{self, Split, contact_box, rebuild};
 use crate::output::write_profile_atomic;
 use crate::press::positive;
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use image::RgbImage;
 use std::path::PathBuf;
-use tactex_core::ball_calibration::{SampleRule, camera_noise_sigma, samples_from_ball_press};
+use tactex_core::ball_calibration::{
+    BallPress, SampleRule, camera_noise_sigma, samples_from_ball_press,
+};
+use tactex_core::gel_glow::{GelGlow, GlowPress};
 use tactex_core::perception::centroid::median;
 use tactex_core::sensor_profile::{CalibrationFit, SensorProfile};
 use tactex_core::shading_table::{ShadingTable, frame_position};
 use tactex_core::tactile_spec::{GelSpec, TactileSpec};
+use tactex_sim::elastic::{ContactSolver, Fidelity};
+use tactex_sim::gel_render::{CpuRenderer, GelImageFields, PressFrame, SensorOptics};
 
 #[derive(Args, Debug)]
 #[command(allow_negative_numbers = true)]
@@ -66,6 +73,88 @@ pub struct CalibrateArgs {
     /// Attribution of the images, stored in the file.
     #[arg(long, default_value = "")]
     pub source: String,
+    /// Fit no glow (light scattered in the gel round a contact): the table alone.
+    #[arg(long)]
+    pub no_glow: bool,
+    /// Contact model that rebuilds the presses the glow is fitted to.
+    #[arg(long, default_value = "layer")]
+    pub fidelity: Fidelity,
+}
+
+/// The glow's blurs (pixels): colour changes spread over 3-27 px, and a wider brightening
+/// that follows the change's magnitude (chosen on the FOTS presses, docs/sensor_profile.md).
+const GLOW_COLOUR_SIGMAS_PX: [f32; 4] = [0.0, 3.0, 9.0, 27.0];
+const GLOW_MAGNITUDE_SIGMAS_PX: [f32; 3] = [9.0, 27.0, 81.0];
+
+/// The glow that maps the twin's renders of the presses onto the real frames: each press
+/// rebuilt and shaded without glow, its change from the flat gel's shading fitted to the
+/// real frame's, over the box of four contact radii.
+fn fit_glow(
+    profile: &SensorProfile,
+    presses: &[(BallPress, RgbImage)],
+    ball_radius_mm: f64,
+    fidelity: Fidelity,
+) -> Result<GelGlow> {
+    let optics = SensorOptics {
+        noise_sigma: 0.0,
+        glow: None,
+        ..SensorOptics::for_profile(profile)
+    };
+    let (w, h) = (optics.width, optics.height);
+    let flat_fields = GelImageFields::flat(w, h);
+    let flat = CpuRenderer.shade_only(
+        &optics,
+        &PressFrame {
+            fields: &flat_fields,
+            seed: 0,
+        },
+    );
+    let mut solver = ContactSolver::new();
+    let mut changes = Vec::new();
+    for (press, real) in presses {
+        let (_, _, fields, _) = rebuild(
+            &mut solver,
+            press,
+            ball_radius_mm,
+            &profile.spec.gel,
+            &optics,
+            fidelity,
+        )?;
+        let shaded = CpuRenderer.shade_only(
+            &optics,
+            &PressFrame {
+                fields: &fields,
+                seed: 0,
+            },
+        );
+        let change: Vec<[f32; 3]> = shaded
+            .iter()
+            .zip(&flat)
+            .map(|(s, f)| std::array::from_fn(|c| s[c] - f[c]))
+            .collect();
+        let target: Vec<[f32; 3]> = real
+            .pixels()
+            .zip(&flat)
+            .map(|(p, f)| std::array::from_fn(|c| f32::from(p[c]) - f[c]))
+            .collect();
+        changes.push((change, target, contact_box(press, w, h)));
+    }
+    let fitted: Vec<GlowPress> = changes
+        .iter()
+        .map(|(change, target, window)| GlowPress {
+            change,
+            target,
+            window: *window,
+        })
+        .collect();
+    GelGlow::fit(
+        &fitted,
+        w as usize,
+        h as usize,
+        &GLOW_COLOUR_SIGMAS_PX,
+        &GLOW_MAGNITUDE_SIGMAS_PX,
+    )
+    .context("fitting the glow")
 }
 
 pub fn run(args: &CalibrateArgs) -> Result<()> {
@@ -181,6 +270,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         // The real background carries the sensor's vignetting.
         vignette: 0.0,
         marker_darkness: stock.marker_darkness,
+        glow: None,
         fit: Some(CalibrationFit {
             images: presses.iter().map(|(p, _)| p.image.clone()).collect(),
             samples: samples.len(),
@@ -188,6 +278,10 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
             ball_radius_mm: radius,
         }),
     };
+    let mut profile = profile;
+    if !args.no_glow {
+        profile.glow = Some(fit_glow(&profile, &presses, radius, args.fidelity)?);
+    }
     profile
         .validate()
         .map_err(|(field, message)| anyhow::anyhow!("the fitted profile: {field}: {message}"))?;

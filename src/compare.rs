@@ -8,24 +8,20 @@
 //! contact circle is estimated on the real frame and on the rendered one and scored against
 //! the marked circle.
 
-use crate::ball_presses::{self, Split};
+use crate::ball_presses::{self, Split, contact_box, rebuild};
 use crate::compare_session::SessionCompare;
 use crate::contact_circle_score::{CircleScore, CircleSummary, score_circle, summarise};
 use crate::output::{write_json_atomic, write_png_atomic};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use glam::DVec2;
 use image::RgbImage;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::ball_calibration::BallPress;
-use tactex_core::hertz::Elastic;
 use tactex_core::perception::ssim::{gray, ssim};
-use tactex_core::tactile_spec::GelSpec;
-use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
+use tactex_sim::elastic::{ContactSolver, Fidelity};
 use tactex_sim::gel_render::{
-    DeviceChoice, GelImageFields, PressFrame, SensorOptics, image_fields, open_renderer, pad_rect,
-    pixel_centre_mm,
+    DeviceChoice, GelImageFields, PressFrame, SensorOptics, open_renderer,
 };
 
 #[derive(Args, Debug)]
@@ -68,6 +64,9 @@ pub struct CompareArgs {
     /// Rendering device: auto, gpu or cpu.
     #[arg(long, default_value = "auto")]
     pub device: DeviceChoice,
+    /// Render without the profile's glow (light scattered in the gel), to see what it adds.
+    #[arg(long, conflicts_with = "session")]
+    pub no_glow: bool,
     /// Write real | rendered | difference images per press here.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -107,6 +106,8 @@ pub struct CompareReport {
     pub sensor: tactex_core::sensor_profile::ProfileId,
     pub split: String,
     pub fidelity: String,
+    /// Whether the presses were rendered with the profile's glow.
+    pub glow: bool,
     pub device: String,
     pub presses: Vec<PressComparison>,
     pub mean: Scores,
@@ -144,15 +145,7 @@ fn ssim_in(a: &RgbImage, b: &RgbImage, window: [u32; 4]) -> f64 {
 fn scores(real: &RgbImage, rendered: &RgbImage, press: &BallPress) -> Scores {
     let (w, h) = real.dimensions();
     let full = [0, 0, w, h];
-    let reach = 2.0 * press.contact_radius_px;
-    let [cx, cy] = press.centre_px;
-    let clip = |v: f64, hi: u32| v.round().clamp(0.0, hi as f64) as u32;
-    let contact = [
-        clip(cx - reach, w),
-        clip(cy - reach, h),
-        clip(cx + reach + 1.0, w),
-        clip(cy + reach + 1.0, h),
-    ];
+    let contact = contact_box(press, w, h);
     Scores {
         ssim: ssim_in(real, rendered, full),
         mae: mae(real, rendered, full),
@@ -170,65 +163,6 @@ fn mean(all: impl Iterator<Item = Scores>) -> Scores {
         ssim_contact: v.iter().map(|s| s.ssim_contact).sum::<f64>() / n,
         mae_contact: v.iter().map(|s| s.mae_contact).sum::<f64>() / n,
     }
-}
-
-/// The press rebuilt: the travel at which the solver's contact radius is the annotated one
-/// (bisection; contact radius grows monotonically with travel), and its gel fields.
-fn rebuild(
-    solver: &mut ContactSolver,
-    press: &BallPress,
-    ball_radius_mm: f64,
-    gel: &GelSpec,
-    optics: &SensorOptics,
-    fidelity: Fidelity,
-) -> Result<(f64, f64, GelImageFields, Vec<String>)> {
-    let centre: DVec2 = pixel_centre_mm(optics, press.centre_px[0], press.centre_px[1]);
-    let surface = ObjectSurface::Sphere {
-        radius_mm: ball_radius_mm,
-        centre_mm: centre,
-    };
-    let target = press.contact_radius_px * optics.mm_per_px;
-    let problem = |approach_mm| ContactProblem {
-        surface: &surface,
-        // Steel: rigid next to the gel.
-        object: Elastic {
-            modulus_mpa: None,
-            poisson: 0.3,
-        },
-        gel: *gel,
-        pad: pad_rect(optics),
-        approach_mm,
-        cell_mm: None,
-    };
-    let (mut lo, mut hi) = (0.0, 0.95 * ball_radius_mm);
-    let radius_at = |solver: &mut ContactSolver, d: f64| -> Result<f64> {
-        Ok(solver.solve(&problem(d), fidelity)?.contact_radius_mm)
-    };
-    // Hand-marked circles can be wider than any contact the ball can make (up to a = R):
-    // such presses are taken at the deepest travel modelled, and say so.
-    let mut warnings = Vec::new();
-    let deepest = radius_at(solver, hi)?;
-    if deepest < target {
-        warnings.push(format!(
-            "annotated contact radius {target:.2} mm is beyond the {deepest:.2} mm the model reaches at {hi:.2} mm travel; pressed to that travel"
-        ));
-        lo = hi;
-    }
-    for _ in 0..30 {
-        let mid = 0.5 * (lo + hi);
-        if radius_at(solver, mid)? < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo < 1e-4 * ball_radius_mm {
-            break;
-        }
-    }
-    let depth = 0.5 * (lo + hi);
-    let solution = solver.solve(&problem(depth), fidelity)?;
-    let fields = image_fields(solver, &solution, gel, optics);
-    Ok((depth, solution.force_n, fields, warnings))
 }
 
 /// real | rendered | difference around mid-grey (4x), side by side.
@@ -277,10 +211,13 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         );
     };
     // The rebuilt presses are compared with single real frames: no added camera noise.
-    let optics = SensorOptics {
+    let mut optics = SensorOptics {
         noise_sigma: 0.0,
         ..SensorOptics::for_profile(&profile)
     };
+    if args.no_glow {
+        optics.glow = None;
+    }
     let spec = &profile.spec;
     let presses = ball_presses::load(
         images,
@@ -343,6 +280,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         sensor: profile.id(),
         split: format!("{:?}", args.split).to_lowercase(),
         fidelity: args.fidelity.name().into(),
+        glow: optics.glow.is_some(),
         device: renderer.name(),
         mean: mean(out.iter().map(|p| p.rendered)),
         background_only_mean: mean(out.iter().map(|p| p.background_only)),
@@ -407,10 +345,15 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         &report.background_only_mean,
     );
     println!(
-        "{} presses ({} split), {} contact, rendered on {}; (c): the box of 4 contact radii around the press",
+        "{} presses ({} split), {} contact, {}, rendered on {}; (c): the box of 4 contact radii around the press",
         report.presses.len(),
         report.split,
         report.fidelity,
+        if report.glow {
+            "with the profile's glow"
+        } else {
+            "no glow"
+        },
         report.device
     );
     for (frames, c) in [

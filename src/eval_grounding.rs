@@ -41,6 +41,7 @@ pub const KINDS: [&str; 10] = [
 ];
 
 #[derive(Args)]
+#[command(allow_negative_numbers = true)]
 pub struct GroundingEvalArgs {
     /// Detectors to compare: classical, yolo:FILE.onnx (a YOLOv8-seg export), error-gsam,
     /// error-yolo (perception-error models).
@@ -50,15 +51,15 @@ pub struct GroundingEvalArgs {
         default_value = "classical,error-gsam,error-yolo"
     )]
     pub detector: Vec<String>,
-    /// Instances per fruit kind (the paper: 4).
+    /// Instances per fruit kind (the paper: 4), 1-100.
     #[arg(long, default_value_t = 4)]
     pub per_kind: usize,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Depth frames in the median (the paper: 10).
+    /// Depth frames in the median (the paper: 10), 1-100.
     #[arg(long, default_value_t = 10)]
     pub depth_frames: usize,
-    /// The centroid error tolerance of the one-sample t-test (mm; the paper: 5).
+    /// The centroid error tolerance of the one-sample t-test (mm; the paper: 5), (0, 1000].
     #[arg(long, default_value_t = 5.0)]
     pub tolerance_mm: f64,
     #[arg(long)]
@@ -165,7 +166,7 @@ fn run_instance(
     sim.camera.set_renderer(renderer.clone());
     let clean = sim.camera.clean()?.clone();
     let (k, pose) = (sim.camera.intrinsics(), sim.camera.pose());
-    let frames = (0..args.depth_frames.max(1))
+    let frames = (0..args.depth_frames)
         .map(|_| sim.camera.capture())
         .collect::<Result<Vec<_>, _>>()?;
     let depths: Vec<&DepthImage> = frames.iter().map(|f| &f.depth_m).collect();
@@ -372,8 +373,26 @@ fn table(report: &Report) -> String {
     s
 }
 
+/// Bounds on the work one run may ask for.
+const MAX_PER_KIND: usize = 100;
+const MAX_DEPTH_FRAMES: usize = 100;
+
 pub fn run(args: &GroundingEvalArgs) -> Result<()> {
-    anyhow::ensure!(args.per_kind >= 1, "--per-kind: must be at least 1");
+    anyhow::ensure!(
+        (1..=MAX_PER_KIND).contains(&args.per_kind),
+        "--per-kind: {}, expected 1..={MAX_PER_KIND}",
+        args.per_kind
+    );
+    anyhow::ensure!(
+        (1..=MAX_DEPTH_FRAMES).contains(&args.depth_frames),
+        "--depth-frames: {}, expected 1..={MAX_DEPTH_FRAMES}",
+        args.depth_frames
+    );
+    anyhow::ensure!(
+        args.tolerance_mm.is_finite() && args.tolerance_mm > 0.0 && args.tolerance_mm <= 1000.0,
+        "--tolerance-mm: {}, expected a distance in (0, 1000] mm",
+        args.tolerance_mm
+    );
     anyhow::ensure!(!args.detector.is_empty(), "--detector: name at least one");
     let catalog = FruitCatalog::builtin();
     let detectors = args

@@ -65,6 +65,7 @@ struct Summary {
     gel_thickness_mm: f64,
     background: String,
     shading: String,
+    glow: Option<String>,
     markers: String,
     fit: Option<String>,
 }
@@ -96,6 +97,19 @@ fn summary(p: &SensorProfile) -> Summary {
             ),
             None => "three analytic lights".into(),
         },
+        glow: p.glow.as_ref().map(|g| {
+            let sigmas = |v: Vec<f32>| {
+                v.iter()
+                    .map(|s| format!("{s}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            format!(
+                "colour blurred at {} px, magnitude at {} px",
+                sigmas(g.colour.iter().map(|t| t.sigma_px).collect()),
+                sigmas(g.magnitude.iter().map(|t| t.sigma_px).collect())
+            )
+        }),
         markers: if m.cols * m.rows == 0 {
             "none".into()
         } else {
@@ -157,6 +171,9 @@ fn show(args: &ShowArgs) -> Result<()> {
     );
     println!("  background  {}", s.background);
     println!("  shading     {}", s.shading);
+    if let Some(glow) = &s.glow {
+        println!("  glow        {glow}");
+    }
     println!("  markers     {}", s.markers);
     if let Some(fit) = &s.fit {
         println!("  fit         {fit}");

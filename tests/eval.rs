@@ -209,6 +209,22 @@ fn bad_hardness_arguments_are_named() {
 }
 
 #[test]
+fn bad_grounding_arguments_are_named() {
+    bad_arguments_are_named(
+        "grounding",
+        &[
+            (&["--tolerance-mm", "NaN"], "--tolerance-mm"),
+            (&["--tolerance-mm", "-5"], "--tolerance-mm"),
+            (&["--tolerance-mm", "1e300"], "--tolerance-mm"),
+            (&["--depth-frames", "0"], "--depth-frames"),
+            (&["--depth-frames", "100000"], "--depth-frames"),
+            (&["--per-kind", "0"], "--per-kind"),
+            (&["--per-kind", "1000000"], "--per-kind"),
+        ],
+    );
+}
+
+#[test]
 fn bad_ripeness_arguments_are_named() {
     bad_arguments_are_named(
         "ripeness",

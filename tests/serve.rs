@@ -273,6 +273,10 @@ fn a_missing_scene_or_a_taken_port_is_a_one_line_error() {
         ),
         (vec!["serve", "--port", port.as_str()], "cannot listen"),
         (vec!["serve", "--max-queries", "0"], "--max-queries"),
+        (
+            vec!["serve", "--max-prompt-chars", "0"],
+            "--max-prompt-chars",
+        ),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_tactex"))
             .args(&args)

@@ -12,6 +12,7 @@ pub mod devices;
 pub mod estimate;
 pub mod explain;
 pub mod frames;
+pub mod gel_glow;
 pub mod gel_share_fit;
 pub mod geometry;
 pub mod hardness;

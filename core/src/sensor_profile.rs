@@ -8,6 +8,7 @@
 //! contents (the canonical TOML, without the background's file name, then the background's
 //! pixels), so two profiles that render alike hash alike wherever their files live.
 
+use crate::gel_glow::{GelGlow, GlowError};
 use crate::photometric::PhotometricModel;
 use crate::shading_table::ShadingTable;
 use crate::tactile_spec::{GelSpec, MarkerGrid, TactileSpec};
@@ -56,6 +57,8 @@ pub struct SensorProfile {
     pub vignette: f64,
     /// Fraction of the light a marker dot's centre blocks.
     pub marker_darkness: f64,
+    /// Light scattered in the gel round a contact (fitted by `calibrate`); None: no glow.
+    pub glow: Option<GelGlow>,
     pub fit: Option<CalibrationFit>,
 }
 
@@ -134,6 +137,8 @@ struct OpticsSection {
     lights: Option<LightsSection>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     table: Option<ShadingTable>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    glow: Option<GelGlow>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -175,6 +180,7 @@ impl SensorProfile {
             noise_sigma_grey: 0.5,
             vignette: 0.55,
             marker_darkness: 0.82,
+            glow: None,
             fit: None,
         }
     }
@@ -290,6 +296,7 @@ impl SensorProfile {
             noise_sigma_grey: c.noise_sigma_grey,
             vignette: c.vignette,
             marker_darkness: m.darkness,
+            glow: raw.optics.glow,
             fit: raw.fit,
         };
         profile
@@ -395,6 +402,14 @@ impl SensorProfile {
                 }
             }
         }
+        if let Some(glow) = &self.glow
+            && let Err(e) = glow.validate()
+        {
+            return match e {
+                GlowError::Invalid { field, message } => bad(&field, message),
+                other => bad("optics.glow", other.to_string()),
+            };
+        }
         if let Some(bg) = &self.background
             && bg.dimensions() != (s.width_px, s.height_px)
         {
@@ -481,6 +496,7 @@ impl SensorProfile {
                 shading: shading.into(),
                 lights,
                 table,
+                glow: self.glow.clone(),
             },
             markers: MarkersSection {
                 cols: s.markers.cols,
@@ -572,6 +588,16 @@ mod tests {
         p.background = Some(RgbImage::from_fn(320, 240, |x, y| {
             image::Rgb([(x % 251) as u8, (y % 241) as u8, 90])
         }));
+        p.glow = Some(GelGlow {
+            colour: vec![crate::gel_glow::ColourGlow {
+                sigma_px: 3.0,
+                mix: [[0.7, 0.1, 0.0], [0.0, 0.6, -0.05], [0.2, 0.0, 0.9]],
+            }],
+            magnitude: vec![crate::gel_glow::MagnitudeGlow {
+                sigma_px: 27.0,
+                colour: [0.11, -0.02, 0.3],
+            }],
+        });
         let path = dir.path().join("bench.toml");
         let bg = SensorProfile::background_path(&path);
         p.background.as_ref().unwrap().save(&bg).unwrap();
@@ -628,6 +654,11 @@ mod tests {
             assert_eq!(e.field, field, "{to}: {e}");
             assert!(!e.to_string().contains('\n'), "{e}");
         }
+        let glowing = format!(
+            "{stock}\n[[optics.glow.magnitude]]\nsigma_px = 500.0\ncolour = [0.1, 0.2, 0.3]\n"
+        );
+        let e = parse(&glowing).unwrap_err();
+        assert_eq!(e.field, "optics.glow.magnitude[0].sigma_px", "{e}");
         let e = parse("format = 3").unwrap_err();
         assert_eq!(e.field, "toml");
         let e = parse(&stock.replacen("[gel]", "[gel]\nshore = 3", 1)).unwrap_err();

@@ -372,7 +372,7 @@ impl ShadingTable {
 
 /// Solves A x = b for a symmetric positive definite A (row-major, overwritten by its Cholesky
 /// factor) and three right-hand sides.
-fn solve_spd(a: &mut [f64], n: usize, b: &[[f64; 3]]) -> Option<Vec<[f64; 3]>> {
+pub(crate) fn solve_spd(a: &mut [f64], n: usize, b: &[[f64; 3]]) -> Option<Vec<[f64; 3]>> {
     for j in 0..n {
         let mut d = a[j * n + j];
         for k in 0..j {

@@ -3,6 +3,7 @@
 
 use glam::DVec2;
 use image::RgbImage;
+use tactex_core::gel_glow::{ColourGlow, GelGlow, MagnitudeGlow};
 use tactex_core::hertz::Elastic;
 use tactex_core::shading_table::{ShadingSample, ShadingTable};
 use tactex_core::tactile_spec::TactileSpec;
@@ -153,8 +154,26 @@ fn gpu_and_cpu_paths_agree_on_a_set_of_presses() {
     let mut table = lights.clone();
     table.shading = Shading::Table(fitted_table(&lights));
     table.noise_sigma = 1.5;
+    // A glow of every kind: unblurred and blurred colour terms, a magnitude term.
+    let mut glowing = table.clone();
+    glowing.glow = Some(GelGlow {
+        colour: vec![
+            ColourGlow {
+                sigma_px: 0.0,
+                mix: [[0.9, 0.05, 0.0], [0.0, 0.8, 0.1], [0.0, 0.0, 1.0]],
+            },
+            ColourGlow {
+                sigma_px: 3.0,
+                mix: [[0.5, 0.0, -0.1], [0.1, 0.4, 0.0], [0.0, 0.2, 0.6]],
+            },
+        ],
+        magnitude: vec![MagnitudeGlow {
+            sigma_px: 9.0,
+            colour: [0.3, 0.1, -0.2],
+        }],
+    });
     let fields = presses(&lights);
-    for optics in [&lights, &table] {
+    for optics in [&lights, &table, &glowing] {
         let frames: Vec<PressFrame> = fields
             .iter()
             .enumerate()

@@ -53,10 +53,10 @@ pub struct ServeArgs {
     pub seed: u64,
     #[command(flatten)]
     pub twin: TwinOptions,
-    /// Questions answered at once; more are refused with HTTP 429 until one finishes.
+    /// Questions answered at once (1-64); more are refused with HTTP 429 until one finishes.
     #[arg(long, default_value_t = 2)]
     pub max_queries: usize,
-    /// Longest question accepted, in characters.
+    /// Longest question accepted, in characters (1-100000).
     #[arg(long, default_value_t = 300)]
     pub max_prompt_chars: usize,
 }
@@ -83,8 +83,14 @@ struct Served {
 type Shared = Arc<Served>;
 
 pub fn run(args: &ServeArgs) -> Result<()> {
-    if args.max_queries == 0 {
-        anyhow::bail!("--max-queries: must be at least 1");
+    if !(1..=64).contains(&args.max_queries) {
+        anyhow::bail!("--max-queries: {}, expected 1..=64", args.max_queries);
+    }
+    if !(1..=100_000).contains(&args.max_prompt_chars) {
+        anyhow::bail!(
+            "--max-prompt-chars: {}, expected 1..=100000",
+            args.max_prompt_chars
+        );
     }
     let catalog = FruitCatalog::builtin();
     let path = args.scene.clone().unwrap_or_else(crate::default_scene);

@@ -1,9 +1,10 @@
-//! The reference renderer: the four shader stages in plain Rust, f32, the same operations in
+//! The reference renderer: the shader stages in plain Rust, f32, the same operations in
 //! the same order for each pixel. A frame goes through all four stages row by row, rows in
-//! parallel (pixels are independent, so the bytes do not depend on the thread count).
+//! parallel (pixels are independent, so the bytes do not depend on the thread count); with a
+//! glow, which spreads light across rows, the frame is shaded whole before the dots and noise.
 
 use super::noise::gaussian3_row;
-use super::{GelRenderer, PressFrame, RenderError, RenderParams, SensorOptics, Shading};
+use super::{GelGlow, GelRenderer, PressFrame, RenderError, RenderParams, SensorOptics, Shading};
 use image::RgbImage;
 use rayon::prelude::*;
 
@@ -147,6 +148,36 @@ impl<'a> ShadedFrame<'a> {
             }
         }
     }
+}
+
+/// The shading of a flat gel: what the glow's change is taken against.
+pub(crate) fn flat_shading(p: &RenderParams, optics: &SensorOptics) -> Vec<[f32; 3]> {
+    shade(
+        p,
+        optics,
+        &vec![[0.0; 2]; p.width as usize * p.height as usize],
+    )
+}
+
+/// Stages 1-2 and the glow (gel_glow_*.wgsl): the shaded frame with its change from the flat
+/// gel's shading replaced by the glow of that change.
+fn glowing(
+    p: &RenderParams,
+    optics: &SensorOptics,
+    glow: &GelGlow,
+    heights: &[f32],
+) -> Vec<[f32; 3]> {
+    let (w, h) = (p.width as usize, p.height as usize);
+    let flat = flat_shading(p, optics);
+    let mut shaded = shade(p, optics, &slopes(p, heights));
+    for (s, f) in shaded.iter_mut().zip(&flat) {
+        *s = std::array::from_fn(|c| s[c] - f[c]);
+    }
+    let mut out = glow.apply(&shaded, w, h);
+    for (o, f) in out.iter_mut().zip(&flat) {
+        *o = std::array::from_fn(|c| f[c] + o[c]);
+    }
+    out
 }
 
 /// Stage 3: marker centres moved by the lateral field (marker_displacement.wgsl).
@@ -295,10 +326,25 @@ impl CpuRenderer {
         let p = RenderParams::new(optics, 1);
         let f = frame.fields;
         let w = p.width as usize;
-        let shading = ShadedFrame::new(&p, optics);
         let centres = marker_centres(&p, optics, &f.lateral_x_mm, &f.lateral_y_mm);
         let dots = dot_reaches(&p, &centres);
         let mut bytes = vec![0u8; w * p.height as usize * 3];
+        if let Some(glow) = &optics.glow {
+            // The glow spreads light across rows: the whole frame is shaded first.
+            let mut shaded = glowing(&p, optics, glow, &f.normal_mm);
+            bytes
+                .par_chunks_mut(3 * w)
+                .zip(shaded.par_chunks_mut(w))
+                .enumerate()
+                .for_each_init(
+                    || vec![[0.0f32; 3]; w],
+                    |noise, (y, (row, shaded))| {
+                        expose_row(&p, &dots, frame.seed, y, shaded, noise, row)
+                    },
+                );
+            return RgbImage::from_raw(p.width, p.height, bytes).expect("sized from the frame");
+        }
+        let shading = ShadedFrame::new(&p, optics);
         bytes.par_chunks_mut(3 * w).enumerate().for_each_init(
             || RowScratch::new(w),
             |s, (y, row)| {
@@ -310,10 +356,14 @@ impl CpuRenderer {
         RgbImage::from_raw(p.width, p.height, bytes).expect("sized from the frame")
     }
 
-    /// The shading stage alone (slopes + shading + vignetting), for timing it on its own.
+    /// The shading stage alone (slopes + shading + vignetting, and the glow when the optics
+    /// have one): the frame before marker dots and noise, in grey levels.
     pub fn shade_only(&self, optics: &SensorOptics, frame: &PressFrame) -> Vec<[f32; 3]> {
         let p = RenderParams::new(optics, 1);
-        shade(&p, optics, &slopes(&p, &frame.fields.normal_mm))
+        match &optics.glow {
+            Some(glow) => glowing(&p, optics, glow, &frame.fields.normal_mm),
+            None => shade(&p, optics, &slopes(&p, &frame.fields.normal_mm)),
+        }
     }
 }
 

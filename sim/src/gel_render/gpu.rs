@@ -1,18 +1,22 @@
-//! The WGSL compute renderer: the four stages of `shaders/` as wgpu compute pipelines, a whole
+//! The WGSL compute renderer: the stages of `shaders/` (four, and three more for a glow) as
+//! wgpu compute pipelines, a whole
 //! batch of presses per dispatch (the frame is the third dispatch dimension), read back as
 //! RGBA8 and unpacked.
 
+use super::cpu::flat_shading;
 use super::{
-    GelImageFields, GelRenderer, PressFrame, RenderError, RenderParams, SensorOptics, Shading,
+    GelGlow, GelImageFields, GelRenderer, PressFrame, RenderError, RenderParams, SensorOptics,
+    Shading,
 };
 use crate::render_device::GpuDevice;
 use image::RgbImage;
+use tactex_core::gel_glow::gaussian_kernel;
 use wgpu::util::DeviceExt;
 
 const COMMON: &str = include_str!("../../../shaders/common.wgsl");
 
 /// Each stage's own source; the shared prelude (`common.wgsl`) goes in front of it.
-pub const SHADER_SOURCES: [(&str, &str); 4] = [
+pub const SHADER_SOURCES: [(&str, &str); 7] = [
     (
         "gel_slopes",
         include_str!("../../../shaders/gel_slopes.wgsl"),
@@ -29,7 +33,28 @@ pub const SHADER_SOURCES: [(&str, &str); 4] = [
         "sensor_exposure",
         include_str!("../../../shaders/sensor_exposure.wgsl"),
     ),
+    (
+        "gel_glow_rows",
+        include_str!("../../../shaders/gel_glow_rows.wgsl"),
+    ),
+    (
+        "gel_glow_columns",
+        include_str!("../../../shaders/gel_glow_columns.wgsl"),
+    ),
+    (
+        "gel_glow_apply",
+        include_str!("../../../shaders/gel_glow_apply.wgsl"),
+    ),
 ];
+
+// Indices into SHADER_SOURCES.
+const SLOPES: usize = 0;
+const SHADING: usize = 1;
+const MARKERS: usize = 2;
+const EXPOSURE: usize = 3;
+const GLOW_ROWS: usize = 4;
+const GLOW_COLUMNS: usize = 5;
+const GLOW_APPLY: usize = 6;
 
 /// The complete WGSL module of a stage, as the device compiles it.
 pub fn shader_source(stage: &str) -> Option<String> {
@@ -44,8 +69,8 @@ const MAX_FRAMES_PER_DISPATCH: usize = 64;
 
 pub struct GpuRenderer {
     gpu: GpuDevice,
-    /// slopes, shading, marker displacement, exposure.
-    pipelines: [wgpu::ComputePipeline; 4],
+    /// One per entry of SHADER_SOURCES.
+    pipelines: [wgpu::ComputePipeline; 7],
 }
 
 impl GpuRenderer {
@@ -160,51 +185,104 @@ impl GpuRenderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let groups = [
-            self.bind(0, &[&uniform, &heights, &slopes]),
-            self.bind(
-                1,
-                &[
-                    &uniform,
-                    &slopes,
-                    &shared.background,
-                    &shared.table,
-                    &shaded,
-                ],
-            ),
-            self.bind(
-                2,
-                &[&uniform, &lateral_x, &lateral_y, &shared.rest, &centres],
-            ),
-            self.bind(3, &[&uniform, &shaded, &centres, &seeds, &pixels]),
-        ];
         let (w, h) = (optics.width, optics.height);
         let tiles = [w.div_ceil(8), h.div_ceil(8), count as u32];
-        let dispatch = [
-            tiles,
-            tiles,
-            [(optics.markers.len() as u32).div_ceil(64), count as u32, 1],
-            tiles,
+        // The stages in order, each with its bind group and dispatch size.
+        let mut steps = vec![
+            (
+                SLOPES,
+                self.bind(SLOPES, &[&uniform, &heights, &slopes]),
+                tiles,
+            ),
+            (
+                SHADING,
+                self.bind(
+                    SHADING,
+                    &[
+                        &uniform,
+                        &slopes,
+                        &shared.background,
+                        &shared.table,
+                        &shaded,
+                    ],
+                ),
+                tiles,
+            ),
         ];
+        let mut glow_sum = None;
+        if let Some(glow) = &shared.glow {
+            let along_rows = self.scratch(
+                "glow along rows",
+                frame_px * 12,
+                wgpu::BufferUsages::empty(),
+            );
+            let sum = self.scratch("glow", frame_px * 12, wgpu::BufferUsages::COPY_DST);
+            for term in &glow.terms {
+                steps.push((
+                    GLOW_ROWS,
+                    self.bind(
+                        GLOW_ROWS,
+                        &[
+                            &uniform,
+                            term,
+                            &glow.kernel,
+                            &glow.flat,
+                            &shaded,
+                            &along_rows,
+                        ],
+                    ),
+                    tiles,
+                ));
+                steps.push((
+                    GLOW_COLUMNS,
+                    self.bind(
+                        GLOW_COLUMNS,
+                        &[&uniform, term, &glow.kernel, &along_rows, &sum],
+                    ),
+                    tiles,
+                ));
+            }
+            steps.push((
+                GLOW_APPLY,
+                self.bind(GLOW_APPLY, &[&uniform, &glow.flat, &sum, &shaded]),
+                tiles,
+            ));
+            glow_sum = Some(sum);
+        }
+        steps.push((
+            MARKERS,
+            self.bind(
+                MARKERS,
+                &[&uniform, &lateral_x, &lateral_y, &shared.rest, &centres],
+            ),
+            [(optics.markers.len() as u32).div_ceil(64), count as u32, 1],
+        ));
+        steps.push((
+            EXPOSURE,
+            self.bind(EXPOSURE, &[&uniform, &shaded, &centres, &seeds, &pixels]),
+            tiles,
+        ));
         let mut encoder = self
             .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("gel render"),
             });
+        if let Some(sum) = &glow_sum {
+            encoder.clear_buffer(sum, 0, None);
+        }
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("gel render"),
                 timestamp_writes: None,
             });
-            for stage in 0..4 {
-                let [x, y, z] = dispatch[stage];
-                if x == 0 || y == 0 || z == 0 {
+            for (stage, group, [x, y, z]) in &steps {
+                if *x == 0 || *y == 0 || *z == 0 {
                     continue;
                 }
-                pass.set_pipeline(&self.pipelines[stage]);
-                pass.set_bind_group(0, &groups[stage], &[]);
-                pass.dispatch_workgroups(x, y, z);
+                pass.set_pipeline(&self.pipelines[*stage]);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(*x, *y, *z);
             }
         }
         encoder.copy_buffer_to_buffer(&pixels, 0, &readback, 0, frame_px * 4);
@@ -229,6 +307,60 @@ struct OpticsBuffers {
     background: wgpu::Buffer,
     table: wgpu::Buffer,
     rest: wgpu::Buffer,
+    glow: Option<GlowBuffers>,
+}
+
+/// The glow's inputs: the flat gel's shading, every term's kernel back to back, and one
+/// uniform block per term.
+struct GlowBuffers {
+    flat: wgpu::Buffer,
+    kernel: wgpu::Buffer,
+    terms: Vec<wgpu::Buffer>,
+}
+
+/// A glow term as the glow stages read it (`GlowTerm` in shaders/common.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct GlowTermBlock {
+    mix: [[f32; 4]; 3],
+    offset: u32,
+    radius: u32,
+    magnitude: u32,
+    padding: u32,
+}
+
+impl GpuRenderer {
+    fn glow_buffers(&self, optics: &SensorOptics, glow: &GelGlow) -> GlowBuffers {
+        let p = RenderParams::new(optics, 1);
+        let flat: Vec<f32> = flat_shading(&p, optics).into_iter().flatten().collect();
+        let mut kernel = Vec::new();
+        let mut terms = Vec::new();
+        for term in glow.terms() {
+            let k = gaussian_kernel(term.sigma_px);
+            let block = GlowTermBlock {
+                mix: term.mix.map(|r| [r[0], r[1], r[2], 0.0]),
+                offset: kernel.len() as u32,
+                radius: (k.len() / 2) as u32,
+                magnitude: u32::from(term.magnitude),
+                padding: 0,
+            };
+            kernel.extend(k);
+            terms.push(
+                self.gpu
+                    .device
+                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("glow term"),
+                        contents: bytemuck::bytes_of(&block),
+                        usage: wgpu::BufferUsages::UNIFORM,
+                    }),
+            );
+        }
+        GlowBuffers {
+            flat: self.storage("flat shading", bytemuck::cast_slice(&flat)),
+            kernel: self.storage("glow kernels", bytemuck::cast_slice(&kernel)),
+            terms,
+        }
+    }
 }
 
 impl GelRenderer for GpuRenderer {
@@ -263,6 +395,7 @@ impl GelRenderer for GpuRenderer {
             background: self.storage("background", bytemuck::cast_slice(&background)),
             table: self.storage("shading table", bytemuck::cast_slice(table)),
             rest: self.storage("marker rest", bytemuck::cast_slice(&optics.markers)),
+            glow: optics.glow.as_ref().map(|g| self.glow_buffers(optics, g)),
         };
         let mut out = Vec::with_capacity(frames.len());
         for part in frames.chunks(chunk) {
@@ -284,6 +417,17 @@ mod tests {
             assert!(
                 module.entry_points.iter().any(|e| e.name == "main"),
                 "{stage} has no main entry point"
+            );
+        }
+    }
+
+    #[test]
+    fn glow_term_block_matches_the_shader_layout() {
+        for stage in ["gel_glow_rows", "gel_glow_columns"] {
+            let source = shader_source(stage).unwrap();
+            assert_eq!(
+                struct_size(&source, "GlowTerm"),
+                std::mem::size_of::<GlowTermBlock>()
             );
         }
     }

@@ -1,6 +1,7 @@
 //! GelSight image synthesis: the gel's displacement fields at pixel resolution -> surface
 //! slopes -> shading over the no-contact background (analytic coloured lights or a calibrated
-//! gradient table) -> vignetting -> marker dots moved by the lateral field -> seeded camera
+//! gradient table) -> vignetting -> glow (light scattered in the gel, when the profile has
+//! one) -> marker dots moved by the lateral field -> seeded camera
 //! noise -> 8-bit RGB.
 //!
 //! One contract, two implementations: `CpuRenderer` (the reference, Rust, f32 like the
@@ -22,6 +23,7 @@ pub use gpu::{GpuRenderer, SHADER_SOURCES, shader_source};
 pub use noise::gaussian3;
 
 use image::RgbImage;
+pub use tactex_core::gel_glow::GelGlow;
 use tactex_core::sensor_profile::SensorProfile;
 pub use tactex_core::sensor_profile::Shading;
 use tactex_core::tactile_spec::TactileSpec;
@@ -45,6 +47,9 @@ pub struct SensorOptics {
     pub vignette: f32,
     /// Camera noise per channel (grey levels, 1 sigma).
     pub noise_sigma: f32,
+    /// Light scattered in the gel: the shading's change is replaced by its glow (before the
+    /// marker dots and the noise). None: the change as shaded.
+    pub glow: Option<GelGlow>,
 }
 
 /// The gel's displacement at every pixel centre of one frame (mm; normal = into the gel,
@@ -140,6 +145,7 @@ impl SensorOptics {
             marker_darkness: profile.marker_darkness as f32,
             vignette: profile.vignette as f32,
             noise_sigma: profile.noise_sigma_grey as f32,
+            glow: profile.glow.clone(),
         }
     }
 
@@ -212,6 +218,10 @@ impl SensorOptics {
             Shading::Table(table) => table
                 .validate()
                 .map_err(|e| invalid("optics.shading", e.to_string()))?,
+        }
+        if let Some(glow) = &self.glow {
+            glow.validate()
+                .map_err(|e| invalid("optics.glow", e.to_string()))?;
         }
         Ok(())
     }
