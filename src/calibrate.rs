@@ -18,7 +18,7 @@ use tactex_core::sensor_profile::{CalibrationFit, SensorProfile};
 use tactex_core::shading_table::{ShadingTable, frame_position};
 use tactex_core::tactile_spec::{GelSpec, TactileSpec};
 use tactex_sim::elastic::{ContactSolver, Fidelity};
-use tactex_sim::gel_render::{CpuRenderer, GelImageFields, PressFrame, SensorOptics};
+use tactex_sim::gel_render::{CpuRenderer, SensorOptics};
 
 #[derive(Args, Debug)]
 #[command(allow_negative_numbers = true)]
@@ -101,14 +101,6 @@ fn fit_glow(
         ..SensorOptics::for_profile(profile)
     };
     let (w, h) = (optics.width, optics.height);
-    let flat_fields = GelImageFields::flat(w, h);
-    let flat = CpuRenderer.shade_only(
-        &optics,
-        &PressFrame {
-            fields: &flat_fields,
-            seed: 0,
-        },
-    );
     let mut solver = ContactSolver::new();
     let mut changes = Vec::new();
     for (press, real) in presses {
@@ -120,18 +112,7 @@ fn fit_glow(
             &optics,
             fidelity,
         )?;
-        let shaded = CpuRenderer.shade_only(
-            &optics,
-            &PressFrame {
-                fields: &fields,
-                seed: 0,
-            },
-        );
-        let change: Vec<[f32; 3]> = shaded
-            .iter()
-            .zip(&flat)
-            .map(|(s, f)| std::array::from_fn(|c| s[c] - f[c]))
-            .collect();
+        let (flat, change) = CpuRenderer.shading_change(&optics, &fields);
         let target: Vec<[f32; 3]> = real
             .pixels()
             .zip(&flat)
@@ -247,7 +228,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
             .unwrap_or_else(|| "calibrated sensor".into()),
     };
     let noise_sigma_grey = median(&mut noise).unwrap_or(0.0);
-    let profile = SensorProfile {
+    let mut profile = SensorProfile {
         source: args.source.clone(),
         spec: TactileSpec {
             model: name,
@@ -278,7 +259,6 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
             ball_radius_mm: radius,
         }),
     };
-    let mut profile = profile;
     if !args.no_glow {
         profile.glow = Some(fit_glow(&profile, &presses, radius, args.fidelity)?);
     }

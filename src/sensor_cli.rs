@@ -98,16 +98,13 @@ fn summary(p: &SensorProfile) -> Summary {
             None => "three analytic lights".into(),
         },
         glow: p.glow.as_ref().map(|g| {
-            let sigmas = |v: Vec<f32>| {
-                v.iter()
-                    .map(|s| format!("{s}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+            let sigmas = |v: &mut dyn Iterator<Item = f32>| {
+                v.map(|s| s.to_string()).collect::<Vec<_>>().join(", ")
             };
             format!(
                 "colour blurred at {} px, magnitude at {} px",
-                sigmas(g.colour.iter().map(|t| t.sigma_px).collect()),
-                sigmas(g.magnitude.iter().map(|t| t.sigma_px).collect())
+                sigmas(&mut g.colour.iter().map(|t| t.sigma_px)),
+                sigmas(&mut g.magnitude.iter().map(|t| t.sigma_px))
             )
         }),
         markers: if m.cols * m.rows == 0 {

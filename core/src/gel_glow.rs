@@ -67,10 +67,6 @@ pub enum GlowError {
     Singular,
 }
 
-fn invalid(field: String, message: String) -> GlowError {
-    GlowError::Invalid { field, message }
-}
-
 /// A normalised Gaussian over `-r..=r`, r = ceil(3 sigma); one tap of 1 for sigma 0.
 pub fn gaussian_kernel(sigma_px: f32) -> Vec<f32> {
     if sigma_px <= 0.0 {
@@ -146,11 +142,11 @@ impl GelGlow {
         colour.chain(magnitude).collect()
     }
 
-    /// Checks every term; Err names the field under `optics.glow`.
-    pub fn validate(&self) -> Result<(), GlowError> {
+    /// Checks every term; Err is the field (under `optics.glow`) and what is wrong with it.
+    pub fn validate(&self) -> Result<(), (String, String)> {
         let count = self.colour.len() + self.magnitude.len();
         if count == 0 || count > MAX_TERMS {
-            return Err(invalid(
+            return Err((
                 "optics.glow".into(),
                 format!("{count} terms, expected 1..={MAX_TERMS}"),
             ));
@@ -159,13 +155,13 @@ impl GelGlow {
         let weight_ok = |v: &f32| v.is_finite() && v.abs() <= 100.0;
         for (i, t) in self.colour.iter().enumerate() {
             if !sigma_ok(t.sigma_px) {
-                return Err(invalid(
+                return Err((
                     format!("optics.glow.colour[{i}].sigma_px"),
                     format!("{}, expected 0..={MAX_SIGMA_PX} px", t.sigma_px),
                 ));
             }
             if !t.mix.as_flattened().iter().all(weight_ok) {
-                return Err(invalid(
+                return Err((
                     format!("optics.glow.colour[{i}].mix"),
                     "weights must be finite and within +-100".into(),
                 ));
@@ -173,13 +169,13 @@ impl GelGlow {
         }
         for (i, t) in self.magnitude.iter().enumerate() {
             if !sigma_ok(t.sigma_px) {
-                return Err(invalid(
+                return Err((
                     format!("optics.glow.magnitude[{i}].sigma_px"),
                     format!("{}, expected 0..={MAX_SIGMA_PX} px", t.sigma_px),
                 ));
             }
             if !t.colour.iter().all(weight_ok) {
-                return Err(invalid(
+                return Err((
                     format!("optics.glow.magnitude[{i}].colour"),
                     "weights must be finite and within +-100".into(),
                 ));
@@ -292,7 +288,8 @@ impl GelGlow {
                 })
                 .collect(),
         };
-        glow.validate()?;
+        glow.validate()
+            .map_err(|(field, message)| GlowError::Invalid { field, message })?;
         Ok(glow)
     }
 }
@@ -391,26 +388,14 @@ mod tests {
         };
         assert!(g.validate().is_ok());
         g.colour[0].sigma_px = f32::NAN;
-        assert!(
-            g.validate()
-                .unwrap_err()
-                .to_string()
-                .starts_with("optics.glow.colour[0].sigma_px")
+        assert_eq!(
+            g.validate().unwrap_err().0,
+            "optics.glow.colour[0].sigma_px"
         );
         g.colour[0].sigma_px = 1.0;
         g.colour[0].mix[1][2] = f32::INFINITY;
-        assert!(
-            g.validate()
-                .unwrap_err()
-                .to_string()
-                .starts_with("optics.glow.colour[0].mix")
-        );
+        assert_eq!(g.validate().unwrap_err().0, "optics.glow.colour[0].mix");
         g.colour.clear();
-        assert!(
-            g.validate()
-                .unwrap_err()
-                .to_string()
-                .starts_with("optics.glow:")
-        );
+        assert_eq!(g.validate().unwrap_err().0, "optics.glow");
     }
 }

@@ -8,7 +8,7 @@
 //! contents (the canonical TOML, without the background's file name, then the background's
 //! pixels), so two profiles that render alike hash alike wherever their files live.
 
-use crate::gel_glow::{GelGlow, GlowError};
+use crate::gel_glow::GelGlow;
 use crate::photometric::PhotometricModel;
 use crate::shading_table::ShadingTable;
 use crate::tactile_spec::{GelSpec, MarkerGrid, TactileSpec};
@@ -403,12 +403,9 @@ impl SensorProfile {
             }
         }
         if let Some(glow) = &self.glow
-            && let Err(e) = glow.validate()
+            && let Err((field, message)) = glow.validate()
         {
-            return match e {
-                GlowError::Invalid { field, message } => bad(&field, message),
-                other => bad("optics.glow", other.to_string()),
-            };
+            return bad(&field, message);
         }
         if let Some(bg) = &self.background
             && bg.dimensions() != (s.width_px, s.height_px)

@@ -159,21 +159,30 @@ pub(crate) fn flat_shading(p: &RenderParams, optics: &SensorOptics) -> Vec<[f32;
     )
 }
 
-/// Stages 1-2 and the glow (gel_glow_*.wgsl): the shaded frame with its change from the flat
-/// gel's shading replaced by the glow of that change.
+/// Stages 1-2 as the flat gel's shading and the frame's change from it: what a glow spreads.
+fn shading_change(
+    p: &RenderParams,
+    optics: &SensorOptics,
+    heights: &[f32],
+) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let flat = flat_shading(p, optics);
+    let mut change = shade(p, optics, &slopes(p, heights));
+    for (s, f) in change.iter_mut().zip(&flat) {
+        *s = std::array::from_fn(|c| s[c] - f[c]);
+    }
+    (flat, change)
+}
+
+/// Stages 1-2 and the glow (gel_glow_*.wgsl): the flat gel's shading plus the glow of the
+/// frame's change from it.
 fn glowing(
     p: &RenderParams,
     optics: &SensorOptics,
     glow: &GelGlow,
     heights: &[f32],
 ) -> Vec<[f32; 3]> {
-    let (w, h) = (p.width as usize, p.height as usize);
-    let flat = flat_shading(p, optics);
-    let mut shaded = shade(p, optics, &slopes(p, heights));
-    for (s, f) in shaded.iter_mut().zip(&flat) {
-        *s = std::array::from_fn(|c| s[c] - f[c]);
-    }
-    let mut out = glow.apply(&shaded, w, h);
+    let (flat, change) = shading_change(p, optics, heights);
+    let mut out = glow.apply(&change, p.width as usize, p.height as usize);
     for (o, f) in out.iter_mut().zip(&flat) {
         *o = std::array::from_fn(|c| f[c] + o[c]);
     }
@@ -354,6 +363,16 @@ impl CpuRenderer {
             },
         );
         RgbImage::from_raw(p.width, p.height, bytes).expect("sized from the frame")
+    }
+
+    /// The flat gel's shading and a frame's change from it (slopes + shading + vignetting,
+    /// no glow, dots or noise; grey levels): what `calibrate` fits a glow to.
+    pub fn shading_change(
+        &self,
+        optics: &SensorOptics,
+        fields: &super::GelImageFields,
+    ) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+        shading_change(&RenderParams::new(optics, 1), optics, &fields.normal_mm)
     }
 
     /// The shading stage alone (slopes + shading + vignetting, and the glow when the optics

@@ -1,8 +1,7 @@
 //! GelSight image synthesis: the gel's displacement fields at pixel resolution -> surface
 //! slopes -> shading over the no-contact background (analytic coloured lights or a calibrated
 //! gradient table) -> vignetting -> glow (light scattered in the gel, when the profile has
-//! one) -> marker dots moved by the lateral field -> seeded camera
-//! noise -> 8-bit RGB.
+//! one) -> marker dots moved by the lateral field -> seeded camera noise -> 8-bit RGB.
 //!
 //! One contract, two implementations: `CpuRenderer` (the reference, Rust, f32 like the
 //! shaders) and `GpuRenderer` (the WGSL compute stages in `shaders/` through wgpu). Both
@@ -221,7 +220,7 @@ impl SensorOptics {
         }
         if let Some(glow) = &self.glow {
             glow.validate()
-                .map_err(|e| invalid("optics.glow", e.to_string()))?;
+                .map_err(|(field, message)| invalid(&field, message))?;
         }
         Ok(())
     }
