@@ -222,6 +222,8 @@ struct Target {
     touch: DVec3,
     /// The pad's turn about the vertical for this press (see `press_site`).
     pad_yaw_rad: f64,
+    /// No site was clear of the neighbours by the grounding margin (see `press_site`).
+    crowded: bool,
 }
 
 struct Press {
@@ -395,6 +397,12 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
             not_measured: None,
             warnings: Vec::new(),
         };
+        if target.crowded {
+            report.warnings.push(
+                "no spot on it was clear of its neighbours by the grounding margin; pressed where they reach least under the pad"
+                    .into(),
+            );
+        }
         match (pressed, estimate) {
             (Ok(p), Some(estimate)) => {
                 report.contact_search_mm = Some(p.search_mm);
@@ -522,6 +530,7 @@ fn ground<C: RgbdCamera>(
             let site = clear_touch(at.touch, i, &detections, &cloud, pad).unwrap_or(PressSite {
                 at: at.touch,
                 yaw_rad: 0.0,
+                crowded: false,
             });
             Some(Target {
                 label: d.label.clone(),
@@ -531,6 +540,7 @@ fn ground<C: RgbdCamera>(
                 surface: at.surface,
                 touch: site.at,
                 pad_yaw_rad: site.yaw_rad,
+                crowded: site.crowded,
             })
         })
         .collect();
@@ -545,7 +555,7 @@ fn ground<C: RgbdCamera>(
 }
 
 /// Where the pad can press detection `index` without meeting anything else first (see
-/// `press_site`); None when nowhere is clear, and the crest is pressed for the arm to judge.
+/// `press_site`); None when the detection has no depth points.
 /// The object's own points are its mask's; everything else is the other detections' and
 /// whatever lies more than a few pixels outside its mask (its own flank just outside the mask
 /// is not an obstacle).
