@@ -35,6 +35,7 @@ mod plot;
 mod press;
 mod sensor_cli;
 mod serve;
+mod twin;
 
 use anyhow::{Result, bail};
 use clap::{Parser, Subcommand};
@@ -71,6 +72,9 @@ enum Command {
     /// A real uFactory xArm (or the vendor's simulator) over its TCP protocol: pose, move,
     /// home.
     Arm(arm_cli::ArmArgs),
+    /// The twin as an xArm 850 controller: programs written against the vendor's Python SDK
+    /// move the GelSight pad through the simulated table; its frames come over HTTP.
+    Twin(twin::TwinArgs),
     /// What the prompt parser reads from a question (intent, property, targets, filters).
     Parse(parse_prompt::ParseArgs),
     /// Press the gel into one object and report force, contact and indentation.
@@ -251,12 +255,13 @@ fn quiet_on_closed_pipe() {
 fn main() -> ExitCode {
     ensure_runtime_dir();
     let cli = Cli::parse();
-    if !matches!(cli.command, Command::Serve(_)) {
+    if !matches!(cli.command, Command::Serve(_) | Command::Twin(_)) {
         quiet_on_closed_pipe();
     }
     let result = match cli.command {
         Command::Ask(args) => ask::run(&args),
         Command::Serve(args) => serve::run(&args),
+        Command::Twin(args) => twin::run(&args),
         Command::Arm(args) => arm_cli::run(&args),
         Command::Parse(args) => parse_prompt::run(&args),
         Command::Press(args) => press::run(&args),

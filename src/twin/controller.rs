@@ -1,0 +1,498 @@
+//! The xArm 850 controller the twin plays: the registers the vendor's Python SDK uses to
+//! connect, enable, set mode and state, read and clear errors, read the TCP pose and move,
+//! answered over the twin's world. A linear move is checked as a real controller checks it
+//! (the safety boundary round the table, the table itself, the crush limit of whatever the
+//! pad presses) and then run by the sim arm in the twin's clock; the controller reports it
+//! moving for the move's duration in wall time, divided by the time scale.
+
+use glam::{DQuat, DVec3, EulerRot};
+use std::collections::VecDeque;
+use std::time::{Duration, Instant};
+use tactex_core::devices::{Arm, DeviceError};
+use tactex_core::geometry::Pose;
+use tactex_hw::xarm::frame::status;
+use tactex_sim::arm::SimArm;
+use tactex_sim::world::SharedWorld;
+
+/// The controller's registers the twin answers (`XCONF.UxbusReg` in the SDK).
+pub mod reg {
+    pub const GET_VERSION: u8 = 1;
+    pub const GET_ROBOT_SN: u8 = 2;
+    pub const MOTION_EN: u8 = 11;
+    pub const SET_STATE: u8 = 12;
+    pub const GET_STATE: u8 = 13;
+    pub const GET_CMDNUM: u8 = 14;
+    pub const GET_ERROR: u8 = 15;
+    pub const CLEAN_ERR: u8 = 16;
+    pub const CLEAN_WAR: u8 = 17;
+    pub const SET_MODE: u8 = 19;
+    pub const MOVE_LINE: u8 = 21;
+    pub const MOVE_HOME: u8 = 25;
+    pub const SET_TCP_JERK: u8 = 31;
+    pub const SET_TCP_MAXACC: u8 = 32;
+    pub const GET_TCP_POSE: u8 = 41;
+    pub const GET_JOINT_POS: u8 = 42;
+}
+
+/// Controller error codes the twin raises (`x_code.py`; `tactex_hw::xarm::codes`).
+pub mod error_code {
+    /// Collision caused abnormal current: the pad driven into the table or an object past
+    /// the crush limit.
+    pub const COLLISION: u8 = 31;
+    /// Safety boundary limit: a target outside the box over the table.
+    pub const SAFETY_BOUNDARY: u8 = 35;
+}
+
+/// Warning codes.
+pub mod warn_code {
+    /// A command parameter is out of range (a non-finite pose, a speed of zero).
+    pub const PARAMETER: u8 = 12;
+}
+
+/// Motion states of the report and `get_state`.
+pub mod motion {
+    pub const MOVING: u8 = 1;
+    pub const READY: u8 = 2;
+    pub const PAUSED: u8 = 3;
+    pub const STOPPED: u8 = 4;
+}
+
+/// How the arm stands on the table and what it reports about itself.
+#[derive(Clone, Debug)]
+pub struct ArmMount {
+    /// The robot base's origin in the table frame (m); its axes are the table's.
+    pub base_m: DVec3,
+    /// The controller's version string (`get_version`): axis, type, serial numbers, firmware.
+    pub version: String,
+    pub robot_sn: String,
+    /// Wall time a move takes is its twin-clock duration divided by this.
+    pub time_scale: f64,
+}
+
+impl Default for ArmMount {
+    fn default() -> Self {
+        Self {
+            base_m: DVec3::new(-0.45, 0.0, 0.0),
+            // An xArm 850 (6 axes, type 12), firmware 2.0.0: the SDK polls get_state to wait
+            // for moves (feedback frames start at 2.0.102) and takes the 1300-series layout.
+            version: "6,12,XF1300TWIN001,AC1300TWIN001,v2.0.0".into(),
+            robot_sn: "XF1300TWIN001".into(),
+            time_scale: 1.0,
+        }
+    }
+}
+
+/// The SDK's TCP pose: x, y, z in mm in the base frame; roll, pitch, yaw in radians.
+pub type TcpPoseMm = [f64; 6];
+
+/// The pose `move_gohome` goes to: the pad pointing down 300 mm in front of and above the
+/// base.
+pub const HOME: TcpPoseMm = [300.0, 0.0, 300.0, std::f64::consts::PI, 0.0, 0.0];
+
+/// A move accepted: from where, to where, starting when and for how long (wall clock).
+#[derive(Clone, Copy, Debug)]
+struct Moving {
+    from: TcpPoseMm,
+    to: TcpPoseMm,
+    started: Instant,
+    duration: Duration,
+}
+
+/// What the report and the control port read of the controller.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    pub state: u8,
+    pub mode: u8,
+    pub cmd_num: u16,
+    pub pose: TcpPoseMm,
+    pub enabled: bool,
+    pub error: u8,
+    pub warning: u8,
+    pub tcp_speed_mm_s: f64,
+}
+
+pub struct Controller {
+    arm: SimArm,
+    world: SharedWorld,
+    mount: ArmMount,
+    enabled: bool,
+    mode: u8,
+    state: u8,
+    error: u8,
+    warning: u8,
+    /// Where the pad is (SDK pose) when no move runs.
+    pose: TcpPoseMm,
+    /// Moves accepted and not yet ended, in order: the controller's command queue.
+    queue: VecDeque<Moving>,
+    /// Motion commands accepted since the controller started.
+    accepted: u16,
+    last_speed_mm_s: f64,
+    /// Why the last fault was raised, for the twin's log.
+    pub last_fault: Option<String>,
+}
+
+/// Reply to one request: the parameter bytes, or the request was invalid.
+pub enum Answer {
+    Params(Vec<u8>),
+    Invalid,
+}
+
+impl Controller {
+    /// A controller over `world`, the pad parked at HOME (the world's tool moved there).
+    pub fn new(world: SharedWorld, arm: SimArm, mount: ArmMount) -> Result<Self, String> {
+        let home = world_pose(&mount, &HOME);
+        world.lock().map_err(|_| "world lock poisoned")?.tool = home;
+        Ok(Self {
+            arm,
+            world,
+            mount,
+            enabled: false,
+            mode: 0,
+            state: motion::STOPPED,
+            error: 0,
+            warning: 0,
+            pose: HOME,
+            queue: VecDeque::new(),
+            accepted: 0,
+            last_speed_mm_s: 0.0,
+            last_fault: None,
+        })
+    }
+
+    pub fn mount(&self) -> &ArmMount {
+        &self.mount
+    }
+
+    /// Ends the moves whose time is up.
+    fn advance(&mut self, now: Instant) {
+        while let Some(m) = self.queue.front()
+            && now >= m.started + m.duration
+        {
+            self.pose = m.to;
+            self.queue.pop_front();
+        }
+        if self.queue.is_empty() && self.state == motion::MOVING {
+            self.state = motion::READY;
+        }
+    }
+
+    pub fn snapshot(&mut self, now: Instant) -> Snapshot {
+        self.advance(now);
+        let (pose, speed) = match self.queue.front() {
+            Some(m) if now >= m.started => {
+                let t = (now - m.started).as_secs_f64() / m.duration.as_secs_f64().max(1e-9);
+                (
+                    lerp(&m.from, &m.to, t.clamp(0.0, 1.0)),
+                    self.last_speed_mm_s,
+                )
+            }
+            _ => (self.pose, 0.0),
+        };
+        Snapshot {
+            state: self.state,
+            mode: self.mode,
+            cmd_num: self.queue.len().min(usize::from(u16::MAX)) as u16,
+            pose,
+            enabled: self.enabled,
+            error: self.error,
+            warning: self.warning,
+            tcp_speed_mm_s: speed,
+        }
+    }
+
+    /// The reply's status byte (`check_private_protocol` in the SDK).
+    pub fn status_bits(&self) -> u8 {
+        let mut bits = 0;
+        if self.error != 0 {
+            bits |= status::ERROR;
+        }
+        if self.warning != 0 {
+            bits |= status::WARNING;
+        }
+        if !self.enabled || self.state >= motion::STOPPED {
+            bits |= status::NOT_READY;
+        }
+        bits
+    }
+
+    /// Raises controller error `code`: the arm stops where it is, not enabled for motion.
+    pub fn fault(&mut self, code: u8, why: String, now: Instant) {
+        self.halt(now);
+        self.error = code;
+        self.state = motion::STOPPED;
+        self.last_fault = Some(why);
+    }
+
+    /// Stops a running move where the pad is now and drops the queued ones; the world's
+    /// tool goes back there along the path it was checked on.
+    fn halt(&mut self, now: Instant) {
+        let here = self.snapshot(now).pose;
+        if !self.queue.is_empty() {
+            self.queue.clear();
+            self.pose = here;
+            if let Ok(mut w) = self.world.lock() {
+                w.tool = world_pose(&self.mount, &here);
+            }
+        }
+    }
+
+    /// Answers register `register` with `params`; None for a register the twin does not
+    /// speak (the caller answers it invalid and sets warning 13).
+    pub fn handle(&mut self, register: u8, params: &[u8], now: Instant) -> Option<Answer> {
+        self.advance(now);
+        let u8s = |n: usize| (params.len() == n).then_some(params);
+        Some(match register {
+            reg::GET_VERSION => Answer::Params(padded(&self.mount.version, 40)),
+            reg::GET_ROBOT_SN => Answer::Params(padded(&self.mount.robot_sn, 40)),
+            reg::MOTION_EN => match u8s(2) {
+                Some(p) => {
+                    self.enabled = p[1] != 0;
+                    if !self.enabled {
+                        self.halt(now);
+                        self.state = motion::STOPPED;
+                    }
+                    Answer::Params(vec![])
+                }
+                None => Answer::Invalid,
+            },
+            reg::SET_STATE => match u8s(1) {
+                Some(p) => {
+                    match p[0] {
+                        0 if self.enabled && self.error == 0 && self.state != motion::MOVING => {
+                            self.state = if self.queue.is_empty() {
+                                motion::READY
+                            } else {
+                                motion::MOVING
+                            };
+                        }
+                        motion::PAUSED | motion::STOPPED => {
+                            self.halt(now);
+                            self.state = p[0];
+                        }
+                        _ => {}
+                    }
+                    Answer::Params(vec![])
+                }
+                None => Answer::Invalid,
+            },
+            reg::GET_STATE => Answer::Params(vec![self.snapshot(now).state]),
+            reg::GET_CMDNUM => Answer::Params(self.snapshot(now).cmd_num.to_be_bytes().to_vec()),
+            reg::GET_ERROR => Answer::Params(vec![self.error, self.warning]),
+            reg::CLEAN_ERR => {
+                self.error = 0;
+                Answer::Params(vec![])
+            }
+            reg::CLEAN_WAR => {
+                self.warning = 0;
+                Answer::Params(vec![])
+            }
+            reg::SET_MODE => match params.len() {
+                1 | 2 => {
+                    self.mode = params[0];
+                    Answer::Params(vec![])
+                }
+                _ => Answer::Invalid,
+            },
+            reg::SET_TCP_JERK | reg::SET_TCP_MAXACC => match params.len() {
+                4 => Answer::Params(vec![]),
+                _ => Answer::Invalid,
+            },
+            reg::GET_TCP_POSE => Answer::Params(f32s(&self.snapshot(now).pose)),
+            // The twin moves the pad in Cartesian space and has no joint model yet: the
+            // joints read zero.
+            reg::GET_JOINT_POS => Answer::Params(f32s(&[0.0; 7])),
+            reg::MOVE_LINE => match move_line_params(params) {
+                Some((target, speed_mm_s)) => {
+                    self.move_to(target, speed_mm_s, now);
+                    Answer::Params(vec![])
+                }
+                None => Answer::Invalid,
+            },
+            reg::MOVE_HOME => match params.len() {
+                12 | 13 => {
+                    // Speed in rad/s of the joints: a Cartesian twin moves home at 100 mm/s
+                    // per 0.35 rad/s (the SDK's default joint speed).
+                    let v = f32_values(&params[..12]);
+                    self.move_to(HOME, (v[0] / 0.35 * 100.0).clamp(1.0, 1000.0), now);
+                    Answer::Params(vec![])
+                }
+                _ => Answer::Invalid,
+            },
+            _ => return None,
+        })
+    }
+
+    /// A linear move of the pad to `target`, checked as a controller checks it.
+    fn move_to(&mut self, target: TcpPoseMm, speed_mm_s: f64, now: Instant) {
+        let ready = self.enabled
+            && self.error == 0
+            && self.mode == 0
+            && matches!(self.state, motion::MOVING | motion::READY);
+        if !ready {
+            return;
+        }
+        if !(target.iter().all(|v| v.is_finite()) && speed_mm_s.is_finite() && speed_mm_s > 0.0) {
+            self.warning = warn_code::PARAMETER;
+            return;
+        }
+        let pose = world_pose(&self.mount, &target);
+        let p = pose.position;
+        let table = self
+            .world
+            .lock()
+            .map(|w| w.table.size_m)
+            .unwrap_or([0.0; 2]);
+        if p.z < 0.0 {
+            let why = format!(
+                "target z {:.1} mm is {:.1} mm into the table",
+                target[2],
+                -p.z * 1e3
+            );
+            return self.fault(error_code::COLLISION, why, now);
+        }
+        if p.x.abs() > table[0] / 2.0 || p.y.abs() > table[1] / 2.0 || p.z > self.arm.max_z_m {
+            let why = format!(
+                "target ({:.1}, {:.1}, {:.1}) mm is outside the safety boundary over the table",
+                target[0], target[1], target[2]
+            );
+            return self.fault(error_code::SAFETY_BOUNDARY, why, now);
+        }
+        let clock_before = self.world.lock().map(|w| w.time_s).unwrap_or(0.0);
+        match self.arm.move_linear(&pose, speed_mm_s * 1e-3) {
+            Ok(()) => {}
+            Err(DeviceError::UnsafeMove { reason, .. }) => {
+                return self.fault(error_code::COLLISION, reason, now);
+            }
+            Err(e) => return self.fault(error_code::COLLISION, e.to_string(), now),
+        }
+        let clock_after = self.world.lock().map(|w| w.time_s).unwrap_or(clock_before);
+        let seconds = (clock_after - clock_before).max(0.0) / self.mount.time_scale;
+        // Queued behind the moves not yet ended, from where the last of them ends.
+        let (from, started) = match self.queue.back() {
+            Some(last) => (last.to, last.started + last.duration),
+            None => (self.pose, now),
+        };
+        self.queue.push_back(Moving {
+            from,
+            to: target,
+            started,
+            duration: Duration::from_secs_f64(seconds),
+        });
+        self.accepted = self.accepted.wrapping_add(1);
+        self.last_speed_mm_s = speed_mm_s;
+        self.state = motion::MOVING;
+    }
+}
+
+/// The world pose of the pad at SDK pose `p`: the base's axes are the table's, the
+/// orientation is the SDK's roll-pitch-yaw (fixed axes x, y, z).
+pub fn world_pose(mount: &ArmMount, p: &TcpPoseMm) -> Pose {
+    Pose::new(
+        mount.base_m + DVec3::new(p[0], p[1], p[2]) * 1e-3,
+        DQuat::from_euler(EulerRot::ZYX, p[5], p[4], p[3]),
+    )
+}
+
+/// The SDK pose of a pad at world pose `pose`.
+#[cfg(test)]
+fn sdk_pose(mount: &ArmMount, pose: &Pose) -> TcpPoseMm {
+    let p = (pose.position - mount.base_m) * 1e3;
+    let (yaw, pitch, roll) = pose.rotation.to_euler(EulerRot::ZYX);
+    [p.x, p.y, p.z, roll, pitch, yaw]
+}
+
+fn lerp(a: &TcpPoseMm, b: &TcpPoseMm, t: f64) -> TcpPoseMm {
+    let mut out = *a;
+    for i in 0..3 {
+        out[i] = a[i] + (b[i] - a[i]) * t;
+    }
+    // Orientation jumps at the end: a press keeps it, and the report's angles stay valid.
+    if t >= 1.0 {
+        out[3..].copy_from_slice(&b[3..]);
+    }
+    out
+}
+
+/// The target and speed of a MOVE_LINE request in any of the layouts the SDK sends: 9 f32
+/// (pose, speed, acceleration, time), with 1-2 bytes of check and motion type, or 10 f32
+/// (with a blend radius) and 3-4 bytes (coordinate frame, axis-angle, check, motion type).
+fn move_line_params(params: &[u8]) -> Option<(TcpPoseMm, f64)> {
+    let floats = match params.len() {
+        36..=38 => 9,
+        43 | 44 => {
+            // Tool-frame or axis-angle targets are not linear base-frame moves.
+            if params[40] != 0 || params[41] != 0 {
+                return None;
+            }
+            10
+        }
+        _ => return None,
+    };
+    let v = f32_values(&params[..floats * 4]);
+    // Only a check of the move (only_check_type > 0) is not a move.
+    let check = match floats {
+        9 => params.get(36).copied().unwrap_or(0),
+        _ => params[42],
+    };
+    if check != 0 {
+        return None;
+    }
+    Some(([v[0], v[1], v[2], v[3], v[4], v[5]], v[6]))
+}
+
+pub fn f32s(values: &[f64]) -> Vec<u8> {
+    values
+        .iter()
+        .flat_map(|v| (*v as f32).to_le_bytes())
+        .collect()
+}
+
+fn f32_values(bytes: &[u8]) -> Vec<f64> {
+    bytes
+        .chunks_exact(4)
+        .map(|c| f64::from(f32::from_le_bytes([c[0], c[1], c[2], c[3]])))
+        .collect()
+}
+
+fn padded(text: &str, n: usize) -> Vec<u8> {
+    let mut out = text.as_bytes().to_vec();
+    out.resize(n, 0);
+    out.truncate(n);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sdk_and_world_poses_round_trip_and_home_points_the_pad_down() {
+        let mount = ArmMount::default();
+        let p = [412.5, -80.0, 95.0, std::f64::consts::PI, 0.0, 0.6];
+        let back = sdk_pose(&mount, &world_pose(&mount, &p));
+        for i in 0..3 {
+            assert!((back[i] - p[i]).abs() < 1e-9, "{back:?}");
+        }
+        let pose = world_pose(&mount, &p);
+        let expected = Pose::tool_down_turned(pose.position, 0.6);
+        assert!(pose.rotation.angle_between(expected.rotation) < 1e-9);
+        let home = world_pose(&mount, &HOME);
+        assert!((home.transform_vector(DVec3::Z) - DVec3::NEG_Z).length() < 1e-12);
+    }
+
+    #[test]
+    fn move_line_takes_every_sdk_layout_and_refuses_checks_and_tool_frames() {
+        let mut nine = f32s(&[300.0, 0.0, 200.0, 3.1, 0.0, 0.0, 50.0, 500.0, 0.0]);
+        assert_eq!(move_line_params(&nine).unwrap().1, 50.0);
+        nine.push(0);
+        assert!(move_line_params(&nine).is_some());
+        nine[36] = 1;
+        assert!(move_line_params(&nine).is_none(), "only a check");
+        let mut ten = f32s(&[300.0, 0.0, 200.0, 3.1, 0.0, 0.0, 50.0, 500.0, 0.0, -1.0]);
+        ten.extend([0, 0, 0]);
+        assert_eq!(move_line_params(&ten).unwrap().0[2], 200.0);
+        ten[40] = 1;
+        assert!(move_line_params(&ten).is_none(), "tool frame");
+        assert!(move_line_params(&[0; 12]).is_none());
+    }
+}
