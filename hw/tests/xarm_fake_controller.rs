@@ -223,13 +223,13 @@ fn a_reply_in_another_protocol_is_a_protocol_error() {
         let mut request = [0u8; 7];
         s.read_exact(&mut request).unwrap();
         // Standard Modbus (protocol id 0) instead of the private protocol.
-        let mut reply = frame::reply(
+        let reply = frame::reply(
             u16::from_be_bytes([request[0], request[1]]),
+            0,
             41,
             0,
             &[0; 24],
         );
-        reply[3] = 0;
         s.write_all(&reply).unwrap();
     });
     let arm = XArm::connect(XArmConfig::new(addr.to_string())).unwrap();

@@ -61,37 +61,14 @@ fn control_client(mut stream: TcpStream, twin: &Twin) -> Result<(), String> {
                 .controller
                 .lock()
                 .map_err(|_| "the controller's lock is poisoned".to_string())?;
-            let answer = c.handle(register, &body[1..], Instant::now());
-            let extra = match answer {
-                Some(Answer::Params(p)) => Ok(p),
-                Some(Answer::Invalid) | None => Err(()),
+            let (bits, params) = match c.handle(register, &body[1..], Instant::now()) {
+                Some(Answer::Params(p)) => (c.status_bits(), p),
+                Some(Answer::Invalid) | None => (c.status_bits() | status::INVALID, Vec::new()),
             };
-            match extra {
-                Ok(params) => reply(
-                    h.transaction,
-                    h.protocol,
-                    register,
-                    c.status_bits(),
-                    &params,
-                ),
-                Err(()) => reply(
-                    h.transaction,
-                    h.protocol,
-                    register,
-                    c.status_bits() | status::INVALID,
-                    &[],
-                ),
-            }
+            frame::reply(h.transaction, h.protocol, register, bits, &params)
         };
         stream.write_all(&reply).map_err(|e| e.to_string())?;
     }
-}
-
-/// A reply frame with the request's protocol id.
-fn reply(transaction: u16, protocol: u16, register: u8, status: u8, params: &[u8]) -> Vec<u8> {
-    let mut out = frame::reply(transaction, register, status, params);
-    out[2..4].copy_from_slice(&protocol.to_be_bytes());
-    out
 }
 
 pub fn serve_reports(listener: TcpListener, kind: ReportKind, twin: &std::sync::Arc<Twin>) {
@@ -107,19 +84,16 @@ fn report_client(mut stream: TcpStream, kind: ReportKind, twin: &Twin) {
     let period = Duration::from_secs_f64(1.0 / kind.rate_hz());
     let mut next = Instant::now();
     let mut counter = 0u32;
+    let firmware = match twin.controller.lock() {
+        Ok(c) => c.mount().firmware().to_string(),
+        Err(_) => return,
+    };
     loop {
         let bytes = {
             let Ok(mut c) = twin.controller.lock() else {
                 return;
             };
             let snapshot = c.snapshot(Instant::now());
-            let firmware = c
-                .mount()
-                .version
-                .rsplit(',')
-                .next()
-                .unwrap_or("")
-                .to_string();
             report::encode(
                 kind,
                 &snapshot,

@@ -10,7 +10,7 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 use tactex_core::devices::{Arm, DeviceError};
 use tactex_core::geometry::Pose;
-use tactex_hw::xarm::frame::status;
+use tactex_hw::xarm::frame::{f32_params, f32_values, status};
 use tactex_sim::arm::SimArm;
 use tactex_sim::world::SharedWorld;
 
@@ -67,6 +67,13 @@ pub struct ArmMount {
     pub robot_sn: String,
     /// Wall time a move takes is its twin-clock duration divided by this.
     pub time_scale: f64,
+}
+
+impl ArmMount {
+    /// The firmware part of the version string (its last field, e.g. "v2.0.0").
+    pub fn firmware(&self) -> &str {
+        self.version.rsplit(',').next().unwrap_or("")
+    }
 }
 
 impl Default for ArmMount {
@@ -297,10 +304,10 @@ impl Controller {
                 4 => Answer::Params(vec![]),
                 _ => Answer::Invalid,
             },
-            reg::GET_TCP_POSE => Answer::Params(f32s(&self.snapshot(now).pose)),
+            reg::GET_TCP_POSE => Answer::Params(f32_params(&self.snapshot(now).pose)),
             // The twin moves the pad in Cartesian space and has no joint model yet: the
             // joints read zero.
-            reg::GET_JOINT_POS => Answer::Params(f32s(&[0.0; 7])),
+            reg::GET_JOINT_POS => Answer::Params(f32_params(&[0.0; 7])),
             reg::MOVE_LINE => match move_line_params(params) {
                 Some((target, speed_mm_s)) => {
                     self.move_to(target, speed_mm_s, now);
@@ -440,20 +447,6 @@ fn move_line_params(params: &[u8]) -> Option<(TcpPoseMm, f64)> {
     Some(([v[0], v[1], v[2], v[3], v[4], v[5]], v[6]))
 }
 
-pub fn f32s(values: &[f64]) -> Vec<u8> {
-    values
-        .iter()
-        .flat_map(|v| (*v as f32).to_le_bytes())
-        .collect()
-}
-
-fn f32_values(bytes: &[u8]) -> Vec<f64> {
-    bytes
-        .chunks_exact(4)
-        .map(|c| f64::from(f32::from_le_bytes([c[0], c[1], c[2], c[3]])))
-        .collect()
-}
-
 fn padded(text: &str, n: usize) -> Vec<u8> {
     let mut out = text.as_bytes().to_vec();
     out.resize(n, 0);
@@ -482,13 +475,13 @@ mod tests {
 
     #[test]
     fn move_line_takes_every_sdk_layout_and_refuses_checks_and_tool_frames() {
-        let mut nine = f32s(&[300.0, 0.0, 200.0, 3.1, 0.0, 0.0, 50.0, 500.0, 0.0]);
+        let mut nine = f32_params(&[300.0, 0.0, 200.0, 3.1, 0.0, 0.0, 50.0, 500.0, 0.0]);
         assert_eq!(move_line_params(&nine).unwrap().1, 50.0);
         nine.push(0);
         assert!(move_line_params(&nine).is_some());
         nine[36] = 1;
         assert!(move_line_params(&nine).is_none(), "only a check");
-        let mut ten = f32s(&[300.0, 0.0, 200.0, 3.1, 0.0, 0.0, 50.0, 500.0, 0.0, -1.0]);
+        let mut ten = f32_params(&[300.0, 0.0, 200.0, 3.1, 0.0, 0.0, 50.0, 500.0, 0.0, -1.0]);
         ten.extend([0, 0, 0]);
         assert_eq!(move_line_params(&ten).unwrap().0[2], 200.0);
         ten[40] = 1;

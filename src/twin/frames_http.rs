@@ -99,13 +99,18 @@ async fn gelsight_frame(State(twin): State<Shared>) -> Response {
     .await
 }
 
+/// The RealSense's next frame.
+fn camera_frame(twin: &Twin) -> Result<tactex_core::frames::RgbdFrame> {
+    Ok(twin
+        .camera
+        .lock()
+        .map_err(|_| anyhow::anyhow!("lock poisoned"))?
+        .capture()?)
+}
+
 async fn camera_color(State(twin): State<Shared>) -> Response {
     blocking("camera", move || {
-        let frame = twin
-            .camera
-            .lock()
-            .map_err(|_| anyhow::anyhow!("lock poisoned"))?
-            .capture()?;
+        let frame = camera_frame(&twin)?;
         Ok(png(crate::output::png_bytes(&frame.color)?, None))
     })
     .await
@@ -113,11 +118,7 @@ async fn camera_color(State(twin): State<Shared>) -> Response {
 
 async fn camera_depth(State(twin): State<Shared>) -> Response {
     blocking("camera", move || {
-        let frame = twin
-            .camera
-            .lock()
-            .map_err(|_| anyhow::anyhow!("lock poisoned"))?
-            .capture()?;
+        let frame = camera_frame(&twin)?;
         let mut bytes = std::io::Cursor::new(Vec::new());
         depth_to_u16(&frame.depth_m)
             .write_to(&mut bytes, image::ImageFormat::Png)

@@ -8,7 +8,8 @@
 //! - rich (30002, the SDK's default): 587 bytes, adding the arm's type and firmware, speed
 //!   and acceleration limits, servo codes, temperatures and the rest of the 2.x layout.
 
-use super::controller::{Snapshot, f32s};
+use super::controller::Snapshot;
+use tactex_hw::xarm::frame::f32_params;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ReportKind {
@@ -62,13 +63,13 @@ pub fn encode(kind: ReportKind, s: &Snapshot, ctx: &ReportContext) -> Vec<u8> {
     out.push((s.state & 0x0f) | (s.mode << 4));
     out.extend_from_slice(&s.cmd_num.to_be_bytes());
     // Joint angles (the twin has no joint model yet: zeros), the TCP pose, joint torques.
-    out.extend(f32s(&[0.0; 7]));
-    out.extend(f32s(&s.pose));
-    out.extend(f32s(&[0.0; 7]));
+    out.extend(f32_params(&[0.0; 7]));
+    out.extend(f32_params(&s.pose));
+    out.extend(f32_params(&[0.0; 7]));
     debug_assert_eq!(out.len(), 87);
     if kind == ReportKind::Real {
         // Force-torque sensor: external and raw forces.
-        out.extend(f32s(&[0.0; 12]));
+        out.extend(f32_params(&[0.0; 12]));
         debug_assert_eq!(out.len(), kind.len());
         return out;
     }
@@ -76,11 +77,11 @@ pub fn encode(kind: ReportKind, s: &Snapshot, ctx: &ReportContext) -> Vec<u8> {
     // Brakes released and motors enabled together.
     out.extend([motors, motors, s.error, s.warning]);
     // TCP offset (the twin's TCP is the gel's centre), TCP load (mass, centre of mass).
-    out.extend(f32s(&[0.0; 6]));
-    out.extend(f32s(&[0.0; 4]));
+    out.extend(f32_params(&[0.0; 6]));
+    out.extend(f32_params(&[0.0; 4]));
     // Collision and teach sensitivity, gravity direction.
     out.extend([3, 3]);
-    out.extend(f32s(&[0.0, 0.0, -1.0]));
+    out.extend(f32_params(&[0.0, 0.0, -1.0]));
     debug_assert_eq!(out.len(), 145);
     if kind == ReportKind::Normal {
         return out;
@@ -91,44 +92,44 @@ pub fn encode(kind: ReportKind, s: &Snapshot, ctx: &ReportContext) -> Vec<u8> {
     version.resize(30, 0);
     out.extend(version);
     // TCP jerk, min and max acceleration (mm/s^2), min and max speed (mm/s).
-    out.extend(f32s(&[10000.0, 1.0, 50000.0, 0.1, 1000.0]));
+    out.extend(f32_params(&[10000.0, 1.0, 50000.0, 0.1, 1000.0]));
     // Joint jerk, min and max acceleration, min and max speed (rad).
-    out.extend(f32s(&[500.0, 0.01, 20.0, 0.01, std::f64::consts::PI]));
+    out.extend(f32_params(&[500.0, 0.01, 20.0, 0.01, std::f64::consts::PI]));
     // Rotation jerk and max acceleration.
-    out.extend(f32s(&[2.3, 2.3]));
+    out.extend(f32_params(&[2.3, 2.3]));
     // Servo error and warning codes (7 joints), tool GPIO codes, temperatures (deg C).
     out.extend([0u8; 14]);
     out.extend([0u8; 2]);
     out.extend([35u8; 7]);
     // Target TCP speed and target joint speeds (the 8th float of the SDK's read).
-    out.extend(f32s(&[s.tcp_speed_mm_s]));
-    out.extend(f32s(&[0.0; 7]));
+    out.extend(f32_params(&[s.tcp_speed_mm_s]));
+    out.extend(f32_params(&[0.0; 7]));
     out.extend_from_slice(&ctx.counter.to_be_bytes());
     // World offset, controller and tool GPIO reset, not a simulation robot (the twin
     // answers as the real arm does), collision detection on, no collision tool.
-    out.extend(f32s(&[0.0; 6]));
+    out.extend(f32_params(&[0.0; 6]));
     out.extend([0, 0, 0, 1, 0]);
-    out.extend(f32s(&[0.0; 6]));
+    out.extend(f32_params(&[0.0; 6]));
     // Joint voltages (centivolts, big-endian) and currents.
     for _ in 0..7 {
         out.extend_from_slice(&4800u16.to_be_bytes());
     }
-    out.extend(f32s(&[0.0; 7]));
+    out.extend(f32_params(&[0.0; 7]));
     // Control box GPIO: module status and error, 8 big-endian words, 4 x 8 IO configs.
     out.extend([0, 0]);
     out.extend([0u8; 16]);
     out.extend([0u8; 32]);
     debug_assert_eq!(out.len(), 433);
     // Force-torque sensor, identification progress, axis-angle pose.
-    out.extend(f32s(&[0.0; 12]));
+    out.extend(f32_params(&[0.0; 12]));
     out.push(0);
-    out.extend(f32s(&[0.0; 3]));
+    out.extend(f32_params(&[0.0; 3]));
     // Configuration bits, reduced mode, its TCP boundary, speeds and joint limits.
     out.push(0);
     out.push(0);
     out.extend([0u8; 12]);
-    out.extend(f32s(&[0.0, 0.0]));
-    out.extend(f32s(&[0.0; 14]));
+    out.extend(f32_params(&[0.0, 0.0]));
+    out.extend(f32_params(&[0.0; 14]));
     // Fence mode, collision rebound, GPIO alarm, switch, monitored device.
     out.extend([0, 0]);
     out.extend_from_slice(&0u32.to_be_bytes());

@@ -213,6 +213,7 @@ fn answer(
         s.violations.push(why);
         Some(frame::reply(
             transaction,
+            PROTOCOL_ID,
             raw_register,
             status::INVALID,
             &[],
@@ -304,7 +305,13 @@ fn answer(
         bits |= status::NOT_READY;
     }
     (
-        Some(frame::reply(transaction, raw_register, bits, &out)),
+        Some(frame::reply(
+            transaction,
+            PROTOCOL_ID,
+            raw_register,
+            bits,
+            &out,
+        )),
         close,
     )
 }

@@ -119,11 +119,12 @@ pub struct Reply {
     pub params: Vec<u8>,
 }
 
-/// One reply frame, for the fake controller and tests.
-pub fn reply(transaction: u16, register: u8, status: u8, params: &[u8]) -> Vec<u8> {
+/// One reply frame, carrying the request's transaction and protocol ids (the SDK moves from
+/// protocol 2 to 3 once connected), for the fake controller, the twin's controller and tests.
+pub fn reply(transaction: u16, protocol: u16, register: u8, status: u8, params: &[u8]) -> Vec<u8> {
     let mut out = Vec::with_capacity(HEADER_LEN + 2 + params.len());
     out.extend_from_slice(&transaction.to_be_bytes());
-    out.extend_from_slice(&PROTOCOL_ID.to_be_bytes());
+    out.extend_from_slice(&protocol.to_be_bytes());
     out.extend_from_slice(&(2 + params.len() as u16).to_be_bytes());
     out.push(register);
     out.push(status);
@@ -167,7 +168,7 @@ mod tests {
 
     #[test]
     fn reply_length_counts_register_and_status() {
-        let r = reply(3, 13, status::WARNING, &[2]);
+        let r = reply(3, PROTOCOL_ID, 13, status::WARNING, &[2]);
         assert_eq!(
             header(r[..6].try_into().unwrap()),
             Header {
