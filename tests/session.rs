@@ -236,3 +236,41 @@ fn compare_session_sees_a_recording_made_with_a_softer_gel() {
         serde_json::from_slice(ok(&compare_session(&dir, &["--gel-modulus-mpa", "0.15"]))).unwrap();
     assert_eq!(report["mean_ssim"].as_f64().unwrap(), 1.0);
 }
+
+#[test]
+fn two_recordings_into_one_directory_one_wins_and_the_session_is_whole() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let spawn = || {
+        std::process::Command::new(env!("CARGO_BIN_EXE_tactex"))
+            .args(["ask", "--json", "--record", dir.to_str().unwrap()])
+            .arg("Which fruit is the softest?")
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("runs tactex")
+    };
+    let (a, b) = (spawn(), spawn());
+    let outs = [a.wait_with_output().unwrap(), b.wait_with_output().unwrap()];
+    let won: Vec<&Output> = outs.iter().filter(|o| o.status.success()).collect();
+    assert_eq!(won.len(), 1, "exactly one recording wins");
+    let lost = outs.iter().find(|o| !o.status.success()).unwrap();
+    let stderr = one_line_error(lost);
+    assert!(
+        stderr.contains("recording a session here") || stderr.contains("already exists"),
+        "{stderr}"
+    );
+    // Whole: every frame listed exists, and no frame exists that is not listed.
+    let manifest: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap();
+    let listed = manifest["tactile"]["frames"].as_array().unwrap();
+    for f in listed {
+        assert!(dir.join(f["image"].as_str().unwrap()).is_file());
+    }
+    let on_disk = std::fs::read_dir(dir.join("tactile")).unwrap().count();
+    assert_eq!(on_disk, listed.len());
+    assert!(!dir.join("recording.pid").exists());
+    assert!(!tmp.path().join("s.partial").exists());
+}

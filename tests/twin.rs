@@ -280,7 +280,7 @@ fn a_press_through_the_controller_shows_in_the_gelsight_and_repeats_byte_for_byt
         let state: serde_json::Value = serde_json::from_slice(&twin.get("/state")).unwrap();
         assert_eq!(state["error_code"], 31, "{state}");
         assert!(
-            state["last_fault"].as_str().unwrap().contains("lime"),
+            state["last_notice"].as_str().unwrap().contains("lime"),
             "{state}"
         );
         let depth = image::load_from_memory(&twin.get("/camera/depth.png")).unwrap();
@@ -300,4 +300,69 @@ fn a_press_through_the_controller_shows_in_the_gelsight_and_repeats_byte_for_byt
         "the pad pressed into the lime shows: {changes:?}"
     );
     assert_eq!(a, press(), "same scene, seed and commands: the same frames");
+}
+
+#[test]
+fn the_gelsight_images_the_pad_mid_move_and_streams_as_mjpeg() {
+    let twin = Twin::start();
+    let arm = twin.arm();
+    arm.prepare().unwrap();
+    arm.move_line(&down(480.0, -40.0, 60.0), 200.0).unwrap();
+    let reference = twin.get("/gelsight/frame.png");
+    // A slow descent into the lime (16 mm at 0.5 mm/s: 1.6 s of wall time at --time-scale 20),
+    // from a second client; the frame taken early in it is where the pad is then, above the
+    // lime, not where the move ends.
+    let mover = {
+        let control = twin.control.clone();
+        std::thread::spawn(move || {
+            let mut config = XArmConfig::new(control);
+            config.workspace =
+                WorkspaceBox::from_bounds_mm([-5e3, 5e3, -5e3, 5e3, -5e3, 5e3]).unwrap();
+            let arm = XArm::connect(config).unwrap();
+            arm.move_line(&down(480.0, -40.0, 44.0), 0.5).unwrap();
+        })
+    };
+    std::thread::sleep(Duration::from_millis(200));
+    let state: serde_json::Value = serde_json::from_slice(&twin.get("/state")).unwrap();
+    let mid = twin.get("/gelsight/frame.png");
+    let z = state["pose"][2].as_f64().unwrap();
+    assert!(state["state"] == 1 && z < 60.0 && z > 50.0, "{state}");
+    mover.join().unwrap();
+    let end = twin.get("/gelsight/frame.png");
+    let (early, late) = (
+        mean_abs_diff(&reference, &mid),
+        mean_abs_diff(&reference, &end),
+    );
+    assert!(early < 3.0 && late > 5.0, "{early} {late}");
+
+    // The MJPEG stream: parts framed by the boundary the header names, each a whole JPEG.
+    let mut r = ureq::get(&format!("http://{}/gelsight/stream.mjpg", twin.http))
+        .call()
+        .unwrap();
+    let kind = r.headers()["content-type"].to_str().unwrap().to_string();
+    let boundary = kind.split("boundary=").nth(1).unwrap().to_string();
+    assert!(kind.starts_with("multipart/x-mixed-replace"), "{kind}");
+    let mut body = r.body_mut().as_reader();
+    for _ in 0..2 {
+        let mut head = Vec::new();
+        while !head.ends_with(b"\r\n\r\n") {
+            let mut byte = [0u8];
+            body.read_exact(&mut byte).unwrap();
+            head.push(byte[0]);
+        }
+        let head = String::from_utf8(head).unwrap();
+        assert!(head.starts_with(&format!("--{boundary}\r\n")), "{head}");
+        let length: usize = head
+            .lines()
+            .find_map(|l| l.strip_prefix("Content-Length: "))
+            .unwrap()
+            .parse()
+            .unwrap();
+        let mut jpeg = vec![0u8; length + 2];
+        body.read_exact(&mut jpeg).unwrap();
+        let frame =
+            image::load_from_memory_with_format(&jpeg[..length], image::ImageFormat::Jpeg).unwrap();
+        assert_eq!((frame.width(), frame.height()), (320, 240));
+        assert_eq!(&jpeg[length..], b"\r\n");
+    }
 }

@@ -65,6 +65,9 @@ fn control_client(mut stream: TcpStream, twin: &Twin) -> Result<(), String> {
                 Some(Answer::Params(p)) => (c.status_bits(), p),
                 Some(Answer::Invalid) | None => (c.status_bits() | status::INVALID, Vec::new()),
             };
+            for notice in c.take_notices() {
+                eprintln!("tactex twin: {notice}");
+            }
             frame::reply(h.transaction, h.protocol, register, bits, &params)
         };
         stream.write_all(&reply).map_err(|e| e.to_string())?;

@@ -7,9 +7,12 @@
 
 use glam::{DQuat, DVec3, EulerRot};
 use std::collections::VecDeque;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactex_core::devices::{Arm, DeviceError};
 use tactex_core::geometry::Pose;
+use tactex_hw::session::SessionRecorder;
+use tactex_hw::session::format::MoveRecord;
 use tactex_hw::xarm::frame::{f32_params, f32_values, status};
 use tactex_sim::arm::SimArm;
 use tactex_sim::world::SharedWorld;
@@ -28,11 +31,27 @@ pub mod reg {
     pub const SET_MODE: u8 = 19;
     pub const MOVE_LINE: u8 = 21;
     pub const MOVE_HOME: u8 = 25;
+    pub const MOVE_SERVO_CART: u8 = 30;
     pub const SET_TCP_JERK: u8 = 31;
     pub const SET_TCP_MAXACC: u8 = 32;
     pub const GET_TCP_POSE: u8 = 41;
     pub const GET_JOINT_POS: u8 = 42;
+    pub const MOVE_RELATIVE: u8 = 83;
 }
+
+/// The controller's modes (`set_mode`): planned moves run in position mode only, servo
+/// targets in servo mode only; a command for another mode is not executed (uFactory's
+/// manual), and the twin says so on stderr and in `/state`.
+pub mod mode {
+    pub const POSITION: u8 = 0;
+    pub const SERVO: u8 = 1;
+}
+
+/// A servo target further than this from the pad is not executed (uFactory's servo mode
+/// guide: steps of at most 10 mm).
+pub const SERVO_STEP_MAX_MM: f64 = 10.0;
+/// Servo targets run at the TCP's top speed.
+pub const SERVO_SPEED_MM_S: f64 = 1000.0;
 
 /// Controller error codes the twin raises (`x_code.py`; `tactex_hw::xarm::codes`).
 pub mod error_code {
@@ -134,8 +153,24 @@ pub struct Controller {
     /// Motion commands accepted since the controller started.
     accepted: u16,
     last_speed_mm_s: f64,
-    /// Why the last fault was raised, for the twin's log.
-    pub last_fault: Option<String>,
+    /// Why the last fault was raised or the last command not executed, for `/state`.
+    pub last_notice: Option<String>,
+    /// Notices not yet written to the twin's log.
+    unlogged: Vec<String>,
+    /// The session the moves are written into (`tactex twin --record`).
+    recorder: Option<Arc<SessionRecorder>>,
+}
+
+/// Where a move goes, as the request gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MoveTarget {
+    /// A pose in the base frame.
+    Base(TcpPoseMm),
+    /// An offset in the pad's own frame from where the last move ends (`set_tool_position`).
+    Tool(TcpPoseMm),
+    /// An offset added in the base frame to where the last move ends (`set_position(...,
+    /// relative=True)`): position and roll, pitch, yaw each added.
+    Relative(TcpPoseMm),
 }
 
 /// Reply to one request: the parameter bytes, or the request was invalid.
@@ -162,8 +197,15 @@ impl Controller {
             queue: VecDeque::new(),
             accepted: 0,
             last_speed_mm_s: 0.0,
-            last_fault: None,
+            last_notice: None,
+            unlogged: Vec::new(),
+            recorder: None,
         })
+    }
+
+    /// Writes every move asked for, and how it ended, into `recorder`'s session.
+    pub fn record_into(&mut self, recorder: Arc<SessionRecorder>) {
+        self.recorder = Some(recorder);
     }
 
     pub fn mount(&self) -> &ArmMount {
@@ -227,7 +269,36 @@ impl Controller {
         self.halt(now);
         self.error = code;
         self.state = motion::STOPPED;
-        self.last_fault = Some(why);
+        self.notice(format!("error {code}: {why}"));
+    }
+
+    fn notice(&mut self, text: String) {
+        self.unlogged.push(text.clone());
+        self.last_notice = Some(text);
+    }
+
+    /// The notices since the last call, for the twin's log.
+    pub fn take_notices(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.unlogged)
+    }
+
+    /// Puts the world's pad where the controller's clock has it now: the sensors image the
+    /// pad mid-move, not at the move's end.
+    pub fn place_pad_now(&mut self, now: Instant) -> Pose {
+        let here = self.snapshot(now).pose;
+        self.place_pad(&here);
+        world_pose(&self.mount, &here)
+    }
+
+    fn place_pad(&self, pose: &TcpPoseMm) {
+        if let Ok(mut w) = self.world.lock() {
+            w.tool = world_pose(&self.mount, pose);
+        }
+    }
+
+    /// Where the pad will be once the queued moves end: where the next move starts.
+    fn planned_pose(&self) -> TcpPoseMm {
+        self.queue.back().map_or(self.pose, |m| m.to)
     }
 
     /// Stops a running move where the pad is now and drops the queued ones; the world's
@@ -237,9 +308,7 @@ impl Controller {
         if !self.queue.is_empty() {
             self.queue.clear();
             self.pose = here;
-            if let Ok(mut w) = self.world.lock() {
-                w.tool = world_pose(&self.mount, &here);
-            }
+            self.place_pad(&here);
         }
     }
 
@@ -310,7 +379,14 @@ impl Controller {
             reg::GET_JOINT_POS => Answer::Params(f32_params(&[0.0; 7])),
             reg::MOVE_LINE => match move_line_params(params) {
                 Some((target, speed_mm_s)) => {
-                    self.move_to(target, speed_mm_s, now);
+                    self.planned_move(target, speed_mm_s, now);
+                    Answer::Params(vec![])
+                }
+                None => Answer::Invalid,
+            },
+            reg::MOVE_RELATIVE => match move_relative_params(params) {
+                Some((offset, speed_mm_s)) => {
+                    self.planned_move(MoveTarget::Relative(offset), speed_mm_s, now);
                     Answer::Params(vec![])
                 }
                 None => Answer::Invalid,
@@ -320,7 +396,24 @@ impl Controller {
                     // Speed in rad/s of the joints: a Cartesian twin moves home at 100 mm/s
                     // per 0.35 rad/s (the SDK's default joint speed).
                     let v = f32_values(&params[..12]);
-                    self.move_to(HOME, (v[0] / 0.35 * 100.0).clamp(1.0, 1000.0), now);
+                    let speed = (v[0] / 0.35 * 100.0).clamp(1.0, 1000.0);
+                    self.planned_move(MoveTarget::Base(HOME), speed, now);
+                    Answer::Params(vec![])
+                }
+                _ => Answer::Invalid,
+            },
+            // Pose, speed and acceleration (not used: servo targets run at top speed), and
+            // where the SDK puts its time the tool-frame flag.
+            reg::MOVE_SERVO_CART => match params.len() {
+                36 => {
+                    let v = f32_values(params);
+                    let pose = [v[0], v[1], v[2], v[3], v[4], v[5]];
+                    let target = if v[8] >= 0.5 {
+                        MoveTarget::Tool(pose)
+                    } else {
+                        MoveTarget::Base(pose)
+                    };
+                    self.servo_to(target, now);
                     Answer::Params(vec![])
                 }
                 _ => Answer::Invalid,
@@ -329,15 +422,56 @@ impl Controller {
         })
     }
 
-    /// A linear move of the pad to `target`, checked as a controller checks it.
-    fn move_to(&mut self, target: TcpPoseMm, speed_mm_s: f64, now: Instant) {
-        let ready = self.enabled
-            && self.error == 0
-            && self.mode == 0
-            && matches!(self.state, motion::MOVING | motion::READY);
-        if !ready {
+    fn ready(&self) -> bool {
+        self.enabled && self.error == 0 && matches!(self.state, motion::MOVING | motion::READY)
+    }
+
+    /// A planned move (position mode), queued behind the others.
+    fn planned_move(&mut self, target: MoveTarget, speed_mm_s: f64, now: Instant) {
+        if !self.ready() {
             return;
         }
+        if self.mode != mode::POSITION {
+            let m = self.mode;
+            return self.notice(format!(
+                "a planned move in mode {m} was not executed: planned moves run in mode 0 (set_mode(0), set_state(0))"
+            ));
+        }
+        let target = resolve(target, &self.planned_pose());
+        self.move_to(target, speed_mm_s, now);
+    }
+
+    /// A servo target (servo mode): no queue, the latest target replaces whatever runs, at
+    /// the TCP's top speed; one more than 10 mm from the pad is not executed.
+    fn servo_to(&mut self, target: MoveTarget, now: Instant) {
+        if !self.ready() {
+            return;
+        }
+        if self.mode != mode::SERVO {
+            let m = self.mode;
+            return self.notice(format!(
+                "a servo target in mode {m} was not executed: servo targets run in mode 1 (set_mode(1), set_state(0))"
+            ));
+        }
+        self.halt(now);
+        let here = self.pose;
+        let target = resolve(target, &here);
+        let step = DVec3::new(
+            target[0] - here[0],
+            target[1] - here[1],
+            target[2] - here[2],
+        );
+        if step.length() > SERVO_STEP_MAX_MM {
+            return self.notice(format!(
+                "a servo target {:.1} mm from the pad was not executed: servo steps are at most {SERVO_STEP_MAX_MM} mm",
+                step.length()
+            ));
+        }
+        self.move_to(target, SERVO_SPEED_MM_S, now);
+    }
+
+    /// A linear move of the pad to `target`, checked as a controller checks it.
+    fn move_to(&mut self, target: TcpPoseMm, speed_mm_s: f64, now: Instant) {
         if !(target.iter().all(|v| v.is_finite()) && speed_mm_s.is_finite() && speed_mm_s > 0.0) {
             self.warning = warn_code::PARAMETER;
             return;
@@ -364,21 +498,35 @@ impl Controller {
             );
             return self.fault(error_code::SAFETY_BOUNDARY, why, now);
         }
+        // Queued behind the moves not yet ended, from where the last of them ends.
+        let (from, started) = match self.queue.back() {
+            Some(last) => (last.to, last.started + last.duration),
+            None => (self.pose, now),
+        };
+        // The sim arm checks the target and times the move from where the pad starts it; the
+        // world's pad then goes back to where the clock has it now.
+        self.place_pad(&from);
         let clock_before = self.world.lock().map(|w| w.time_s).unwrap_or(0.0);
-        match self.arm.move_linear(&pose, speed_mm_s * 1e-3) {
+        let checked = self.arm.move_linear(&pose, speed_mm_s * 1e-3);
+        let clock_after = self.world.lock().map(|w| w.time_s).unwrap_or(clock_before);
+        self.place_pad_now(now);
+        if let Some(recorder) = &self.recorder {
+            recorder.arm_move(MoveRecord {
+                target: pose,
+                speed_m_s: speed_mm_s * 1e-3,
+                reached: world_pose(&self.mount, if checked.is_ok() { &target } else { &from }),
+                time_s: Some(clock_after),
+                error: checked.as_ref().err().map(ToString::to_string),
+            });
+        }
+        match checked {
             Ok(()) => {}
             Err(DeviceError::UnsafeMove { reason, .. }) => {
                 return self.fault(error_code::COLLISION, reason, now);
             }
             Err(e) => return self.fault(error_code::COLLISION, e.to_string(), now),
         }
-        let clock_after = self.world.lock().map(|w| w.time_s).unwrap_or(clock_before);
         let seconds = (clock_after - clock_before).max(0.0) / self.mount.time_scale;
-        // Queued behind the moves not yet ended, from where the last of them ends.
-        let (from, started) = match self.queue.back() {
-            Some(last) => (last.to, last.started + last.duration),
-            None => (self.pose, now),
-        };
         self.queue.push_back(Moving {
             from,
             to: target,
@@ -408,6 +556,22 @@ fn sdk_pose(mount: &ArmMount, pose: &Pose) -> TcpPoseMm {
     [p.x, p.y, p.z, roll, pitch, yaw]
 }
 
+/// The base-frame pose `target` names, from `planned` (where the last move ends).
+pub fn resolve(target: MoveTarget, planned: &TcpPoseMm) -> TcpPoseMm {
+    match target {
+        MoveTarget::Base(p) => p,
+        MoveTarget::Relative(d) => std::array::from_fn(|i| planned[i] + d[i]),
+        MoveTarget::Tool(d) => {
+            let frame = |p: &TcpPoseMm| DQuat::from_euler(EulerRot::ZYX, p[5], p[4], p[3]);
+            let rotation = frame(planned);
+            let at = DVec3::new(planned[0], planned[1], planned[2])
+                + rotation * DVec3::new(d[0], d[1], d[2]);
+            let (yaw, pitch, roll) = (rotation * frame(&d)).to_euler(EulerRot::ZYX);
+            [at.x, at.y, at.z, roll, pitch, yaw]
+        }
+    }
+}
+
 fn lerp(a: &TcpPoseMm, b: &TcpPoseMm, t: f64) -> TcpPoseMm {
     let mut out = *a;
     for i in 0..3 {
@@ -423,15 +587,17 @@ fn lerp(a: &TcpPoseMm, b: &TcpPoseMm, t: f64) -> TcpPoseMm {
 /// The target and speed of a MOVE_LINE request in any of the layouts the SDK sends: 9 f32
 /// (pose, speed, acceleration, time), with 1-2 bytes of check and motion type, or 10 f32
 /// (with a blend radius) and 3-4 bytes (coordinate frame, axis-angle, check, motion type).
-fn move_line_params(params: &[u8]) -> Option<(TcpPoseMm, f64)> {
-    let floats = match params.len() {
-        36..=38 => 9,
+/// A joint-interpolated move to a Cartesian pose (motion type 1 or 2) is run as a line:
+/// the twin has no joint model, and over a table the two end at the same pose.
+fn move_line_params(params: &[u8]) -> Option<(MoveTarget, f64)> {
+    let (floats, tool_frame) = match params.len() {
+        36..=38 => (9, false),
         43 | 44 => {
-            // Tool-frame or axis-angle targets are not linear base-frame moves.
-            if params[40] != 0 || params[41] != 0 {
+            // Axis-angle targets are not spoken.
+            if params[41] != 0 || params[40] > 1 {
                 return None;
             }
-            10
+            (10, params[40] == 1)
         }
         _ => return None,
     };
@@ -444,7 +610,27 @@ fn move_line_params(params: &[u8]) -> Option<(TcpPoseMm, f64)> {
     if check != 0 {
         return None;
     }
-    Some(([v[0], v[1], v[2], v[3], v[4], v[5]], v[6]))
+    let pose = [v[0], v[1], v[2], v[3], v[4], v[5]];
+    let target = if tool_frame {
+        MoveTarget::Tool(pose)
+    } else {
+        MoveTarget::Base(pose)
+    };
+    Some((target, v[6]))
+}
+
+/// The offset and speed of a MOVE_RELATIVE request: 11 f32 (7 offsets, of which a Cartesian
+/// move reads 6, speed, acceleration, time, radius), then joint-motion and axis-angle flags,
+/// optionally check and motion type. Joint and axis-angle offsets are not spoken.
+fn move_relative_params(params: &[u8]) -> Option<(TcpPoseMm, f64)> {
+    if !(46..=48).contains(&params.len()) || params[44] != 0 || params[45] != 0 {
+        return None;
+    }
+    if params.get(46).is_some_and(|&check| check != 0) {
+        return None;
+    }
+    let v = f32_values(&params[..44]);
+    Some(([v[0], v[1], v[2], v[3], v[4], v[5]], v[7]))
 }
 
 fn padded(text: &str, n: usize) -> Vec<u8> {
@@ -474,7 +660,7 @@ mod tests {
     }
 
     #[test]
-    fn move_line_takes_every_sdk_layout_and_refuses_checks_and_tool_frames() {
+    fn move_line_takes_every_sdk_layout_and_refuses_checks_and_axis_angles() {
         let mut nine = f32_params(&[300.0, 0.0, 200.0, 3.1, 0.0, 0.0, 50.0, 500.0, 0.0]);
         assert_eq!(move_line_params(&nine).unwrap().1, 50.0);
         nine.push(0);
@@ -483,9 +669,51 @@ mod tests {
         assert!(move_line_params(&nine).is_none(), "only a check");
         let mut ten = f32_params(&[300.0, 0.0, 200.0, 3.1, 0.0, 0.0, 50.0, 500.0, 0.0, -1.0]);
         ten.extend([0, 0, 0]);
-        assert_eq!(move_line_params(&ten).unwrap().0[2], 200.0);
+        assert!(matches!(move_line_params(&ten).unwrap().0, MoveTarget::Base(p) if p[2] == 200.0));
         ten[40] = 1;
-        assert!(move_line_params(&ten).is_none(), "tool frame");
+        assert!(matches!(
+            move_line_params(&ten).unwrap().0,
+            MoveTarget::Tool(_)
+        ));
+        ten[41] = 1;
+        assert!(move_line_params(&ten).is_none(), "axis-angle");
         assert!(move_line_params(&[0; 12]).is_none());
+    }
+
+    #[test]
+    fn move_relative_reads_the_sdk_layout_and_refuses_joint_offsets() {
+        let mut p = f32_params(&[0.0, 0.0, -0.25, 0.0, 0.0, 0.0, 0.0, 20.0, 500.0, 0.0, -1.0]);
+        p.extend([0, 0]);
+        let (offset, speed) = move_relative_params(&p).unwrap();
+        assert_eq!((offset[2], speed), (-0.25, 20.0));
+        p[44] = 1;
+        assert!(move_relative_params(&p).is_none(), "joint offsets");
+    }
+
+    #[test]
+    fn a_tool_frame_offset_along_the_downward_pad_goes_down_in_the_base_frame() {
+        // The pad points down (roll pi) turned 90 degrees: its +z is the base's -z and its +x
+        // the base's +y.
+        let planned = [
+            400.0,
+            20.0,
+            100.0,
+            std::f64::consts::PI,
+            0.0,
+            std::f64::consts::FRAC_PI_2,
+        ];
+        let t = resolve(MoveTarget::Tool([5.0, 0.0, 2.0, 0.0, 0.0, 0.0]), &planned);
+        let expected = [400.0, 25.0, 98.0];
+        for i in 0..3 {
+            assert!((t[i] - expected[i]).abs() < 1e-9, "{t:?}");
+        }
+        let a = world_pose(&ArmMount::default(), &t).rotation;
+        let b = world_pose(&ArmMount::default(), &planned).rotation;
+        assert!(a.angle_between(b) < 1e-9);
+        let r = resolve(
+            MoveTarget::Relative([1.0, 0.0, -0.25, 0.0, 0.0, 0.1]),
+            &planned,
+        );
+        assert!((r[2] - 99.75).abs() < 1e-12 && (r[5] - planned[5] - 0.1).abs() < 1e-12);
     }
 }

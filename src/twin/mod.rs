@@ -18,7 +18,9 @@ use std::net::{IpAddr, SocketAddr, TcpListener};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use tactex_core::catalog::FruitCatalog;
+use tactex_core::devices::{RgbdCamera, TactileSensor};
 use tactex_core::scene::Scene;
+use tactex_hw::session::{SessionRecorder, TwinRecord};
 use tactex_sim::SimDevices;
 use tactex_sim::camera::SimCamera;
 use tactex_sim::elastic::Fidelity;
@@ -64,6 +66,11 @@ pub struct TwinArgs {
     /// Moves take their twin-clock duration divided by this in wall time (0.01-1000).
     #[arg(long, default_value_t = 1.0)]
     pub time_scale: f64,
+    /// Write every GelSight and RealSense frame served (with the pad's pose) and every move
+    /// into a new session directory, as `ask --record` does; it is whole once the twin stops
+    /// on Ctrl-C or SIGTERM (`tactex compare --session DIR` reads it back).
+    #[arg(long, value_name = "DIR")]
+    pub record: Option<PathBuf>,
 }
 
 fn parse_base(text: &str) -> std::result::Result<DVec3, String> {
@@ -88,6 +95,7 @@ pub struct Twin {
     pub gelsight: Mutex<SimGelSight>,
     pub camera: Mutex<SimCamera>,
     pub world: tactex_sim::world::SharedWorld,
+    pub recorder: Option<Arc<SessionRecorder>>,
 }
 
 fn bind(host: IpAddr, port: u16, flag: &str) -> Result<TcpListener> {
@@ -109,19 +117,55 @@ pub fn run(args: &TwinArgs) -> Result<()> {
     let path = args.scene.clone().unwrap_or_else(crate::default_scene);
     let scene = Scene::load(&path, &catalog)?;
     let sensor = crate::ask::load_sensor(args.sensor.as_deref())?;
+    let sensor_id = sensor.id();
     let sim = SimDevices::with_sensor(&scene, args.seed, sensor, args.fidelity)?;
     let mount = ArmMount {
         base_m: args.base_m,
         time_scale: args.time_scale,
         ..ArmMount::default()
     };
-    let controller = Controller::new(sim.world.clone(), sim.arm, mount)
+    let mut controller = Controller::new(sim.world.clone(), sim.arm, mount)
         .map_err(|e| anyhow::anyhow!("the twin's controller: {e}"))?;
+    let recorder = match &args.record {
+        Some(dir) => {
+            let recorder = Arc::new(SessionRecorder::create(dir).context("--record")?);
+            recorder.start_camera(
+                sim.camera.name(),
+                sim.camera.intrinsics(),
+                sim.camera.pose(),
+            );
+            recorder.start_tactile(sim.tactile.name(), sim.tactile.spec());
+            let (pad, time_s) = {
+                let w = sim
+                    .world
+                    .lock()
+                    .map_err(|_| anyhow::anyhow!("world lock"))?;
+                (w.tool, w.time_s)
+            };
+            recorder.start_arm("twin-xarm-850", pad, Some(time_s));
+            let scene_toml = std::fs::read_to_string(&path)
+                .with_context(|| format!("{}: cannot read the scene again", path.display()))?;
+            recorder.twin(TwinRecord {
+                scene_toml,
+                scene_path: std::path::absolute(&path)
+                    .unwrap_or(path.clone())
+                    .display()
+                    .to_string(),
+                seed: args.seed,
+                fidelity: Some(args.fidelity.name().into()),
+                sensor: Some(sensor_id),
+            });
+            controller.record_into(recorder.clone());
+            Some(recorder)
+        }
+        None => None,
+    };
     let twin = Arc::new(Twin {
         controller: Mutex::new(controller),
         gelsight: Mutex::new(sim.tactile),
         camera: Mutex::new(sim.camera),
         world: sim.world,
+        recorder,
     });
     let control = bind(args.host, args.port, "--port")?;
     let reports = [
@@ -160,5 +204,11 @@ pub fn run(args: &TwinArgs) -> Result<()> {
         let twin = twin.clone();
         std::thread::spawn(move || control_port::serve_control(control, &twin));
     }
-    frames_http::serve(http, twin)
+    frames_http::serve(http, twin.clone())?;
+    if let (Some(recorder), Some(dir)) = (&twin.recorder, &args.record) {
+        // The servers' threads stop with the process; a move or frame after this is refused.
+        recorder.finish("twin", "", None).context("--record")?;
+        println!("tactex twin: session written to {}", dir.display());
+    }
+    Ok(())
 }

@@ -59,8 +59,71 @@ pub fn depth_from_u16(depth: &ImageBuffer<Luma<u16>, Vec<u16>>, scale_m: f64) ->
     })
 }
 
+/// The file in `DIR.partial` naming the process that records into it.
+const LOCK: &str = "recording.pid";
+
+/// Whether process `pid` runs (where /proc says; elsewhere assumed to).
+fn process_runs(pid: u32) -> bool {
+    if cfg!(target_os = "linux") {
+        Path::new(&format!("/proc/{pid}")).exists()
+    } else {
+        true
+    }
+}
+
+/// Creates `partial` for this process alone: the directory's creation is the lock, and its
+/// pid file says whose it is. One left by a process that no longer runs is removed first.
+fn claim(partial: &Path) -> Result<(), SessionError> {
+    for _ in 0..2 {
+        match std::fs::create_dir(partial) {
+            Ok(()) => {
+                let lock = partial.join(LOCK);
+                return std::fs::write(&lock, std::process::id().to_string())
+                    .map_err(|e| SessionError::file(&lock, e));
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                let owner = std::fs::read_to_string(partial.join(LOCK))
+                    .ok()
+                    .and_then(|t| t.trim().parse::<u32>().ok());
+                match owner {
+                    Some(pid) if process_runs(pid) => {
+                        return Err(SessionError::file(
+                            partial,
+                            format!("another tactex (pid {pid}) is recording a session here"),
+                        ));
+                    }
+                    // No pid file yet: its owner is between creating it and writing the file.
+                    None if partial_is_new(partial) => {
+                        return Err(SessionError::file(
+                            partial,
+                            "another tactex is recording a session here",
+                        ));
+                    }
+                    _ => std::fs::remove_dir_all(partial).map_err(|e| {
+                        SessionError::file(partial, format!("cannot remove a stale recording: {e}"))
+                    })?,
+                }
+            }
+            Err(e) => return Err(SessionError::file(partial, format!("cannot create: {e}"))),
+        }
+    }
+    Err(SessionError::file(
+        partial,
+        "another tactex keeps creating this recording",
+    ))
+}
+
+fn partial_is_new(partial: &Path) -> bool {
+    std::fs::metadata(partial)
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| t.elapsed().ok())
+        .is_some_and(|age| age.as_secs() < 10)
+}
+
 impl SessionRecorder {
-    /// Starts a session in `dir`, which must not exist yet.
+    /// Starts a session in `dir`, which must not exist yet. While it records, `DIR.partial`
+    /// is this process's: a second recorder into the same directory is refused.
     pub fn create(dir: &Path) -> Result<SessionRecorder, SessionError> {
         if dir.exists() {
             return Err(SessionError::file(
@@ -69,10 +132,7 @@ impl SessionRecorder {
             ));
         }
         let partial = partial_dir(dir);
-        if partial.exists() {
-            std::fs::remove_dir_all(&partial)
-                .map_err(|e| SessionError::file(&partial, format!("cannot remove: {e}")))?;
-        }
+        claim(&partial)?;
         for sub in ["camera", "tactile"] {
             std::fs::create_dir_all(partial.join(sub))
                 .map_err(|e| SessionError::file(&partial, format!("cannot create: {e}")))?;
@@ -92,13 +152,7 @@ impl SessionRecorder {
     }
 
     pub fn camera<'a, C: RgbdCamera>(&self, camera: &'a mut C) -> RecordingCamera<'a, C> {
-        lock(&self.log).camera = Some(CameraRecord {
-            name: camera.name().into(),
-            intrinsics: camera.intrinsics(),
-            pose: camera.pose(),
-            depth_scale_m: DEPTH_SCALE_M,
-            frames: Vec::new(),
-        });
+        self.start_camera(camera.name(), camera.intrinsics(), camera.pose());
         RecordingCamera {
             inner: camera,
             log: self.log.clone(),
@@ -106,11 +160,7 @@ impl SessionRecorder {
     }
 
     pub fn tactile<'a, T: TactileSensor>(&self, sensor: &'a mut T) -> RecordingTactile<'a, T> {
-        lock(&self.log).tactile = Some(TactileRecord {
-            name: sensor.name().into(),
-            spec: sensor.spec().clone(),
-            frames: Vec::new(),
-        });
+        self.start_tactile(sensor.name(), sensor.spec());
         RecordingTactile {
             inner: sensor,
             log: self.log.clone(),
@@ -118,20 +168,57 @@ impl SessionRecorder {
     }
 
     pub fn arm<'a, A: Arm>(&self, arm: &'a mut A) -> Result<RecordingArm<'a, A>, DeviceError> {
-        let start_pose = arm.pose()?;
-        let mut log = lock(&self.log);
-        log.arm_pose = start_pose;
-        log.arm = Some(ArmRecord {
-            name: arm.name().into(),
-            start_pose,
-            start_time_s: arm.sim_time_s(),
-            moves: Vec::new(),
-        });
-        drop(log);
+        self.start_arm(arm.name(), arm.pose()?, arm.sim_time_s());
         Ok(RecordingArm {
             inner: arm,
             log: self.log.clone(),
         })
+    }
+
+    /// Records a camera's frames from now on (a device that is not wrapped, e.g. one shared
+    /// between servers: its frames come through `camera_frame`).
+    pub fn start_camera(&self, name: &str, intrinsics: CameraIntrinsics, pose: Pose) {
+        lock(&self.log).camera = Some(CameraRecord {
+            name: name.into(),
+            intrinsics,
+            pose,
+            depth_scale_m: DEPTH_SCALE_M,
+            frames: Vec::new(),
+        });
+    }
+
+    pub fn start_tactile(&self, name: &str, spec: &TactileSpec) {
+        lock(&self.log).tactile = Some(TactileRecord {
+            name: name.into(),
+            spec: spec.clone(),
+            frames: Vec::new(),
+        });
+    }
+
+    pub fn start_arm(&self, name: &str, start_pose: Pose, start_time_s: Option<f64>) {
+        let mut log = lock(&self.log);
+        log.arm_pose = start_pose;
+        log.arm = Some(ArmRecord {
+            name: name.into(),
+            start_pose,
+            start_time_s,
+            moves: Vec::new(),
+        });
+    }
+
+    /// Writes a camera frame; returns it as the session stores it (depth in 0.1 mm steps).
+    pub fn camera_frame(&self, frame: RgbdFrame) -> Result<RgbdFrame, DeviceError> {
+        record_camera_frame(&self.log, frame)
+    }
+
+    /// Writes a tactile frame taken with the pad at `arm_pose`.
+    pub fn tactile_frame(&self, frame: &TactileFrame, arm_pose: Pose) -> Result<(), DeviceError> {
+        record_tactile_frame(&self.log, frame, Some(arm_pose))
+    }
+
+    /// Notes a move the arm was asked for and how it ended.
+    pub fn arm_move(&self, record: MoveRecord) {
+        record_move(&self.log, record);
     }
 
     /// Notes the sim world being recorded, so that the twin can rebuild its presses.
@@ -139,9 +226,10 @@ impl SessionRecorder {
         lock(&self.log).twin = Some(twin);
     }
 
-    /// Writes the manifest and moves the session to its directory.
+    /// Writes the manifest and moves the session to its directory; frames offered after it
+    /// are refused.
     pub fn finish(
-        self,
+        &self,
         backend: &str,
         prompt: &str,
         answer: Option<serde_json::Value>,
@@ -162,10 +250,17 @@ impl SessionRecorder {
             answer,
             twin: log.twin.clone(),
         };
+        if log.finished {
+            return Err(SessionError::file(
+                &log.dir,
+                "the session is already written",
+            ));
+        }
         let path = log.partial.join(MANIFEST);
         let text =
             serde_json::to_string_pretty(&manifest).map_err(|e| SessionError::file(&path, e))?;
         std::fs::write(&path, text + "\n").map_err(|e| SessionError::file(&path, e))?;
+        let _ = std::fs::remove_file(log.partial.join(LOCK));
         std::fs::rename(&log.partial, &log.dir).map_err(|e| {
             SessionError::file(&log.dir, format!("cannot move the session here: {e}"))
         })?;
@@ -212,27 +307,69 @@ impl<C: RgbdCamera> RgbdCamera for RecordingCamera<'_, C> {
     /// while recording is the one a replay gives.
     fn capture(&mut self) -> Result<RgbdFrame, DeviceError> {
         let frame = self.inner.capture()?;
-        let mut log = lock(&self.log);
-        let n = log.camera.as_ref().map_or(0, |c| c.frames.len());
-        let (color, depth) = (
-            format!("camera/color-{n:04}.png"),
-            format!("camera/depth-{n:04}.png"),
-        );
-        let stored = depth_to_u16(&frame.depth_m);
-        save_png(&frame.color, &log.partial.join(&color))?;
-        save_png(&stored, &log.partial.join(&depth))?;
-        if let Some(c) = log.camera.as_mut() {
-            c.frames.push(RgbdRecord {
-                color,
-                depth,
-                timestamp_s: frame.timestamp_s,
-            });
-        }
-        Ok(RgbdFrame {
-            color: frame.color,
-            depth_m: depth_from_u16(&stored, DEPTH_SCALE_M),
+        record_camera_frame(&self.log, frame)
+    }
+}
+
+fn refuse_finished(log: &Log) -> Result<(), DeviceError> {
+    if log.finished {
+        return Err(recorder_error(&log.dir, "the session is already written"));
+    }
+    Ok(())
+}
+
+fn record_camera_frame(log: &Mutex<Log>, frame: RgbdFrame) -> Result<RgbdFrame, DeviceError> {
+    let mut log = lock(log);
+    refuse_finished(&log)?;
+    let n = log.camera.as_ref().map_or(0, |c| c.frames.len());
+    let (color, depth) = (
+        format!("camera/color-{n:04}.png"),
+        format!("camera/depth-{n:04}.png"),
+    );
+    let stored = depth_to_u16(&frame.depth_m);
+    save_png(&frame.color, &log.partial.join(&color))?;
+    save_png(&stored, &log.partial.join(&depth))?;
+    if let Some(c) = log.camera.as_mut() {
+        c.frames.push(RgbdRecord {
+            color,
+            depth,
             timestamp_s: frame.timestamp_s,
-        })
+        });
+    }
+    Ok(RgbdFrame {
+        color: frame.color,
+        depth_m: depth_from_u16(&stored, DEPTH_SCALE_M),
+        timestamp_s: frame.timestamp_s,
+    })
+}
+
+/// Writes `frame`, taken with the pad at `arm_pose` (None: where the last move left it).
+fn record_tactile_frame(
+    log: &Mutex<Log>,
+    frame: &TactileFrame,
+    arm_pose: Option<Pose>,
+) -> Result<(), DeviceError> {
+    let mut log = lock(log);
+    refuse_finished(&log)?;
+    let n = log.tactile.as_ref().map_or(0, |t| t.frames.len());
+    let image = format!("tactile/{n:04}.png");
+    save_png::<_, Vec<u8>>(&frame.image, &log.partial.join(&image))?;
+    let arm_pose = arm_pose.unwrap_or(log.arm_pose);
+    if let Some(t) = log.tactile.as_mut() {
+        t.frames.push(TactileFrameRecord {
+            image,
+            timestamp_s: frame.timestamp_s,
+            arm_pose,
+        });
+    }
+    Ok(())
+}
+
+fn record_move(log: &Mutex<Log>, record: MoveRecord) {
+    let mut log = lock(log);
+    log.arm_pose = record.reached;
+    if let Some(a) = log.arm.as_mut() {
+        a.moves.push(record);
     }
 }
 
@@ -250,18 +387,7 @@ impl<T: TactileSensor> TactileSensor for RecordingTactile<'_, T> {
     }
     fn capture(&mut self) -> Result<TactileFrame, DeviceError> {
         let frame = self.inner.capture()?;
-        let mut log = lock(&self.log);
-        let n = log.tactile.as_ref().map_or(0, |t| t.frames.len());
-        let image = format!("tactile/{n:04}.png");
-        save_png::<_, Vec<u8>>(&frame.image, &log.partial.join(&image))?;
-        let arm_pose = log.arm_pose;
-        if let Some(t) = log.tactile.as_mut() {
-            t.frames.push(TactileFrameRecord {
-                image,
-                timestamp_s: frame.timestamp_s,
-                arm_pose,
-            });
-        }
+        record_tactile_frame(&self.log, &frame, None)?;
         Ok(frame)
     }
 }
@@ -281,18 +407,16 @@ impl<A: Arm> Arm for RecordingArm<'_, A> {
     fn move_linear(&mut self, target: &Pose, speed_m_s: f64) -> Result<(), DeviceError> {
         let result = self.inner.move_linear(target, speed_m_s);
         let reached = self.inner.pose()?;
-        let mut log = lock(&self.log);
-        log.arm_pose = reached;
-        let time_s = self.inner.sim_time_s();
-        if let Some(a) = log.arm.as_mut() {
-            a.moves.push(MoveRecord {
+        record_move(
+            &self.log,
+            MoveRecord {
                 target: *target,
                 speed_m_s,
                 reached,
-                time_s,
+                time_s: self.inner.sim_time_s(),
                 error: result.as_ref().err().map(ToString::to_string),
-            });
-        }
+            },
+        );
         result
     }
     fn stop(&mut self) -> Result<(), DeviceError> {
@@ -300,5 +424,26 @@ impl<A: Arm> Arm for RecordingArm<'_, A> {
     }
     fn sim_time_s(&self) -> Option<f64> {
         self.inner.sim_time_s()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_partial_directory_is_claimed_once_and_a_stale_one_taken_over() {
+        let tmp = tempfile::tempdir().unwrap();
+        let partial = tmp.path().join("s.partial");
+        claim(&partial).unwrap();
+        let second = claim(&partial).unwrap_err().to_string();
+        assert!(second.contains("is recording a session here"), "{second}");
+        // A pid no process has (above Linux's pid_max): left by a crash, taken over.
+        std::fs::write(partial.join(LOCK), "4294967295").unwrap();
+        std::fs::write(partial.join("leftover.png"), b"x").unwrap();
+        if cfg!(target_os = "linux") {
+            claim(&partial).unwrap();
+            assert!(!partial.join("leftover.png").exists());
+        }
     }
 }
