@@ -217,7 +217,12 @@ pub fn explain(
         }
     }
     for kind in missing {
-        parts.push(format!("I could not find a {kind} on the table."));
+        let article = if kind.starts_with(['a', 'e', 'i', 'o', 'u']) {
+            "an"
+        } else {
+            "a"
+        };
+        parts.push(format!("I could not find {article} {kind} on the table."));
     }
     for name in &query.unknown {
         parts.push(format!(
@@ -307,6 +312,12 @@ mod tests {
         let text = explain(&q, &[], &[], &["kiwi".into()]);
         assert!(
             text.contains("I could not find a kiwi on the table."),
+            "{text}"
+        );
+        let q = crate::query::parse("Identify the hardness of the orange", &c).unwrap();
+        let text = explain(&q, &[], &[], &["orange".into()]);
+        assert!(
+            text.contains("I could not find an orange on the table."),
             "{text}"
         );
     }

@@ -78,12 +78,20 @@ pub enum QueryError {
 
 pub const MAX_PROMPT_CHARS: usize = 2000;
 
-/// Lower-cased words with the lexicon's phrases rewritten ("ready to eat" -> "ripe").
-fn words_of(prompt: &str) -> Vec<String> {
+/// Marks a break between list items (",", ";", ":", "/", "&") among the words.
+const BREAK: &str = "|";
+
+/// Lower-cased words with the lexicon's phrases rewritten ("ready to eat" -> "ripe"), and
+/// whether each is followed by a list break ("lime, orange, apple": "orange" ends an item).
+fn words_of(prompt: &str) -> (Vec<String>, Vec<bool>) {
     let spaced: String = prompt
         .to_lowercase()
         .chars()
-        .map(|c| if c.is_alphanumeric() { c } else { ' ' })
+        .map(|c| match c {
+            c if c.is_alphanumeric() => c.to_string(),
+            ',' | ';' | ':' | '/' | '&' => format!(" {BREAK} "),
+            _ => " ".into(),
+        })
         .collect();
     let mut text = format!(
         " {} ",
@@ -92,7 +100,18 @@ fn words_of(prompt: &str) -> Vec<String> {
     for (phrase, with) in lexicon::PHRASES {
         text = text.replace(&format!(" {phrase} "), &format!(" {with} "));
     }
-    text.split_whitespace().map(str::to_string).collect()
+    let (mut words, mut breaks) = (Vec::new(), Vec::new());
+    for w in text.split_whitespace() {
+        if w == BREAK {
+            if let Some(b) = breaks.last_mut() {
+                *b = true;
+            }
+        } else {
+            words.push(w.to_string());
+            breaks.push(false);
+        }
+    }
+    (words, breaks)
 }
 
 /// Words a quantifier may look past to reach its noun ("all of the three ripe bananas").
@@ -110,7 +129,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             max: MAX_PROMPT_CHARS,
         });
     }
-    let words = words_of(trimmed);
+    let (words, breaks) = words_of(trimmed);
     let at = |i: usize| words.get(i).map(String::as_str);
     let is_fruit = |w: &str| catalog.find_word(w).is_some();
     let is_noun = |w: &str| is_fruit(w) || lexicon::GENERIC_NOUNS.contains(&w);
@@ -149,15 +168,28 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             continue;
         }
         if lexicon::COLOURS.contains(&w) {
-            let names_noun = at(i + 1).is_some_and(|n| is_noun(n) || lexicon::COLOURS.contains(&n));
+            // A fruit name is a fruit before it is a colour: in a list ("mango, lime, orange,
+            // apple", "the lime orange and apple") it is one of the items.
+            let listed = is_fruit(w)
+                && (breaks[i] || prev.is_some_and(is_fruit) || (i > 0 && breaks[i - 1]));
+            let names_noun = !breaks[i]
+                && at(i + 1).is_some_and(|n| is_noun(n) || lexicon::COLOURS.contains(&n));
             // "the orange" is the fruit, "the orange one" a colour. "Is the banana green?"
             // asks about ripeness; "the green apple" filters by colour.
-            if names_noun {
+            if names_noun && !listed {
                 filters.color.get_or_insert_with(|| w.to_string());
                 continue;
             }
             if w == "green" {
-                properties.push((Property::Ripeness, Degree::Base, true));
+                // "the least green" is the ripest, as "the least ripe" is the greenest.
+                let (degree, flipped) = match prev {
+                    Some("most") => (Degree::Superlative, false),
+                    Some("least") => (Degree::Superlative, true),
+                    Some("more") => (Degree::Comparative, false),
+                    Some("less") => (Degree::Comparative, true),
+                    _ => (Degree::Base, false),
+                };
+                properties.push((Property::Ripeness, degree, !flipped));
                 continue;
             }
             if !is_fruit(w) {
@@ -249,7 +281,9 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         .iter()
         .filter(|p| p.1 == Degree::Superlative)
         .count();
-    let ranked = has(lexicon::RANKING) || (superlatives >= 2 && has(&["from"]) && has(&["to"]));
+    let ranked = has(lexicon::RANKING)
+        || (has(&["list"]) && has(&["by"]))
+        || (superlatives >= 2 && has(&["from"]) && has(&["to"]));
     // The property and direction come from the first property word: "from softest to
     // hardest" ranks by softness.
     let (property, _, flipped) =
@@ -258,7 +292,12 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             .copied()
             .unwrap_or((Property::Hardness, Degree::Base, false));
     let comparative = properties.iter().any(|p| p.1 == Degree::Comparative);
-    let superlative = superlatives > 0;
+    // "Which avocado is ready to eat?", "which one is soft?": selects one, as the
+    // superlative does; "which fruits are ripe?" asks about each.
+    let selects = words.first().is_some_and(|w| w == "which")
+        && !properties.is_empty()
+        && !(plural || generic_plural);
+    let superlative = superlatives > 0 || selects;
     let intent = if ranked {
         Intent::Summarize
     } else if (comparative || has(lexicon::COMPARING)) && targets.len() >= 2 {
@@ -271,7 +310,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         || targets.len() > 1
         || plural
         || filters.count.is_some_and(|n| n > 1)
-        || has(lexicon::SUMMARISING)
+        // "Describe the avocado", "tell me how firm the avocado is": one object is identified.
+        || (has(lexicon::SUMMARISING) && !(targets.len() == 1 && !generic))
     {
         Intent::Summarize
     } else {
@@ -488,7 +528,51 @@ mod tests {
             (Intent::Extreme, Property::Hardness)
         );
         let query = q("Which fruit is ready to eat?");
-        assert_eq!(query.property, Property::Ripeness);
+        assert_eq!(
+            (query.intent, query.property, query.extreme),
+            (Intent::Extreme, Property::Ripeness, Some(Extreme::Most))
+        );
+    }
+
+    #[test]
+    fn which_of_one_kind_with_a_plain_property_selects_among_them() {
+        let query = q("Which avocado is ready to eat?");
+        assert_eq!(
+            (query.intent, query.property, query.extreme, query.targets),
+            (
+                Intent::Extreme,
+                Property::Ripeness,
+                Some(Extreme::Most),
+                names(&["avocado"])
+            )
+        );
+        let query = q("Which banana is soft?");
+        assert_eq!(query.intent, Intent::Extreme);
+        let query = q("Which bananas are ripe?");
+        assert_eq!(query.intent, Intent::Summarize);
+        let query = q("Is the avocado ripe?");
+        assert_eq!(query.intent, Intent::Identify);
+    }
+
+    #[test]
+    fn a_fruit_name_in_a_list_is_a_fruit_not_a_colour() {
+        for prompt in [
+            "mango, lime, orange, apple: which is the softest?",
+            "Of the mango, the orange and the apple, which is softest?",
+            "lime orange apple mango which is softest",
+            "orange, mango: which is softer?",
+        ] {
+            let query = q(prompt);
+            assert!(
+                query.targets.contains(&"orange".to_string()),
+                "{prompt}: {query:?}"
+            );
+            assert_eq!(query.filters.color, None, "{prompt}");
+        }
+        let query = q("Is the orange one riper than the green apple?");
+        assert_eq!(query.filters.color.as_deref(), Some("orange"));
+        let query = q("Which is softer, the orange apple or the banana?");
+        assert_eq!(query.filters.color.as_deref(), Some("orange"));
     }
 
     #[test]
