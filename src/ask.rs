@@ -146,6 +146,22 @@ impl TwinOptions {
     }
 }
 
+/// A scene file a question can be asked about: it parses (`Scene::load`) and, placed in the
+/// twin's world, every object rests where the file puts it, fits the table, and the camera
+/// stands outside them. `scene check`, `ask`, `serve`, `twin` and `bench ask` all load
+/// through here, so that what one refuses the others refuse with the same message.
+pub fn load_scene(
+    path: &Path,
+    catalog: &FruitCatalog,
+) -> Result<(Scene, tactex_sim::world::SimWorld)> {
+    let scene = Scene::load(path, catalog)?;
+    let world = tactex_sim::world::SimWorld::from_scene(&scene)?;
+    world
+        .check_as_placed(&scene)
+        .map_err(|why| anyhow::anyhow!("{}: {why}", path.display()))?;
+    Ok((scene, world))
+}
+
 /// The profile at `path` (`--sensor`), or the built-in GelSight Mini.
 pub fn load_sensor(path: Option<&Path>) -> Result<SensorProfile> {
     match path {
@@ -546,7 +562,7 @@ pub fn run(args: &AskArgs) -> Result<()> {
                 bail!("--session: only with --backend replay");
             }
             let path = args.scene.clone().unwrap_or_else(crate::default_scene);
-            let scene = Scene::load(&path, &catalog)?;
+            let (scene, _) = load_scene(&path, &catalog)?;
             let opened = args.twin.open()?;
             let sensor = with_gel_modulus(opened.sensor.clone(), args.gel_modulus_mpa)?;
             let twin = Twin {

@@ -92,7 +92,7 @@ pub fn run(args: &AskBenchArgs) -> Result<()> {
     let catalog = FruitCatalog::builtin();
     tactex_core::query::parse(&args.prompt, &catalog).context("--prompt")?;
     let path = args.scene.clone().unwrap_or_else(crate::default_scene);
-    let scene = Scene::load(&path, &catalog)?;
+    let (scene, _) = crate::ask::load_scene(&path, &catalog)?;
     let sensor = load_sensor(args.sensor.as_deref())?;
     let detector = DetectorChoice::parse("classical")?;
     let renderer: Arc<dyn SceneRenderer> = Arc::new(CpuSceneRenderer);

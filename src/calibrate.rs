@@ -3,8 +3,8 @@
 //! noise, and writes a sensor profile (TOML + its background PNG beside it).
 
 use crate::ball_presses::{self, Split, contact_box, rebuild};
+use crate::flag_range::{above, within};
 use crate::output::write_profile_atomic;
-use crate::press::positive;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbImage;
@@ -32,9 +32,11 @@ pub struct CalibrateArgs {
     /// The sensor's no-contact frame.
     #[arg(long)]
     pub background: PathBuf,
-    #[arg(long)]
+    /// The ball's radius (mm, above 0 up to 100).
+    #[arg(long, value_parser = above(0.0, 100.0))]
     pub ball_radius_mm: f64,
-    #[arg(long)]
+    /// The frames' scale (mm per pixel, above 0 up to 1).
+    #[arg(long, value_parser = above(0.0, 1.0))]
     pub mm_per_px: f64,
     /// The sensor profile to write (TOML; its background goes beside it as
     /// NAME.background.png).
@@ -43,17 +45,17 @@ pub struct CalibrateArgs {
     /// The profile's name (default: the output file's stem).
     #[arg(long)]
     pub name: Option<String>,
-    /// The gel's Young's modulus (MPa); default the GelSight Mini's.
-    #[arg(long)]
+    /// The gel's Young's modulus (MPa, above 0 up to 1000); default the GelSight Mini's.
+    #[arg(long, value_parser = above(0.0, 1000.0))]
     pub gel_modulus_mpa: Option<f64>,
-    /// The gel's thickness (mm); default the GelSight Mini's.
-    #[arg(long)]
+    /// The gel's thickness (mm, above 0 up to 50); default the GelSight Mini's.
+    #[arg(long, value_parser = above(0.0, 50.0))]
     pub gel_thickness_mm: Option<f64>,
-    /// The gel's Poisson ratio; default the GelSight Mini's.
-    #[arg(long)]
+    /// The gel's Poisson ratio (0 to 0.5); default the GelSight Mini's.
+    #[arg(long, value_parser = within(0.0, 0.5))]
     pub gel_poisson: Option<f64>,
-    /// The camera's frame rate (Hz); default the GelSight Mini's.
-    #[arg(long)]
+    /// The camera's frame rate (Hz, above 0 up to 1000); default the GelSight Mini's.
+    #[arg(long, value_parser = above(0.0, 1000.0))]
     pub frame_rate_hz: Option<f64>,
     /// Which presses to fit: calib (all but every third), eval, or all.
     #[arg(long, value_enum, default_value_t = Split::Calib)]
@@ -64,11 +66,11 @@ pub struct CalibrateArgs {
     /// Table nodes over slope direction.
     #[arg(long, default_value_t = 24)]
     pub dir_bins: u32,
-    /// Largest slope (dw/dr) the table covers.
-    #[arg(long, default_value_t = 2.5)]
-    pub mag_max: f32,
-    /// Weight tying neighbouring table nodes together.
-    #[arg(long, default_value_t = 20.0)]
+    /// Largest slope (dw/dr) the table covers (above 0 up to 100).
+    #[arg(long, default_value_t = 2.5, value_parser = above(0.0, 100.0))]
+    pub mag_max: f64,
+    /// Weight tying neighbouring table nodes together (0 to 1e6).
+    #[arg(long, default_value_t = 20.0, value_parser = within(0.0, 1e6))]
     pub smoothness: f64,
     /// Attribution of the images, stored in the file.
     #[arg(long, default_value = "")]
@@ -139,8 +141,7 @@ fn fit_glow(
 }
 
 pub fn run(args: &CalibrateArgs) -> Result<()> {
-    let radius = positive("ball-radius-mm", args.ball_radius_mm)?;
-    let scale = positive("mm-per-px", args.mm_per_px)?;
+    let (radius, scale) = (args.ball_radius_mm, args.mm_per_px);
     let background = ball_presses::load_rgb(&args.background)?;
     let presses = ball_presses::load(
         &args.images,
@@ -174,7 +175,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         &samples,
         args.mag_bins,
         args.dir_bins,
-        args.mag_max,
+        args.mag_max as f32,
         args.smoothness,
     )
     .context("fitting the shading table")?;
@@ -201,24 +202,11 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
     let table = table.split_flat();
     let stock = SensorProfile::gelsight_mini();
     let gel = GelSpec {
-        modulus_mpa: match args.gel_modulus_mpa {
-            Some(e) => positive("gel-modulus-mpa", e)?,
-            None => stock.spec.gel.modulus_mpa,
-        },
-        poisson: match args.gel_poisson {
-            Some(nu) if nu.is_finite() && (0.0..=0.5).contains(&nu) => nu,
-            Some(nu) => bail!("--gel-poisson: must be in [0, 0.5], got {nu}"),
-            None => stock.spec.gel.poisson,
-        },
-        thickness_mm: match args.gel_thickness_mm {
-            Some(t) => positive("gel-thickness-mm", t)?,
-            None => stock.spec.gel.thickness_mm,
-        },
+        modulus_mpa: args.gel_modulus_mpa.unwrap_or(stock.spec.gel.modulus_mpa),
+        poisson: args.gel_poisson.unwrap_or(stock.spec.gel.poisson),
+        thickness_mm: args.gel_thickness_mm.unwrap_or(stock.spec.gel.thickness_mm),
     };
-    let frame_rate_hz = match args.frame_rate_hz {
-        Some(f) => positive("frame-rate-hz", f)?,
-        None => stock.spec.frame_rate_hz,
-    };
+    let frame_rate_hz = args.frame_rate_hz.unwrap_or(stock.spec.frame_rate_hz);
     let name = match &args.name {
         Some(n) => n.clone(),
         None => args

@@ -2,7 +2,7 @@
 //! paper's contact criterion against a no-contact frame, and the contact circle and region.
 
 use crate::ball_presses::load_rgb;
-use crate::press::positive;
+use crate::flag_range::above;
 use anyhow::{Result, bail};
 use clap::Args;
 use serde::Serialize;
@@ -17,8 +17,9 @@ pub struct ContactArgs {
     /// A no-contact frame of the same sensor.
     #[arg(long)]
     pub reference: PathBuf,
-    /// Millimetres per pixel, to give the circle in mm too (GelSight Mini at 320x240: 0.0634).
-    #[arg(long)]
+    /// Millimetres per pixel (above 0 up to 1), to give the circle in mm too (GelSight Mini
+    /// at 320x240: 0.0634).
+    #[arg(long, value_parser = above(0.0, 1.0))]
     pub mm_per_px: Option<f64>,
     /// Print one JSON object on stdout.
     #[arg(long)]
@@ -40,10 +41,7 @@ struct ContactReport {
 }
 
 pub fn run(args: &ContactArgs) -> Result<()> {
-    let mm_per_px = args
-        .mm_per_px
-        .map(|v| positive("mm-per-px", v))
-        .transpose()?;
+    let mm_per_px = args.mm_per_px;
     let image = load_rgb(&args.image)?;
     let reference = load_rgb(&args.reference)?;
     if reference.dimensions() != image.dimensions() {

@@ -25,6 +25,7 @@ mod eval_grounding;
 mod eval_hardness;
 mod eval_ripeness;
 mod eval_scenarios;
+mod flag_range;
 mod learned_model;
 mod llm_explainer;
 mod markers;
@@ -37,13 +38,11 @@ mod sensor_cli;
 mod serve;
 mod twin;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::scene::Scene;
-use tactex_sim::SimDevices;
 
 // Frames, fields and FFT scratch are allocated and freed by the hundred per press; glibc
 // returns blocks this size to the kernel on every free and faults them back in, which cost
@@ -180,12 +179,8 @@ pub(crate) fn default_scene() -> PathBuf {
 
 fn scene_check(file: &Path) -> Result<()> {
     let catalog = FruitCatalog::builtin();
-    let scene = Scene::load(file, &catalog)?;
-    let sim = SimDevices::from_scene(&scene, 0)?;
-    let world = sim
-        .world
-        .lock()
-        .map_err(|_| anyhow::anyhow!("world lock poisoned"))?;
+    // Checked whole before anything is printed: a scene is valid or refused, never both.
+    let (scene, world) = ask::load_scene(file, &catalog)?;
     println!(
         "{}: scene '{}' is valid: {} objects on a {:.2} x {:.2} m table",
         file.display(),
@@ -210,13 +205,6 @@ fn scene_check(file: &Path) -> Result<()> {
             o.ripeness
                 .as_ref()
                 .map_or(String::new(), |r| format!(", {r}"))
-        );
-    }
-    if world.settle_shift_m > 0.01 {
-        bail!(
-            "{}: objects moved {:.3} m while settling: they overlap or rest unstably",
-            file.display(),
-            world.settle_shift_m
         );
     }
     Ok(())
@@ -254,7 +242,16 @@ fn quiet_on_closed_pipe() {
 
 fn main() -> ExitCode {
     ensure_runtime_dir();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // A value out of its flag's range is a bad value like any other: one line, exit 1.
+        Err(e) if e.kind() == clap::error::ErrorKind::ValueValidation => {
+            let text = e.render().to_string();
+            eprintln!("{}", text.lines().next().unwrap_or("error: invalid value"));
+            return ExitCode::FAILURE;
+        }
+        Err(e) => e.exit(),
+    };
     if !matches!(cli.command, Command::Serve(_) | Command::Twin(_)) {
         quiet_on_closed_pipe();
     }

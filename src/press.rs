@@ -1,6 +1,7 @@
 //! `tactex press`: one press of the GelSight gel into a primitive or a mesh at a chosen
 //! fidelity, reported as JSON or text, with the gel maps written as 16-bit PNGs.
 
+use crate::flag_range::{above, within};
 use crate::output::{write_json_atomic, write_png_atomic, write_png16_atomic};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
@@ -30,48 +31,50 @@ pub struct PressArgs {
     /// The object's shape.
     #[arg(long, value_enum)]
     shape: Shape,
-    /// Sphere radius (mm).
-    #[arg(long, default_value_t = 10.0)]
+    /// Sphere radius (mm, above 0 up to 500).
+    #[arg(long, default_value_t = 10.0, value_parser = above(0.0, 500.0))]
     radius_mm: f64,
-    /// Ellipsoid or box size X,Y,Z (mm; full extents); default a cube or ball of 2 radii.
-    #[arg(long, value_delimiter = ',')]
+    /// Ellipsoid or box size X,Y,Z (mm, full extents, each above 0 up to 1000); default a
+    /// cube or ball of 2 radii.
+    #[arg(long, value_delimiter = ',', value_parser = above(0.0, 1000.0))]
     size_mm: Option<Vec<f64>>,
-    /// Turn of an ellipsoid or box about the pressing axis (degrees).
-    #[arg(long, default_value_t = 0.0)]
+    /// Turn of an ellipsoid or box about the pressing axis (degrees, -360 to 360).
+    #[arg(long, default_value_t = 0.0, value_parser = within(-360.0, 360.0))]
     yaw_deg: f64,
     /// Mesh file (.obj, .gltf, .glb) for --shape mesh, pressed at the middle of its top.
     #[arg(long)]
     mesh: Option<PathBuf>,
-    /// Mesh units to metres (scenes use metres).
-    #[arg(long, default_value_t = 1.0)]
+    /// Mesh units to metres (scenes use metres; above 0 up to 1000).
+    #[arg(long, default_value_t = 1.0, value_parser = above(0.0, 1000.0))]
     mesh_scale: f64,
     /// Object hardness as in scene files: "35A", "55 00", "rigid".
     #[arg(long, conflicts_with = "modulus_mpa")]
     hardness: Option<String>,
-    /// Object Young's modulus instead of a Shore value (MPa).
-    #[arg(long)]
+    /// Object Young's modulus instead of a Shore value (MPa, above 0 up to 1e6).
+    #[arg(long, value_parser = above(0.0, 1e6))]
     modulus_mpa: Option<f64>,
-    /// Object Poisson ratio.
-    #[arg(long, default_value_t = 0.45)]
+    /// Object Poisson ratio (0 to 0.5).
+    #[arg(long, default_value_t = 0.45, value_parser = within(0.0, 0.5))]
     object_poisson: f64,
-    /// The sensor's travel past first touch (mm): total approach of gel and object.
-    #[arg(long)]
+    /// The sensor's travel past first touch (mm, 0 to 30): total approach of gel and object.
+    #[arg(long, value_parser = within(0.0, 30.0))]
     depth_mm: f64,
     /// Contact model.
     #[arg(long, default_value = "layer")]
     fidelity: String,
-    /// Solver cell (mm); default from the contact's size.
-    #[arg(long)]
+    /// Solver cell (mm, 0.02 to 5: a pad of 1,000 cells across down to 4); default from the
+    /// contact's size.
+    #[arg(long, value_parser = within(0.02, 5.0))]
     grid_mm: Option<f64>,
     /// The contact solve stops when one step changes the pressure by less than this
-    /// (relative); `bench contact` measures what looser values trade.
-    #[arg(long, default_value_t = 1e-6)]
+    /// (relative, 1e-12 to 0.5); `bench contact` measures what looser values trade.
+    #[arg(long, default_value_t = 1e-6, value_parser = within(1e-12, 0.5))]
     tolerance: f64,
-    /// Gel thickness (mm); GelSight Mini ~4.
-    #[arg(long)]
+    /// Gel thickness (mm, above 0 up to 50); GelSight Mini ~4.
+    #[arg(long, value_parser = above(0.0, 50.0))]
     gel_thickness_mm: Option<f64>,
-    /// Gel Young's modulus (MPa); GelSight Mini ~0.15-0.45.
-    #[arg(long)]
+    /// Gel Young's modulus (MPa, above 0 up to 1000); GelSight Mini ~0.15-0.45.
+    #[arg(long, value_parser = above(0.0, 1000.0))]
     gel_modulus_mpa: Option<f64>,
     /// Write the gel displacement and pressure maps (16-bit PNG + JSON sidecar), the
     /// rendered GelSight Mini frame (tactile.png) and a no-contact frame (reference.png) here.
@@ -89,8 +92,8 @@ pub struct PressArgs {
     /// are common on other gels); 0x0 for none. Default: the profile's.
     #[arg(long)]
     marker_grid: Option<String>,
-    /// Marker pitch (mm). Default: the profile's.
-    #[arg(long)]
+    /// Marker pitch (mm, above 0 up to 20). Default: the profile's.
+    #[arg(long, value_parser = above(0.0, 20.0))]
     marker_pitch_mm: Option<f64>,
     /// Seed of the rendered frame's camera noise.
     #[arg(long, default_value_t = 0)]
@@ -145,14 +148,6 @@ struct PressReport {
     warnings: Vec<String>,
 }
 
-pub(crate) fn positive(name: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        bail!("--{name}: must be a positive finite number, got {v}")
-    }
-}
-
 fn surface(args: &PressArgs) -> Result<ObjectSurface> {
     let size = |default: f64| -> Result<DVec3> {
         match &args.size_mm {
@@ -160,17 +155,14 @@ fn surface(args: &PressArgs) -> Result<ObjectSurface> {
                 if v.len() != 3 {
                     bail!("--size-mm: give three sizes X,Y,Z in mm, got {}", v.len());
                 }
-                for (axis, x) in ["x", "y", "z"].iter().zip(v) {
-                    positive(&format!("size-mm ({axis})"), *x)?;
-                }
                 Ok(DVec3::new(v[0], v[1], v[2]))
             }
-            None => Ok(DVec3::splat(2.0 * positive("radius-mm", default)?)),
+            None => Ok(DVec3::splat(2.0 * default)),
         }
     };
     Ok(match args.shape {
         Shape::Sphere => ObjectSurface::Sphere {
-            radius_mm: positive("radius-mm", args.radius_mm)?,
+            radius_mm: args.radius_mm,
             centre_mm: DVec2::ZERO,
         },
         Shape::Ellipsoid => ObjectSurface::Ellipsoid {
@@ -188,7 +180,6 @@ fn surface(args: &PressArgs) -> Result<ObjectSurface> {
                 .mesh
                 .as_ref()
                 .context("--shape mesh needs --mesh FILE")?;
-            positive("mesh-scale", args.mesh_scale)?;
             let mesh = tactex_sim::mesh::load(path)?;
             mesh.validate(&path.display().to_string())?;
             ObjectSurface::from_mesh_top(&mesh, args.mesh_scale * 1e3)
@@ -199,7 +190,7 @@ fn surface(args: &PressArgs) -> Result<ObjectSurface> {
 fn object(args: &PressArgs) -> Result<Hardness> {
     match (&args.hardness, args.modulus_mpa) {
         (Some(text), _) => Hardness::parse(text).with_context(|| format!("--hardness {text:?}")),
-        (None, Some(e)) => Ok(Hardness::ModulusMpa(positive("modulus-mpa", e)?)),
+        (None, Some(e)) => Ok(Hardness::ModulusMpa(e)),
         (None, None) => bail!("give the object's --hardness (e.g. \"35A\") or --modulus-mpa"),
     }
 }
@@ -209,24 +200,6 @@ pub fn run(args: &PressArgs) -> Result<()> {
         .fidelity
         .parse()
         .map_err(|e| anyhow::anyhow!("--fidelity: {e}"))?;
-    if !(args.depth_mm.is_finite() && args.depth_mm >= 0.0) {
-        bail!(
-            "--depth-mm: must be a finite number >= 0, got {}",
-            args.depth_mm
-        );
-    }
-    if let Some(cell) = args.grid_mm {
-        positive("grid-mm", cell)?;
-    }
-    if !(args.tolerance.is_finite() && args.tolerance > 0.0 && args.tolerance < 1.0) {
-        bail!("--tolerance: must be in (0, 1), got {}", args.tolerance);
-    }
-    if !(args.object_poisson.is_finite() && (0.0..=0.5).contains(&args.object_poisson)) {
-        bail!(
-            "--object-poisson: must be in [0, 0.5], got {}",
-            args.object_poisson
-        );
-    }
     let hardness = object(args)?;
     let surface = surface(args)?;
     let mut profile = crate::ask::load_sensor(args.sensor.as_deref())?;
@@ -243,14 +216,14 @@ pub fn run(args: &PressArgs) -> Result<()> {
         spec.markers.rows = rows;
     }
     if let Some(pitch) = args.marker_pitch_mm {
-        spec.markers.pitch_mm = positive("marker-pitch-mm", pitch)?;
+        spec.markers.pitch_mm = pitch;
     }
     let mut gel = spec.gel;
     if let Some(t) = args.gel_thickness_mm {
-        gel.thickness_mm = positive("gel-thickness-mm", t)?;
+        gel.thickness_mm = t;
     }
     if let Some(e) = args.gel_modulus_mpa {
-        gel.modulus_mpa = positive("gel-modulus-mpa", e)?;
+        gel.modulus_mpa = e;
     }
     spec.gel = gel;
     let pad = Rect::centred(DVec2::from(spec.pad_size_mm()) / 2.0);

@@ -330,14 +330,58 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
             "name = \"x\"\n[[objects]]\nkind = \"lime\"\nposition_m = [0.0, 1.5]\n",
             "objects[0].position_m: [0, 1.5] is off the table",
         ),
+        // Nonsense a scene must not carry into the world: sizes no object on a table has,
+        // objects placed in one another, a camera that cannot see the table or stands in a
+        // fruit. `scene check` and `ask` refuse them alike.
+        (
+            "name = \"x\"\n[[objects]]\nkind = \"sphere\"\nradius_m = 1e308\nhardness = \"40A\"\nposition_m = [0, 0]\n",
+            "objects[0].radius_m: 1e308 m is not a size an object on a table has",
+        ),
+        (
+            "name = \"x\"\n[[objects]]\nkind = \"sphere\"\nradius_m = 1e-12\nhardness = \"40A\"\nposition_m = [0, 0]\n",
+            "objects[0].radius_m: 1e-12 m is not a size an object on a table has",
+        ),
+        (
+            "name = \"x\"\n[table]\nsize_m = [1e9, 0.4]\n",
+            "table.size_m: [1e9, 0.4] m: each side must be 0.05 to 10 m",
+        ),
+        (
+            "name = \"x\"\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n",
+            "objects[0] (apple) and objects[1] (apple) are placed in one another",
+        ),
+        (
+            "name = \"x\"\n[camera]\nposition_m = [0.0, 0.0, 0.7]\nlook_at_m = [0.0, 0.0, 2.0]\n[[objects]]\nkind = \"lime\"\nposition_m = [0, 0]\n",
+            "camera: a camera at [0.0, 0.0, 0.7] looking at [0.0, 0.0, 2.0] does not look down at the table",
+        ),
+        (
+            "name = \"x\"\n[camera]\nposition_m = [0.0, 0.0, 0.02]\nlook_at_m = [0.0, 0.1, 0.0]\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n",
+            "camera: at [0.0, 0.0, 0.02] it stands inside objects[0] (apple)",
+        ),
     ];
     for (body, expected) in cases {
         let (_dir, path) = bad_scene(body);
         let e = fails(&["ask", "--scene", &path, softest]);
         assert!(e.contains(&format!("{path}: {expected}")), "{e}");
+        let out = tactex(&["scene", "check", &path]);
+        assert!(out.stdout.is_empty(), "refused, not also printed valid");
         let e = fails(&["scene", "check", &path]);
         assert!(e.contains(expected), "{e}");
     }
+
+    // A mesh a million times too large: the scale is refused before the mesh is built.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("tri.obj"),
+        "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nv 0 0 0.05\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n",
+    )
+    .unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, "name = \"x\"\n[[objects]]\nkind = \"mesh\"\nmesh = \"tri.obj\"\nscale = 1e6\nhardness = \"40A\"\nposition_m = [0, 0]\n").unwrap();
+    let e = fails(&["scene", "check", path.to_str().unwrap()]);
+    assert!(
+        e.contains("objects[0].scale: 1e6 is not a mesh unit in metres"),
+        "{e}"
+    );
 
     // A mesh file that exists but is not a mesh.
     let dir = tempfile::tempdir().unwrap();
@@ -352,10 +396,8 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
 
     let e = fails(&["ask", "  "]);
     assert!(e.contains("prompt: empty"), "{e}");
-    // A bad flag value is clap's usage error (exit 2), naming the flag and the choices.
-    let out = tactex(&["ask", "--estimator", "magic", softest]);
-    let e = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{e}");
+    // A bad flag value is a bad value like any other: one line naming the flag and choices.
+    let e = fails(&["ask", "--estimator", "magic", softest]);
     assert!(
         e.contains("--estimator") && e.contains("unknown estimator \"magic\""),
         "{e}"

@@ -246,8 +246,21 @@ impl Scene {
                 .and_then(|t| t.color)
                 .unwrap_or(DEFAULT_TABLE_COLOR),
         };
-        if table.size_m.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-            return Err(err("table.size_m", "must be finite and positive".into()));
+        if table
+            .size_m
+            .iter()
+            .any(|s| !(s.is_finite() && (TABLE_SIZE_M[0]..=TABLE_SIZE_M[1]).contains(s)))
+        {
+            return Err(err(
+                "table.size_m",
+                format!(
+                    "[{}, {}] m: each side must be {} to {} m",
+                    show(table.size_m[0]),
+                    show(table.size_m[1]),
+                    TABLE_SIZE_M[0],
+                    TABLE_SIZE_M[1]
+                ),
+            ));
         }
         check_color(&table.color).map_err(|m| err("table.color", m))?;
 
@@ -295,6 +308,17 @@ impl Scene {
                     "must differ from camera.position_m".into(),
                 )
             })?;
+        // A camera that cannot see the table answers nothing: it must stand above the table
+        // top and look down at least 10 degrees.
+        let forward = (DVec3::from_array(target) - DVec3::from_array(eye)).normalize();
+        if eye[2] <= 0.0 || forward.z > -(10f64.to_radians().sin()) {
+            return Err(err(
+                "camera",
+                format!(
+                    "a camera at {eye:?} looking at {target:?} does not look down at the table (it must stand above z = 0 and look at least 10 degrees down)"
+                ),
+            ));
+        }
         let k = raw.intrinsics.unwrap_or_default();
         let finite = [k.fx, k.fy, k.cx, k.cy].iter().all(|v| v.is_finite());
         if !finite
@@ -322,13 +346,19 @@ impl Scene {
         err: &impl Fn(&str, String) -> SceneError,
     ) -> Result<SceneObject, SceneError> {
         let field = |name: &str| format!("objects[{i}].{name}");
-        let positive = |name: &str, v: f64| -> Result<f64, SceneError> {
-            if v.is_finite() && v > 0.0 {
+        // Sizes in metres an object on a table can have: 1 mm to 1 m.
+        let size = |name: &str, v: f64| -> Result<f64, SceneError> {
+            if v.is_finite() && (OBJECT_SIZE_M[0]..=OBJECT_SIZE_M[1]).contains(&v) {
                 Ok(v)
             } else {
                 Err(err(
                     &field(name),
-                    format!("must be finite and positive, got {v}"),
+                    format!(
+                        "{} m is not a size an object on a table has ({} to {} m)",
+                        show(v),
+                        OBJECT_SIZE_M[0],
+                        OBJECT_SIZE_M[1]
+                    ),
                 ))
             }
         };
@@ -339,7 +369,7 @@ impl Scene {
             let v =
                 v.ok_or_else(|| err(&field(name), format!("required for kind '{}'", o.kind)))?;
             for x in v {
-                positive(name, x)?;
+                size(name, x)?;
             }
             Ok(v)
         };
@@ -408,7 +438,7 @@ impl Scene {
                 }
                 let kind = match kind_name.as_str() {
                     "sphere" => ObjectKind::Sphere {
-                        radius_m: positive("radius_m", need("radius_m", o.radius_m)?)?,
+                        radius_m: size("radius_m", need("radius_m", o.radius_m)?)?,
                     },
                     "ellipsoid" => ObjectKind::Ellipsoid {
                         radii_m: need3("radii_m", o.radii_m)?,
@@ -429,7 +459,23 @@ impl Scene {
                         }
                         ObjectKind::Mesh {
                             path,
-                            scale: positive("scale", o.scale.unwrap_or(1.0))?,
+                            scale: {
+                                let scale = o.scale.unwrap_or(1.0);
+                                if !(scale.is_finite()
+                                    && (MESH_SCALE[0]..=MESH_SCALE[1]).contains(&scale))
+                                {
+                                    return Err(err(
+                                        &field("scale"),
+                                        format!(
+                                            "{} is not a mesh unit in metres ({} for millimetres to {})",
+                                            show(scale),
+                                            MESH_SCALE[0] * 10.0,
+                                            MESH_SCALE[1]
+                                        ),
+                                    ));
+                                }
+                                scale
+                            },
                         }
                     }
                 };
@@ -498,6 +544,22 @@ impl Scene {
             color,
             poisson,
         })
+    }
+}
+
+/// An object's radius, radii or sides (m): from a 1 mm berry to a 1 m melon on a table.
+pub const OBJECT_SIZE_M: [f64; 2] = [1e-3, 1.0];
+/// A table's sides (m).
+pub const TABLE_SIZE_M: [f64; 2] = [0.05, 10.0];
+/// Mesh units in metres: from 0.1 mm (1e-4) to 10 m.
+pub const MESH_SCALE: [f64; 2] = [1e-4, 10.0];
+
+/// A number shown short: 1e308 as "1e308", not 309 digits.
+fn show(v: f64) -> String {
+    if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
     }
 }
 

@@ -31,6 +31,29 @@ impl TriMesh {
         )
     }
 
+    /// Whether `p` lies inside the closed mesh: a vertical ray from it crosses the surface an
+    /// odd number of times. The ray is nudged off the axes so that it misses edges.
+    pub fn contains(&self, p: DVec3) -> bool {
+        let (x, y) = (p.x + 1.37e-9, p.y + 2.71e-9);
+        let mut crossings = 0;
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| self.vertices[i as usize]);
+            let d = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+            if d.abs() < 1e-18 {
+                continue;
+            }
+            let u = ((x - a.x) * (c.y - a.y) - (c.x - a.x) * (y - a.y)) / d;
+            let v = ((b.x - a.x) * (y - a.y) - (x - a.x) * (b.y - a.y)) / d;
+            if u < 0.0 || v < 0.0 || u + v > 1.0 {
+                continue;
+            }
+            if a.z + u * (b.z - a.z) + v * (c.z - a.z) > p.z {
+                crossings += 1;
+            }
+        }
+        crossings % 2 == 1
+    }
+
     /// Scales each axis so the bounding box is `size` and centres it at the origin.
     pub fn fit_box(mut self, size: DVec3) -> Self {
         let (lo, hi) = self.bounds();
@@ -422,6 +445,20 @@ fn gltf_node(
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn a_point_is_inside_a_closed_mesh_by_the_parity_of_a_vertical_ray() {
+        let ball = ellipsoid(DVec3::new(0.03, 0.02, 0.04));
+        assert!(ball.contains(DVec3::ZERO));
+        assert!(ball.contains(DVec3::new(0.025, 0.0, 0.0)));
+        assert!(!ball.contains(DVec3::new(0.035, 0.0, 0.0)));
+        assert!(!ball.contains(DVec3::new(0.0, 0.0, 0.05)));
+        assert!(!ball.contains(DVec3::new(0.0, 0.0, -0.05)));
+        let cube = cuboid(DVec3::splat(0.02));
+        assert!(cube.contains(DVec3::new(0.009, -0.009, 0.009)));
+        assert!(!cube.contains(DVec3::new(0.011, 0.0, 0.0)));
+    }
+
     use super::*;
 
     #[test]

@@ -54,6 +54,9 @@ pub enum WorldError {
     },
 }
 
+/// An object that moved further than this while settling was not placed where it can rest.
+pub const SETTLE_LIMIT_M: f64 = 0.01;
+
 /// Height the tool parks at before a run (m).
 pub const TOOL_PARK_Z_M: f64 = 0.35;
 
@@ -174,6 +177,93 @@ impl SimWorld {
         })
     }
 
+    /// What makes the world as placed not a table a question can be asked about: an object
+    /// that moved over 1 cm while settling (it overlaps another, or rests unstably), one
+    /// larger than the table, or a camera inside an object. `scene` names the file.
+    pub fn check_as_placed(&self, scene: &Scene) -> Result<(), String> {
+        let table_side = self.table.size_m[0].min(self.table.size_m[1]);
+        for (i, (o, placed)) in self.objects.iter().zip(&scene.objects).enumerate() {
+            let (lo, hi) = o.mesh.bounds();
+            let extent = (hi - lo).max_element();
+            if extent > table_side {
+                return Err(format!(
+                    "objects[{i}] ({}): {extent:.2} m across, larger than the {table_side:.2} m table",
+                    o.label
+                ));
+            }
+            let moved = (o.pose.position.truncate()
+                - glam::DVec2::new(placed.position_m[0], placed.position_m[1]))
+            .length();
+            if moved > SETTLE_LIMIT_M {
+                let other = self
+                    .objects
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != i)
+                    .min_by(|a, b| {
+                        let d = |x: &SimObject| (x.centre - o.centre).truncate().length();
+                        d(a.1).total_cmp(&d(b.1))
+                    })
+                    .map(|(j, x)| format!(" (nearest: objects[{j}], {})", x.label))
+                    .unwrap_or_default();
+                return Err(format!(
+                    "objects[{i}] ({}) moved {moved:.3} m while settling: it overlaps another object or rests unstably{other}",
+                    o.label
+                ));
+            }
+        }
+        if let Some((i, j)) = self.interpenetrating() {
+            let (a, b) = (&self.objects[i], &self.objects[j]);
+            return Err(format!(
+                "objects[{i}] ({}) and objects[{j}] ({}) are placed in one another",
+                a.label, b.label
+            ));
+        }
+        let eye = self.camera_pose.position;
+        if let Some((i, o)) = self.objects.iter().enumerate().find(|(_, o)| {
+            let (lo, hi) = o.mesh.bounds();
+            eye.cmpge(lo).all() && eye.cmple(hi).all()
+        }) {
+            return Err(format!(
+                "camera: at {:?} it stands inside objects[{i}] ({})",
+                eye.to_array(),
+                o.label
+            ));
+        }
+        Ok(())
+    }
+
+    /// The first pair of objects of which one is deep in the other: over a fifth of its
+    /// vertices, drawn a fifth of the way in towards its centre (touching surfaces never
+    /// reach that deep), lie inside the other.
+    fn interpenetrating(&self) -> Option<(usize, usize)> {
+        for (i, a) in self.objects.iter().enumerate() {
+            let (alo, ahi) = a.mesh.bounds();
+            for (j, b) in self.objects.iter().enumerate().skip(i + 1) {
+                let (blo, bhi) = b.mesh.bounds();
+                if alo.cmpgt(bhi).any() || blo.cmpgt(ahi).any() {
+                    continue;
+                }
+                let deep = |x: &SimObject, y: &SimObject| {
+                    let step = (x.mesh.vertices.len() / 150).max(1);
+                    let samples: Vec<DVec3> = x
+                        .mesh
+                        .vertices
+                        .iter()
+                        .step_by(step)
+                        .map(|v| x.centre + (*v - x.centre) * 0.8)
+                        .collect();
+                    let inside = samples.iter().filter(|p| y.mesh.contains(**p)).count();
+                    inside * 5 > samples.len()
+                };
+                if deep(a, b) || deep(b, a) {
+                    return Some((i, j));
+                }
+            }
+        }
+        None
+    }
+
     /// For each object, whether another comes within `gap_m` of it (vertex to vertex: the
     /// meshes' vertices lie under 3 mm apart, so a touch reads as under 3 mm).
     pub fn touching(&self, gap_m: f64) -> Vec<bool> {
@@ -261,5 +351,33 @@ mod tests {
         }
         let orange = &world.objects[0];
         assert!((orange.centre.truncate() - glam::DVec2::new(0.1, 0.05)).length() < 0.005);
+    }
+
+    #[test]
+    fn fruit_placed_in_one_another_are_found_and_touching_ones_are_not() {
+        let catalog = FruitCatalog::builtin();
+        let three = Scene::parse(
+            "name = \"t\"\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n[[objects]]\nkind = \"lime\"\nposition_m = [0.2, 0]\n",
+            Path::new("t.toml"),
+            &catalog,
+        )
+        .unwrap();
+        let world = SimWorld::from_scene(&three).unwrap();
+        assert_eq!(world.interpenetrating(), Some((0, 1)));
+        // Crowded tables as the evaluations draw them: half the fruits put against another,
+        // settled touching. None is deep in another.
+        let variation = crate::scene_random::Variation {
+            touching_share: 0.6,
+            ..Default::default()
+        };
+        let kinds = [
+            "apple", "banana", "lime", "orange", "mango", "kiwi", "peach", "lemon",
+        ];
+        for seed in 0..6 {
+            let scene =
+                crate::scene_random::random_scene(&kinds, &catalog, seed, &variation).unwrap();
+            let world = SimWorld::from_scene(&scene).unwrap();
+            assert_eq!(world.interpenetrating(), None, "seed {seed}");
+        }
     }
 }

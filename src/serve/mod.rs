@@ -94,7 +94,7 @@ pub fn run(args: &ServeArgs) -> Result<()> {
     }
     let catalog = FruitCatalog::builtin();
     let path = args.scene.clone().unwrap_or_else(crate::default_scene);
-    let scene = Scene::load(&path, &catalog)?;
+    let (scene, _) = crate::ask::load_scene(&path, &catalog)?;
     let OpenedTwin {
         detector,
         renderer,

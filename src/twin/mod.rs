@@ -19,7 +19,6 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::{RgbdCamera, TactileSensor};
-use tactex_core::scene::Scene;
 use tactex_hw::session::{SessionRecorder, TwinRecord};
 use tactex_sim::SimDevices;
 use tactex_sim::camera::SimCamera;
@@ -115,7 +114,7 @@ pub fn run(args: &TwinArgs) -> Result<()> {
     }
     let catalog = FruitCatalog::builtin();
     let path = args.scene.clone().unwrap_or_else(crate::default_scene);
-    let scene = Scene::load(&path, &catalog)?;
+    let (scene, _) = crate::ask::load_scene(&path, &catalog)?;
     let sensor = crate::ask::load_sensor(args.sensor.as_deref())?;
     let sensor_id = sensor.id();
     let sim = SimDevices::with_sensor(&scene, args.seed, sensor, args.fidelity)?;

@@ -311,7 +311,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         || plural
         || filters.count.is_some_and(|n| n > 1)
         // "Describe the avocado", "tell me how firm the avocado is": one object is identified.
-        || (has(lexicon::SUMMARISING) && !(targets.len() == 1 && !generic))
+        || (has(lexicon::SUMMARISING) && (targets.len() != 1 || generic))
     {
         Intent::Summarize
     } else {
