@@ -157,7 +157,7 @@ pub fn load_scene(
     let scene = Scene::load(path, catalog)?;
     let world = tactex_sim::world::SimWorld::from_scene(&scene)?;
     world
-        .check_as_placed(&scene)
+        .check_as_placed()
         .map_err(|why| anyhow::anyhow!("{}: {why}", path.display()))?;
     Ok((scene, world))
 }

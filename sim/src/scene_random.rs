@@ -241,9 +241,9 @@ mod tests {
         assert_ne!(a.objects[0].position_m, c.objects[0].position_m);
         let world = SimWorld::from_scene(&a).unwrap();
         assert!(
-            world.settle_shift_m < 0.01,
+            world.settle_shift_m() < 0.01,
             "moved {} m",
-            world.settle_shift_m
+            world.settle_shift_m()
         );
         for (i, o) in world.objects.iter().enumerate() {
             let (lo, hi) = o.mesh.bounds();

@@ -21,6 +21,8 @@ pub struct SimObject {
     pub pose: Pose,
     /// Centre of the world-frame bounding box (ground truth for positions).
     pub centre: DVec3,
+    /// How far it moved across the table while settling from where the scene put it (m).
+    pub settle_shift_m: f64,
 }
 
 #[derive(Debug)]
@@ -32,8 +34,6 @@ pub struct SimWorld {
     /// Pose of the tactile pad (centre of the gel surface, tool z pointing at the object).
     pub tool: Pose,
     pub time_s: f64,
-    /// Largest distance any object moved while settling (m).
-    pub settle_shift_m: f64,
 }
 
 pub type SharedWorld = Arc<Mutex<SimWorld>>;
@@ -139,7 +139,6 @@ impl SimWorld {
         }
 
         let mut objects = Vec::new();
-        let mut settle_shift_m: f64 = 0.0;
         for ((o, local), (handle, start)) in scene
             .objects
             .iter()
@@ -153,7 +152,6 @@ impl SimWorld {
                 DVec3::new(t.x as f64, t.y as f64, t.z as f64),
                 DQuat::from_xyzw(r.x as f64, r.y as f64, r.z as f64, r.w as f64).normalize(),
             );
-            settle_shift_m = settle_shift_m.max((pose.position - *start).truncate().length());
             let mesh = local.transformed(pose.rotation, pose.position);
             let (lo, hi) = mesh.bounds();
             objects.push(SimObject {
@@ -164,6 +162,7 @@ impl SimWorld {
                 mesh,
                 pose,
                 centre: (lo + hi) / 2.0,
+                settle_shift_m: (pose.position - *start).truncate().length(),
             });
         }
         Ok(SimWorld {
@@ -173,16 +172,15 @@ impl SimWorld {
             intrinsics: scene.intrinsics,
             tool: Pose::tool_down(DVec3::new(0.0, 0.0, TOOL_PARK_Z_M)),
             time_s: 0.0,
-            settle_shift_m,
         })
     }
 
     /// What makes the world as placed not a table a question can be asked about: an object
     /// that moved over 1 cm while settling (it overlaps another, or rests unstably), one
     /// larger than the table, or a camera inside an object. `scene` names the file.
-    pub fn check_as_placed(&self, scene: &Scene) -> Result<(), String> {
+    pub fn check_as_placed(&self) -> Result<(), String> {
         let table_side = self.table.size_m[0].min(self.table.size_m[1]);
-        for (i, (o, placed)) in self.objects.iter().zip(&scene.objects).enumerate() {
+        for (i, o) in self.objects.iter().enumerate() {
             let (lo, hi) = o.mesh.bounds();
             let extent = (hi - lo).max_element();
             if extent > table_side {
@@ -191,9 +189,7 @@ impl SimWorld {
                     o.label
                 ));
             }
-            let moved = (o.pose.position.truncate()
-                - glam::DVec2::new(placed.position_m[0], placed.position_m[1]))
-            .length();
+            let moved = o.settle_shift_m;
             if moved > SETTLE_LIMIT_M {
                 let other = self
                     .objects
@@ -262,6 +258,14 @@ impl SimWorld {
             }
         }
         None
+    }
+
+    /// The furthest any object moved while settling (m).
+    pub fn settle_shift_m(&self) -> f64 {
+        self.objects
+            .iter()
+            .map(|o| o.settle_shift_m)
+            .fold(0.0, f64::max)
     }
 
     /// For each object, whether another comes within `gap_m` of it (vertex to vertex: the
@@ -341,9 +345,9 @@ mod tests {
         .unwrap();
         let world = SimWorld::from_scene(&scene).unwrap();
         assert!(
-            world.settle_shift_m < 0.005,
+            world.settle_shift_m() < 0.005,
             "moved {} m while settling",
-            world.settle_shift_m
+            world.settle_shift_m()
         );
         for o in &world.objects {
             let (lo, _) = o.mesh.bounds();

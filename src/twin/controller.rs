@@ -150,8 +150,6 @@ pub struct Controller {
     pose: TcpPoseMm,
     /// Moves accepted and not yet ended, in order: the controller's command queue.
     queue: VecDeque<Moving>,
-    /// Motion commands accepted since the controller started.
-    accepted: u16,
     last_speed_mm_s: f64,
     /// Why the last fault was raised or the last command not executed, for `/state`.
     pub last_notice: Option<String>,
@@ -195,7 +193,6 @@ impl Controller {
             warning: 0,
             pose: HOME,
             queue: VecDeque::new(),
-            accepted: 0,
             last_speed_mm_s: 0.0,
             last_notice: None,
             unlogged: Vec::new(),
@@ -533,7 +530,6 @@ impl Controller {
             started,
             duration: Duration::from_secs_f64(seconds),
         });
-        self.accepted = self.accepted.wrapping_add(1);
         self.last_speed_mm_s = speed_mm_s;
         self.state = motion::MOVING;
     }

@@ -126,7 +126,7 @@ fn with_pad_placed<T>(twin: &Twin, capture: impl FnOnce(Pose) -> Result<T>) -> R
 }
 
 /// The GelSight's next frame, written into the session when the twin records one.
-pub fn gelsight_capture(twin: &Twin) -> Result<TactileFrame> {
+fn gelsight_capture(twin: &Twin) -> Result<TactileFrame> {
     with_pad_placed(twin, |pad| {
         let frame = twin
             .gelsight
