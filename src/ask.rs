@@ -611,7 +611,13 @@ fn print_answer(a: &Answer) {
     if let Some(notice) = &a.explain_notice {
         eprintln!("note: {notice}");
     }
-    println!("{}\n", a.answer);
+    // An LLM's answer is outside text: its lines kept, any control characters shown.
+    let answer: Vec<String> = a
+        .answer
+        .lines()
+        .map(tactex_core::printable::printable)
+        .collect();
+    println!("{}\n", answer.join("\n"));
     println!(
         "{:<3} {:<11} {:<13} {:>24} {:>9} {:>9} {:>10} {:>13} {:>13}  ripeness",
         "#",

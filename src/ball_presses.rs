@@ -3,7 +3,7 @@
 //! 6th, ...) is held out for evaluation, the others calibrate; and a press rebuilt in the
 //! twin (the ball pressed until the solver's contact radius is the annotated one).
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::ValueEnum;
 use glam::DVec2;
 use image::RgbImage;
@@ -37,8 +37,8 @@ impl Split {
 }
 
 pub fn load_rgb(path: &Path) -> Result<RgbImage> {
-    Ok(image::open(path)
-        .with_context(|| format!("{}: cannot read the image", path.display()))?
+    Ok(tactex_core::image_file::open(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot read the image: {e}", path.display()))?
         .to_rgb8())
 }
 

@@ -7,7 +7,7 @@
 use crate::ask::{Twin, load_sensor};
 use crate::bench_contact::median;
 use crate::estimator_choice::EstimatorChoice;
-use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -169,11 +169,12 @@ pub fn run(args: &AskBenchArgs) -> Result<()> {
         threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
         rows,
     };
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         write_bytes_atomic(&dir.join("ask_bench.md"), markdown(&report).as_bytes())?;
         write_json_atomic(&dir.join("ask_bench.json"), &report)?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

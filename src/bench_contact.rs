@@ -4,7 +4,7 @@
 //! for the default grid, what the conjugate gradient's stopping tolerance and its
 //! preconditioner buy.
 
-use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::plot;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -344,9 +344,9 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
     }
     bar.finish_and_clear();
 
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create", dir.display()))?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         write_bytes_atomic(&dir.join("contact_bench.csv"), csv(&rows).as_bytes())?;
         write_bytes_atomic(&dir.join("contact_bench.md"), markdown(&rows).as_bytes())?;
         write_json_atomic(&dir.join("contact_bench.json"), &rows)?;
@@ -374,6 +374,7 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
             "force error vs finest layer (%)",
             &points,
         )?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&rows)?);

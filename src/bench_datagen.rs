@@ -3,7 +3,7 @@
 //! and the time the paper's 5,000-sequence pretraining set would take at that rate.
 
 use crate::datagen_tactile::{SampleFormat, TactileDatagenArgs, generate};
-use crate::output::write_json_atomic;
+use crate::output::{OutputDir, write_json_atomic};
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -126,10 +126,11 @@ pub fn run(args: &DatagenBenchArgs) -> Result<()> {
         shapes: args.shapes.clone(),
         rows,
     };
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create", dir.display()))?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         write_json_atomic(&dir.join("datagen_bench.json"), &bench)?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&bench)?);

@@ -5,7 +5,7 @@
 //! the shading alone are timed on their own too.
 
 use crate::bench_contact::median;
-use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use anyhow::Result;
 use clap::Args;
 use glam::DVec2;
@@ -203,11 +203,13 @@ pub fn run(args: &RenderBenchArgs) -> Result<()> {
         batch,
         batch_render_ms,
     };
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         write_bytes_atomic(&dir.join("render_bench.csv"), csv(&report).as_bytes())?;
         write_bytes_atomic(&dir.join("render_bench.md"), markdown(&report).as_bytes())?;
         write_json_atomic(&dir.join("render_bench.json"), &report)?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

@@ -4,7 +4,7 @@
 //! captured frame adds on the CPU. Medians of `--reps` runs, all rows measured in one run.
 
 use crate::bench_contact::median;
-use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -128,11 +128,12 @@ pub fn run(args: &SceneBenchArgs) -> Result<()> {
         frame_noise_ms: median(noise_times),
         rows,
     };
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         write_bytes_atomic(&dir.join("scene_bench.md"), markdown(&report).as_bytes())?;
         write_json_atomic(&dir.join("scene_bench.json"), &report)?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

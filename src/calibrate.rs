@@ -26,7 +26,7 @@ pub struct CalibrateArgs {
     /// Directory of the ball-press images.
     #[arg(long)]
     pub images: PathBuf,
-    /// CSV: image,center_x_px,center_y_px,contact_radius_px.
+    /// CSV: image,center_x_px,center_y_px,contact_radius_px; at most 1000 presses, each image once.
     #[arg(long)]
     pub annotations: PathBuf,
     /// The sensor's no-contact frame.

@@ -11,8 +11,8 @@
 use crate::ball_presses::{self, Split, contact_box, rebuild};
 use crate::compare_session::SessionCompare;
 use crate::contact_circle_score::{CircleScore, CircleSummary, score_circle, summarise};
-use crate::output::{write_json_atomic, write_png_atomic};
-use anyhow::{Context, Result, bail};
+use crate::output::{OutputDir, write_json_atomic, write_png_atomic};
+use anyhow::{Result, bail};
 use clap::Args;
 use image::RgbImage;
 use serde::Serialize;
@@ -253,16 +253,20 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     });
     let mut images = renderer.render_batch(&optics, &frames)?;
     let background = images.pop().expect("the flat frame was rendered last");
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create", dir.display()))?;
-    }
+    let out_dir = args
+        .out
+        .as_deref()
+        .map(|dir| OutputDir::create("--out", dir))
+        .transpose()?;
     let mut out = Vec::new();
     for (((press, real), (depth, force, _, warnings)), rendered) in
         presses.iter().zip(&rebuilt).zip(&images)
     {
-        if let Some(dir) = &args.out {
-            write_png_atomic(&dir.join(&press.image), &side_by_side(real, rendered))?;
+        if let Some(dir) = &out_dir {
+            write_png_atomic(
+                &dir.path().join(&press.image),
+                &side_by_side(real, rendered),
+            )?;
         }
         out.push(PressComparison {
             image: press.image.clone(),
@@ -288,8 +292,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         circle_rendered: summarise(out.iter().map(|p| &p.circle_rendered)),
         presses: out,
     };
-    if let Some(dir) = &args.out {
-        write_json_atomic(&dir.join("compare.json"), &report)?;
+    if let Some(dir) = out_dir {
+        write_json_atomic(&dir.path().join("compare.json"), &report)?;
+        dir.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

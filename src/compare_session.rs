@@ -10,7 +10,7 @@
 use crate::ask::{load_sensor, with_gel_modulus};
 use crate::compare::side_by_side;
 use crate::estimator_choice::EstimatorChoice;
-use crate::output::{write_json_atomic, write_png_atomic};
+use crate::output::{OutputDir, write_json_atomic, write_png_atomic};
 use crate::plot::{self, BarSeries};
 use anyhow::{Context, Result, bail};
 use image::RgbImage;
@@ -137,15 +137,25 @@ fn session_scene(
             manifest.backend
         );
     };
-    let scene = Scene::parse(&twin.scene_toml, Path::new(&twin.scene_path), catalog)
-        .with_context(|| format!("{}: twin.scene_toml", args.session.display()))?;
+    // The text is the session's copy: an error in it is the session's, not the file the
+    // scene was once read from (that path only anchors its meshes).
+    let scene =
+        Scene::parse(&twin.scene_toml, Path::new(&twin.scene_path), catalog).map_err(|e| {
+            anyhow::anyhow!(
+                "{}: twin.scene_toml (the scene recorded from {}): {}: {}",
+                args.session.join("manifest.json").display(),
+                twin.scene_path,
+                e.field,
+                e.message
+            )
+        })?;
     Ok((scene, format!("{} (from the session)", twin.scene_path)))
 }
 
 fn load_frame(dir: &Path, file: &str, timestamp_s: f64) -> Result<TactileFrame> {
     let path = dir.join(file);
-    let image = image::open(&path)
-        .with_context(|| format!("{}: cannot read the recorded frame", path.display()))?
+    let image = tactex_core::image_file::open(&path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot read the recorded frame: {e}", path.display()))?
         .to_rgb8();
     Ok(TactileFrame { image, timestamp_s })
 }
@@ -485,7 +495,9 @@ pub fn run(args: &SessionCompare) -> Result<()> {
         presses,
     };
     if let Some(dir) = args.out {
-        write_outputs(dir, &report, &recorded, &rebuilt, &manifest)?;
+        let out = OutputDir::create("--out", dir)?;
+        write_outputs(out.path(), &report, &recorded, &rebuilt, &manifest)?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -504,7 +516,6 @@ fn write_outputs(
     rebuilt: &[TactileFrame],
     manifest: &Manifest,
 ) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     for press in &report.presses {
         let Some(last) = press.frames.last() else {
             continue;

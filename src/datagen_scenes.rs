@@ -32,6 +32,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
+use tactex_core::dir_claim::LockDir;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::perception::mask::mask_box;
 use tactex_sim::SimDevices;
@@ -58,7 +59,7 @@ pub struct SceneDatagenArgs {
     pub out: PathBuf,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Fruits per scene, MIN-MAX (kinds drawn with repeats, so "both bananas" scenes occur).
+    /// Fruits per scene, MIN-MAX, at most 12 (kinds drawn with repeats, so "both bananas" scenes occur; large kinds fit fewer).
     #[arg(long, default_value = "1-6")]
     pub fruits: String,
     /// Fruit kinds to draw from (catalog names, comma-separated); all catalog fruits if unset.
@@ -122,14 +123,20 @@ struct ObjectMeta {
     labelled: bool,
 }
 
+/// Fruits one scene may ask for: the demo table holds about ten of mixed kinds (fewer
+/// bananas); beyond that no draw fits.
+pub const MAX_FRUITS: usize = 12;
+
 pub fn parse_range(text: &str) -> Result<[usize; 2]> {
     let parsed = match text.split_once('-') {
         Some((a, b)) => a.trim().parse().ok().zip(b.trim().parse().ok()),
         None => text.trim().parse().ok().map(|n| (n, n)),
     };
     match parsed {
-        Some((lo, hi)) if 1 <= lo && lo <= hi => Ok([lo, hi]),
-        _ => bail!("--fruits: '{text}' is not MIN-MAX with 1 <= MIN <= MAX (e.g. 1-6)"),
+        Some((lo, hi)) if 1 <= lo && lo <= hi && hi <= MAX_FRUITS => Ok([lo, hi]),
+        _ => bail!(
+            "--fruits: '{text}' is not MIN-MAX with 1 <= MIN <= MAX <= {MAX_FRUITS} (e.g. 1-6)"
+        ),
     }
 }
 
@@ -419,20 +426,65 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
         }
         .into(),
     };
+    let existed = args.out.exists();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("{}: cannot create the directory", args.out.display()))?;
     let root = args
         .out
         .canonicalize()
         .with_context(|| format!("{}: cannot resolve", args.out.display()))?;
+    let lock = LockDir::claim(&root.join(WRITER_LOCK), "writing this data set")
+        .map_err(|e| anyhow::anyhow!("--out {}: {e}", args.out.display()))?;
+    let result = fill(&root, args, &info, &catalog, &renderer, show_progress);
+    drop(lock);
+    if result.is_err() && !has_scenes(&root) {
+        // Nothing usable was written: leave the directory as it was, so that a corrected run
+        // starts clean.
+        if existed {
+            let _ = std::fs::remove_file(root.join("dataset.json"));
+            for sub in SUBDIRS {
+                for split in ["train", "val"] {
+                    let _ = std::fs::remove_dir(root.join(sub).join(split));
+                }
+                let _ = std::fs::remove_dir(root.join(sub));
+            }
+        } else {
+            let _ = std::fs::remove_dir_all(&root);
+        }
+    }
+    result
+}
+
+/// The directory whose existence says a tactex writes into the data set.
+pub const WRITER_LOCK: &str = ".tactex-writing";
+
+const SUBDIRS: [&str; 5] = ["images", "labels", "depth", "instances", "meta"];
+
+/// Whether any scene is complete (its label file, written last, exists).
+fn has_scenes(root: &Path) -> bool {
+    ["train", "val"].iter().any(|split| {
+        std::fs::read_dir(root.join("labels").join(split))
+            .is_ok_and(|mut entries| entries.next().is_some())
+    })
+}
+
+fn fill(
+    root: &Path,
+    args: &SceneDatagenArgs,
+    info: &DatasetInfo,
+    catalog: &FruitCatalog,
+    renderer: &Arc<dyn SceneRenderer>,
+    show_progress: bool,
+) -> Result<SceneDatagenSummary> {
     let info_path = root.join("dataset.json");
-    if info_path.exists() {
+    // Settings are fixed once a scene is written; before that a new run may change them.
+    if info_path.exists() && has_scenes(root) {
         let text = std::fs::read_to_string(&info_path)
             .with_context(|| format!("{}: cannot read", info_path.display()))?;
         let theirs: DatasetInfo = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a tactex scene data set", info_path.display()))?;
-        if theirs != info {
-            let (theirs, ours) = (serde_json::to_value(&theirs)?, serde_json::to_value(&info)?);
+        if theirs != *info {
+            let (theirs, ours) = (serde_json::to_value(&theirs)?, serde_json::to_value(info)?);
             let fields: Vec<&str> = ours
                 .as_object()
                 .expect("a struct")
@@ -447,9 +499,9 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
             );
         }
     } else {
-        write_json_atomic(&info_path, &info)?;
+        write_json_atomic(&info_path, info)?;
     }
-    for sub in ["images", "labels", "depth", "instances", "meta"] {
+    for sub in SUBDIRS {
         for split in ["train", "val"] {
             let dir = root.join(sub).join(split);
             std::fs::create_dir_all(&dir)
@@ -457,7 +509,7 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
         }
     }
     let todo: Vec<usize> = (0..args.count)
-        .filter(|&i| !scene_paths(&root, i, split(i, info.val_fraction))[1].exists())
+        .filter(|&i| !scene_paths(root, i, split(i, info.val_fraction))[1].exists())
         .collect();
     let bar = ProgressBar::new(todo.len() as u64).with_style(
         ProgressStyle::with_template("scenes [{bar:40}] {pos}/{len}, {per_sec}, eta {eta}")
@@ -470,8 +522,8 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
     let labels = todo
         .par_iter()
         .map(|&i| -> Result<(usize, Option<Rendered>)> {
-            let r = render_scene(i, &info, &catalog, &renderer)?;
-            write_scene(&root, &r)?;
+            let r = render_scene(i, info, catalog, renderer)?;
+            write_scene(root, &r)?;
             bar.inc(1);
             let n = r.polygons.len();
             Ok((n, (i < PREVIEW_SCENES).then_some(r)))
@@ -483,7 +535,7 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
     if let Some(sheet) = preview(&previews) {
         write_png_atomic(&root.join("preview.png"), &sheet)?;
     }
-    write_bytes_atomic(&root.join("data.yaml"), data_yaml(&root, &info).as_bytes())?;
+    write_bytes_atomic(&root.join("data.yaml"), data_yaml(root, info).as_bytes())?;
     Ok(SceneDatagenSummary {
         written: todo.len(),
         skipped: args.count - todo.len(),

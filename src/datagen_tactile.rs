@@ -380,6 +380,15 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
     let mut renderer: Option<Box<dyn GelRenderer>> =
         (choice.renderer.name() != "cpu").then_some(choice.renderer);
     prepare_dir(&args.out, &info)?;
+    // Shards of one data set run side by side; one shard has one writer.
+    let lock_path = args.out.join(format!(
+        "{}-shard-{}-of-{}",
+        crate::datagen_scenes::WRITER_LOCK,
+        shard.0,
+        shard.1
+    ));
+    let _lock = tactex_core::dir_claim::LockDir::claim(&lock_path, "writing this shard")
+        .map_err(|e| anyhow::anyhow!("--out {}: {e}", args.out.display()))?;
     let manifest_path = shard_manifest(&args.out, shard);
     let done = resume(&manifest_path)?;
     let todo: Vec<u64> = (shard.0..args.count)

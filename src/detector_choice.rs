@@ -28,6 +28,9 @@ impl DetectorChoice {
     /// Parses a detector name; a YOLO model is loaded (and checked) here, once.
     pub fn parse(spec: &str) -> Result<Self> {
         if let Some(file) = spec.strip_prefix("yolo:") {
+            if file.trim().is_empty() {
+                bail!("--detector: 'yolo:' names no model; give yolo:FILE.onnx");
+            }
             return Ok(Self::Yolo(Box::new(YoloSegDetector::load(
                 std::path::Path::new(file),
             )?)));

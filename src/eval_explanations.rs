@@ -18,7 +18,7 @@
 
 use crate::eval_scenarios::others;
 use crate::llm_explainer::{ExplainerChoice, explainer};
-use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::plot::{self, BarSeries};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -647,9 +647,9 @@ pub fn run(args: &ExplanationEvalArgs) -> Result<()> {
         categories,
     };
     let table = table(&report);
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create", dir.display()))?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         write_json_atomic(&dir.join("results.json"), &report)?;
         write_json_atomic(&dir.join("cases.json"), &scores)?;
         write_bytes_atomic(&dir.join("table.md"), table.as_bytes())?;
@@ -684,6 +684,7 @@ pub fn run(args: &ExplanationEvalArgs) -> Result<()> {
             &series,
             false,
         )?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

@@ -16,7 +16,7 @@ use crate::ask::{Twin, TwinAnswer};
 use crate::detector_choice::DetectorChoice;
 use crate::estimator_choice::EstimatorChoice;
 use crate::eval_scenarios::match_reports;
-use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::plot::{self, BarSeries, ScatterSeries};
 use anyhow::{Context, Result, bail, ensure};
 use clap::Args;
@@ -659,9 +659,9 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
             placed_touching: rate(&touching, |r| Some(r.placed)).unwrap_or(0.0),
         },
     };
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         write_json_atomic(&dir.join("fruits.json"), &rows)?;
         let scenes = dir.join("scenes");
         std::fs::create_dir_all(&scenes)
@@ -673,6 +673,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
         write_json_atomic(&dir.join("results.json"), &report)?;
         write_bytes_atomic(&dir.join("table.md"), markdown(&report).as_bytes())?;
         plots(dir, &report, &rows)?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

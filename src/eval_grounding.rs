@@ -7,7 +7,7 @@
 //! with and without the mask refinement and the 10-frame depth median.
 
 use crate::detector_choice::{DetectorChoice, GroundTruth};
-use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::plot::{self, StageGroup};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -439,9 +439,9 @@ pub fn run(args: &GroundingEvalArgs) -> Result<()> {
         trials: per,
     };
     let md = table(&report);
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create", dir.display()))?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         write_json_atomic(&dir.join("results.json"), &report)?;
         write_bytes_atomic(&dir.join("table.md"), md.as_bytes())?;
         let groups = |f: fn(&Trial) -> Option<f64>, raw: Option<fn(&Trial) -> Option<f64>>| {
@@ -479,6 +479,7 @@ pub fn run(args: &GroundingEvalArgs) -> Result<()> {
             "IoU",
             &groups(|t| t.iou, None),
         )?;
+        out.finish()?;
     }
     if args.json {
         println!(

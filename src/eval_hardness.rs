@@ -3,7 +3,7 @@
 //! by RMSE, R2 and Spearman's rho (core's stats, checked against scipy), with the paper's
 //! Fig. 5 (predicted against true hardness) as a PNG.
 
-use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::plot::{self, ScatterSeries};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -124,10 +124,12 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
     for path in &args.model {
         estimators.push(Box::new(crate::learned_model::from_file("--model", path)?));
     }
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("--out {}: cannot create", dir.display()))?;
-    }
+    // Claimed before the presses: an --out that cannot be written fails first.
+    let out = args
+        .out
+        .as_deref()
+        .map(|dir| OutputDir::create("--out", dir))
+        .transpose()?;
     let bar = ProgressBar::new(args.count).with_style(
         ProgressStyle::with_template("eval hardness [{bar:30}] {pos}/{len} presses, eta {eta}")
             .expect("a valid template"),
@@ -233,7 +235,8 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
         sensor: sensor_id,
         estimators: scores,
     };
-    if let Some(dir) = &args.out {
+    if let Some(out) = out {
+        let dir = out.path();
         let mut lines = String::new();
         for r in &records {
             lines += &serde_json::to_string(r)?;
@@ -253,6 +256,7 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
             [0.0, 100.0],
             &series,
         )?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

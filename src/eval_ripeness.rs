@@ -9,6 +9,7 @@
 //! penetrometer surveys varies by 10-20 %), so the 20 presses differ in flesh as well as pose.
 
 use crate::estimator_choice::EstimatorChoice;
+use crate::output::OutputDir;
 use crate::plot::{self, StageGroup};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -285,9 +286,9 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         fidelity: fidelity.to_string(),
         fruits: results,
     };
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("--out {}: cannot create", dir.display()))?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         crate::output::write_json_atomic(&dir.join("ripeness.json"), &report)?;
         plot::stage_groups(
             &dir.join("ripeness.png"),
@@ -298,6 +299,7 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
             "predicted hardness (Shore A)",
             &groups,
         )?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

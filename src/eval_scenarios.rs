@@ -19,7 +19,7 @@ use crate::ask::{Twin, TwinAnswer};
 use crate::detector_choice::DetectorChoice;
 use crate::estimator_choice::EstimatorChoice;
 use crate::eval_grounding::KINDS;
-use crate::output::{write_bytes_atomic, write_json_atomic};
+use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::plot::{self, BarSeries};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -640,13 +640,14 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
             })
             .collect(),
     };
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
+    if let Some(out) = &args.out {
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         write_json_atomic(&dir.join("runs.json"), &scores)?;
         write_json_atomic(&dir.join("results.json"), &report)?;
         write_bytes_atomic(&dir.join("table.md"), markdown(&report).as_bytes())?;
         plots(dir, &report)?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

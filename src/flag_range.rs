@@ -3,13 +3,7 @@
 //! physical quantity a user types, so that NaN, infinities and 1e300 never reach a solver.
 
 /// A number shown short: 1e300 as "1e300", not 301 digits.
-pub fn show(v: f64) -> String {
-    if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
-        format!("{v:e}")
-    } else {
-        format!("{v}")
-    }
-}
+pub use tactex_core::printable::short_number as show;
 
 fn parse(text: &str, span: &str) -> Result<f64, String> {
     text.trim()

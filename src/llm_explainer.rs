@@ -56,8 +56,13 @@ impl LlmConfig {
             Some(path) => {
                 let text = std::fs::read_to_string(path)
                     .with_context(|| format!("{}: cannot read", path.display()))?;
-                toml::from_str::<LlmConfigFile>(&text)
-                    .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.message()))?
+                toml::from_str::<LlmConfigFile>(&text).map_err(|e| {
+                    anyhow::anyhow!(
+                        "{}: {}",
+                        path.display(),
+                        tactex_core::file_failure::toml_failure(&text, &e)
+                    )
+                })?
             }
             None => LlmConfigFile::default(),
         };
@@ -227,7 +232,15 @@ pub fn explainer(
     llm_config: Option<&PathBuf>,
 ) -> Result<Box<dyn Explainer>> {
     Ok(match choice {
-        ExplainerChoice::Template => Box::new(TemplateExplainer),
+        ExplainerChoice::Template => {
+            if let Some(path) = llm_config {
+                bail!(
+                    "--llm-config {}: read only by --explainer llm; the explainer here is the template",
+                    path.display()
+                );
+            }
+            Box::new(TemplateExplainer)
+        }
         ExplainerChoice::Llm => Box::new(LlmExplainer::new(
             LlmConfig::load(llm_config.map(PathBuf::as_path))?,
             FruitCatalog::builtin(),

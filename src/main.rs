@@ -314,8 +314,49 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_line(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The error and its causes on one line, a cause that only repeats what is already said
+/// left out (an I/O error wrapped by a library that prints it too), and any control
+/// characters from prompts or files shown as escapes rather than sent to the terminal.
+fn error_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    tactex_core::printable::printable(&line)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::error_line;
+
+    #[test]
+    fn an_error_line_says_each_cause_once_and_shows_control_characters() {
+        // A library error that prints its I/O source, wrapped again by that source.
+        let io = || std::io::Error::new(std::io::ErrorKind::IsADirectory, "Is a directory");
+        let e = anyhow::Error::new(io())
+            .context(format!("failed to persist temporary file: {}", io()))
+            .context("o/tactile.png: cannot write");
+        assert_eq!(
+            error_line(&e),
+            "o/tactile.png: cannot write: failed to persist temporary file: Is a directory"
+        );
+        let e = anyhow::anyhow!("prompt: names no known fruit in \"\u{1b}[2Jhi\"");
+        assert_eq!(
+            error_line(&e),
+            "prompt: names no known fruit in \"\\u{1b}[2Jhi\""
+        );
     }
 }

@@ -21,7 +21,7 @@ pub struct MarkersArgs {
     pub reference: Option<PathBuf>,
     /// Annotated markers to score the detections against: CSV with a header and columns
     /// Mx,My,dx,dy (FOTS's format: rest position and displacement in whole pixels, truncated,
-    /// so the marker is taken at M + d + 1/2).
+    /// so the marker is taken at M + d + 1/2); at most 10000 markers, each once.
     #[arg(long)]
     pub annotations: Option<PathBuf>,
     /// With --annotations: write the frame, 3x, with annotated (red) and found (green)
@@ -53,10 +53,15 @@ struct Miss {
     nearest_px: f64,
 }
 
+/// Markers one annotation file lists at most (a GelSight Mini shows about 100).
+const MAX_MARKERS: usize = 10_000;
+
 fn read_marker_annotations(path: &std::path::Path) -> Result<Vec<(f64, f64)>> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
     let mut out = Vec::new();
+    // The file line of each marker, for a repeated one.
+    let mut lines = Vec::new();
     for (i, line) in text.lines().enumerate().skip(1) {
         if line.trim().is_empty() {
             continue;
@@ -79,7 +84,37 @@ fn read_marker_annotations(path: &std::path::Path) -> Result<Vec<(f64, f64)>> {
                 i + 1
             );
         };
-        out.push((mx + dx + 0.5, my + dy + 0.5));
+        let (x, y) = (mx + dx, my + dy);
+        let side = f64::from(tactex_core::image_file::MAX_SIDE_PX);
+        if !(v.iter().all(|c| c.is_finite())
+            && (0.0..side).contains(&x)
+            && (0.0..side).contains(&y))
+        {
+            bail!(
+                "{}: line {}: marker at ({}, {}) px is not in an image (0 to {side} px)",
+                path.display(),
+                i + 1,
+                crate::flag_range::show(x),
+                crate::flag_range::show(y)
+            );
+        }
+        if out.len() == MAX_MARKERS {
+            bail!(
+                "{}: more than {MAX_MARKERS} annotated markers, the most one frame has",
+                path.display()
+            );
+        }
+        let at = (x + 0.5, y + 0.5);
+        if let Some(j) = out.iter().position(|&p| p == at) {
+            bail!(
+                "{}: line {}: the marker of line {} again",
+                path.display(),
+                i + 1,
+                lines[j]
+            );
+        }
+        out.push(at);
+        lines.push(i + 1);
     }
     if out.is_empty() {
         bail!("{}: no annotated markers", path.display());

@@ -1,9 +1,9 @@
 //! Output files are written whole or not at all: into a temporary file beside the target,
 //! then renamed over it.
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 fn atomic(path: &Path, write: impl FnOnce(&mut std::fs::File) -> Result<()>) -> Result<()> {
     let dir = path
@@ -77,4 +77,129 @@ pub fn write_profile_atomic(
         write_png_atomic(&bg, img)?;
     }
     write_bytes_atomic(path, profile.to_toml(&bg_name).as_bytes())
+}
+
+/// A directory of outputs written whole or not at all: files go into `DIR.partial`, claimed
+/// by this process, and move into `DIR` only when the command has written all of them. A
+/// failed run leaves `DIR` as it was, so the retry starts clean; two runs into one directory
+/// do not mix their files.
+pub struct OutputDir {
+    flag: &'static str,
+    target: PathBuf,
+    staging: PathBuf,
+    finished: bool,
+}
+
+impl OutputDir {
+    /// `flag` names the option that gave `target`, for messages.
+    pub fn create(flag: &'static str, target: &Path) -> Result<OutputDir> {
+        if target.exists() && !target.is_dir() {
+            bail!("{flag} {}: exists and is not a directory", target.display());
+        }
+        // "." or "dir/..": the staging directory needs a name beside the target.
+        let target = if target.file_name().is_none() {
+            target
+                .canonicalize()
+                .with_context(|| format!("{flag} {}: cannot resolve", target.display()))?
+        } else {
+            target.to_path_buf()
+        };
+        if let Some(parent) = target.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent)
+                .with_context(|| format!("{flag} {}: cannot create", parent.display()))?;
+        }
+        let mut name = target.file_name().expect("resolved above").to_os_string();
+        name.push(".partial");
+        let staging = target.with_file_name(name);
+        tactex_core::dir_claim::claim_dir(&staging, "writing outputs")
+            .map_err(|e| anyhow::anyhow!("{flag} {}: {e}", target.display()))?;
+        Ok(OutputDir {
+            flag,
+            target,
+            staging,
+            finished: false,
+        })
+    }
+
+    /// Where the command writes its files until `finish`.
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Moves every file into the target directory, after checking that none lands where a
+    /// directory is (or a directory where a file is), so that a refusal moves nothing.
+    pub fn finish(mut self) -> Result<()> {
+        tactex_core::dir_claim::release_dir(&self.staging);
+        if !self.target.exists() {
+            std::fs::rename(&self.staging, &self.target).with_context(|| {
+                format!("{} {}: cannot create", self.flag, self.target.display())
+            })?;
+        } else {
+            if let Some((dest, is_dir)) = first_conflict(&self.staging, &self.target)? {
+                let (there, ours) = if is_dir {
+                    ("a directory", "a file")
+                } else {
+                    ("a file", "a directory")
+                };
+                bail!(
+                    "{}: is {there}, where {} {} writes {ours}; nothing was written",
+                    dest.display(),
+                    self.flag,
+                    self.target.display()
+                );
+            }
+            move_into(&self.staging, &self.target)?;
+        }
+        self.finished = true;
+        Ok(())
+    }
+}
+
+impl Drop for OutputDir {
+    fn drop(&mut self) {
+        if !self.finished {
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
+}
+
+/// The first place in `to` where an entry of `from` cannot go, and whether what stands
+/// there is a directory.
+fn first_conflict(from: &Path, to: &Path) -> Result<Option<(PathBuf, bool)>> {
+    for entry in
+        std::fs::read_dir(from).with_context(|| format!("{}: cannot read", from.display()))?
+    {
+        let entry = entry?;
+        let dest = to.join(entry.file_name());
+        let Ok(there) = std::fs::symlink_metadata(&dest) else {
+            continue;
+        };
+        if entry.file_type()?.is_dir() {
+            if !there.is_dir() {
+                return Ok(Some((dest, false)));
+            }
+            if let Some(found) = first_conflict(&entry.path(), &dest)? {
+                return Ok(Some(found));
+            }
+        } else if there.is_dir() {
+            return Ok(Some((dest, true)));
+        }
+    }
+    Ok(None)
+}
+
+fn move_into(from: &Path, to: &Path) -> Result<()> {
+    for entry in
+        std::fs::read_dir(from).with_context(|| format!("{}: cannot read", from.display()))?
+    {
+        let entry = entry?;
+        let dest = to.join(entry.file_name());
+        if entry.file_type()?.is_dir() && dest.is_dir() {
+            move_into(&entry.path(), &dest)?;
+        } else {
+            std::fs::rename(entry.path(), &dest)
+                .with_context(|| format!("{}: cannot write", dest.display()))?;
+        }
+    }
+    std::fs::remove_dir(from).with_context(|| format!("{}: cannot remove", from.display()))
 }

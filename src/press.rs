@@ -2,7 +2,7 @@
 //! fidelity, reported as JSON or text, with the gel maps written as 16-bit PNGs.
 
 use crate::flag_range::{above, within};
-use crate::output::{write_json_atomic, write_png_atomic, write_png16_atomic};
+use crate::output::{OutputDir, write_json_atomic, write_png_atomic, write_png16_atomic};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use glam::{DVec2, DVec3};
@@ -208,10 +208,15 @@ pub fn run(args: &PressArgs) -> Result<()> {
         let (cols, rows) = grid
             .split_once(['x', 'X'])
             .and_then(|(c, r)| Some((c.trim().parse::<u32>().ok()?, r.trim().parse::<u32>().ok()?)))
-            .filter(|(c, r)| u64::from(*c) * u64::from(*r) <= 10_000)
             .with_context(|| {
-                format!("--marker-grid: '{grid}' is not COLSxROWS with at most 10000 markers (e.g. 9x7, 11x9)")
+                format!("--marker-grid: '{grid}' is not COLSxROWS (e.g. 9x7, 11x9)")
             })?;
+        let markers = u64::from(cols) * u64::from(rows);
+        if markers == 0 || markers > 10_000 {
+            bail!(
+                "--marker-grid: {cols}x{rows} is {markers} markers; a gel has 1 to 10000 (e.g. 9x7, 11x9)"
+            );
+        }
         spec.markers.cols = cols;
         spec.markers.rows = rows;
     }
@@ -265,9 +270,11 @@ pub fn run(args: &PressArgs) -> Result<()> {
         residual: solution.residual,
         warnings: solution.warnings.clone(),
     };
-    if let Some(dir) = &args.out {
+    if let Some(out) = &args.out {
         // The renderer first: a missing device fails before any file is written.
         let choice = open_renderer(args.device)?;
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
         if let Some(note) = &choice.note {
             eprintln!("note: {note}");
         }
@@ -295,6 +302,7 @@ pub fn run(args: &PressArgs) -> Result<()> {
         let frame = frames.pop().expect("two frames rendered");
         write_png_atomic(&dir.join("tactile.png"), &frame)?;
         write_png_atomic(&dir.join("reference.png"), &reference)?;
+        out.finish()?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -369,7 +377,6 @@ fn write_maps(
     pad: &Rect,
     report: &PressReport,
 ) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     // The gel moves beyond the solver grid: map it over the pad, at the solver's cell unless
     // that would exceed 1024 cells a side.
     let cells = pad.size().max_element() / solution.grid.cell_mm;

@@ -108,3 +108,14 @@ fn controller_errors_and_a_missing_controller_are_one_line_errors() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_controller_reporting_a_pose_that_is_not_a_number_is_a_one_line_error() {
+    let f = FakeController::start().unwrap();
+    f.with(|s| s.pose.z_mm = f64::NAN);
+    let stderr = one_line_error(&tactex_arm(&f, &["pose", "--json"]));
+    assert!(stderr.contains("not a number"), "{stderr}");
+    f.with(|s| s.pose.z_mm = f64::INFINITY);
+    let stderr = one_line_error(&tactex_arm(&f, &["pose"]));
+    assert!(stderr.contains("not a number (inf)"), "{stderr}");
+}

@@ -313,7 +313,7 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
     );
 
     let cases = [
-        ("name = \"x\"\n[[objects]\n", "line 2: malformed TOML"),
+        ("name = \"x\"\n[[objects]\n", "toml: line 2 (`[[objects]`)"),
         (
             "name = \"x\"\n[[objects]]\nkind = \"durian\"\nposition_m = [0, 0]\n",
             "objects[0].kind: unknown kind 'durian'",
@@ -580,4 +580,69 @@ fn the_llm_explainer_without_an_endpoint_is_a_one_line_error() {
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(err.contains("TACTEX_LLM_BASE_URL"), "{err}");
+}
+
+#[test]
+fn a_prompt_with_terminal_escape_codes_is_shown_escaped_not_acted_on() {
+    let err = fails(&["ask", "hello \u{1b}[2J\u{1b}]0;pwned\u{7} there"]);
+    assert!(err.contains("\\u{1b}[2J"), "{err}");
+    assert!(!err.trim_end().chars().any(char::is_control), "{err:?}");
+}
+
+#[test]
+fn a_mesh_that_cannot_be_simulated_is_refused_for_what_is_wrong_with_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path();
+    std::fs::create_dir(p.join("meshdir")).unwrap();
+    std::fs::write(
+        p.join("tri.obj"),
+        "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    // A glTF whose buffer lives in a .bin that is not there.
+    std::fs::write(
+        p.join("m.gltf"),
+        r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"buffers":[{"byteLength":36,"uri":"m.bin"}],
+"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,
+"count":3,"type":"VEC3","max":[1,1,0],"min":[0,0,0]}]}"#,
+    )
+    .unwrap();
+    for (mesh, says) in [
+        ("meshdir", "is a directory, not a mesh file"),
+        ("tri.obj", "1 triangles on 3 vertices"),
+        ("m.gltf", "buffer 0 file"),
+    ] {
+        let scene = p.join("s.toml");
+        std::fs::write(
+            &scene,
+            format!(
+                "name = \"x\"\n[[objects]]\nkind = \"mesh\"\nmesh = \"{mesh}\"\nhardness = \"40A\"\nposition_m = [0, 0]\n"
+            ),
+        )
+        .unwrap();
+        let e = fails(&["scene", "check", scene.to_str().unwrap()]);
+        assert!(
+            e.contains("objects[0].mesh") && e.contains(says),
+            "{mesh}: {e}"
+        );
+        if mesh == "m.gltf" {
+            assert!(e.contains("m.bin' not found"), "{e}");
+        }
+    }
+    // More objects than a table holds: refused for the count, before any is placed.
+    let many: String = (0..65)
+        .map(|i| {
+            format!(
+                "[[objects]]\nkind = \"lime\"\nposition_m = [{}, 0]\n",
+                i as f64 * 1e-3
+            )
+        })
+        .collect();
+    let (_d, path) = bad_scene(&format!("name = \"x\"\n{many}"));
+    let e = fails(&["scene", "check", &path]);
+    assert!(
+        e.contains("objects: 65 objects; a scene has at most 64"),
+        "{e}"
+    );
 }

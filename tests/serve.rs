@@ -225,6 +225,68 @@ fn bad_requests_get_error_responses_and_the_server_keeps_serving() {
         .send(&huge)
         .expect("POST reaches the server");
     assert_eq!(r.status().as_u16(), 413);
+    let text = r.into_body().read_to_string().unwrap();
+    let reply: Value = serde_json::from_str(&text).expect("413 answered as JSON");
+    assert!(reply["error"].as_str().unwrap().contains("16384 bytes"));
+
+    // Only JSON bodies, and only from this server's page or from clients without an Origin:
+    // a page elsewhere cannot queue questions (a form posts text/plain without preflight).
+    let host = server.url.trim_start_matches("http://").to_string();
+    let question = r#"{"prompt": "hello"}"#;
+    for (content_type, origin, want, says) in [
+        ("text/plain", None, 415, "application/json"),
+        (
+            "application/x-www-form-urlencoded",
+            None,
+            415,
+            "application/json",
+        ),
+        (
+            "application/json",
+            Some("http://evil.example".to_string()),
+            403,
+            "Origin",
+        ),
+        ("application/json", Some("null".to_string()), 403, "Origin"),
+        // Past both checks: the prompt itself is what is wrong.
+        (
+            "application/json",
+            Some(format!("http://{host}")),
+            422,
+            "no known fruit",
+        ),
+        (
+            "application/json; charset=utf-8",
+            None,
+            422,
+            "no known fruit",
+        ),
+    ] {
+        let mut request = agent().post(&url).header("Content-Type", content_type);
+        if let Some(origin) = &origin {
+            request = request.header("Origin", origin);
+        }
+        let mut r = request.send(question).expect("POST reaches the server");
+        let status = r.status().as_u16();
+        let reply: Value = serde_json::from_str(&r.body_mut().read_to_string().unwrap())
+            .expect("an error as JSON");
+        assert_eq!(status, want, "{content_type} {origin:?}: {reply}");
+        assert!(
+            reply["error"].as_str().unwrap().contains(says),
+            "{content_type} {origin:?}: {reply}"
+        );
+    }
+    // URLs that do not parse and methods a route has not: JSON errors like the rest.
+    for (path, want) in [
+        ("/api/queries/abc/events", 400),
+        ("/api/queries/1/objects/x/frames/0.png", 400),
+        ("/api/ask", 405),
+    ] {
+        let (status, body) = get(&format!("{}{path}", server.url));
+        assert_eq!(status, want, "{path}");
+        let reply: Value = serde_json::from_slice(&body).expect("an error as JSON");
+        assert!(reply["error"].is_string(), "{path}: {reply}");
+    }
 
     for (path, what) in [
         ("/api/queries/999/events", "question 999"),
@@ -276,6 +338,11 @@ fn a_missing_scene_or_a_taken_port_is_a_one_line_error() {
         (
             vec!["serve", "--max-prompt-chars", "0"],
             "--max-prompt-chars",
+        ),
+        // A config the template never reads is refused rather than silently ignored.
+        (
+            vec!["serve", "--llm-config", "no/such/llm.toml"],
+            "--llm-config no/such/llm.toml",
         ),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_tactex"))

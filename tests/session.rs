@@ -124,6 +124,29 @@ fn broken_or_missing_sessions_and_misused_flags_are_one_line_errors() {
     .unwrap();
     let stderr = one_line_error(&replay(&dir, p));
     assert!(stderr.contains("manifest.json: format"), "{stderr}");
+    // A camera no lens has is named as such, not found out later as a diverged replay.
+    let mut m: Value = serde_json::from_str(&text).unwrap();
+    m["camera"]["intrinsics"]["fx"] = (-600.0).into();
+    std::fs::write(&manifest, serde_json::to_vec(&m).unwrap()).unwrap();
+    let stderr = one_line_error(&replay(&dir, p));
+    assert!(
+        stderr.contains("manifest.json: camera.intrinsics") && stderr.contains("fx -600"),
+        "{stderr}"
+    );
+    // A session's own scene text with a mistake is the session's error, not the demo's.
+    let mut m: Value = serde_json::from_str(&text).unwrap();
+    let toml = m["twin"]["scene_toml"]
+        .as_str()
+        .unwrap()
+        .replacen("position_m", "positionx_m", 1);
+    m["twin"]["scene_toml"] = toml.into();
+    std::fs::write(&manifest, serde_json::to_vec(&m).unwrap()).unwrap();
+    let stderr = one_line_error(&compare_session(&dir, &[]));
+    assert!(
+        stderr.contains("manifest.json: twin.scene_toml (the scene recorded from")
+            && stderr.contains("positionx_m"),
+        "{stderr}"
+    );
     std::fs::write(&manifest, &text).unwrap();
     std::fs::remove_file(dir.join("tactile/0003.png")).unwrap();
     let stderr = one_line_error(&replay(&dir, p));
@@ -271,6 +294,6 @@ fn two_recordings_into_one_directory_one_wins_and_the_session_is_whole() {
     }
     let on_disk = std::fs::read_dir(dir.join("tactile")).unwrap().count();
     assert_eq!(on_disk, listed.len());
-    assert!(!dir.join("recording.pid").exists());
+    assert!(!dir.join("tactex.pid").exists());
     assert!(!tmp.path().join("s.partial").exists());
 }

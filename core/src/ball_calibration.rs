@@ -29,6 +29,10 @@ pub enum AnnotationError {
 }
 
 /// Reads `image,center_x_px,center_y_px,contact_radius_px` rows (a header line first).
+/// Annotated presses one calibration reads at most: each is an image decoded and fitted
+/// (the FOTS set has 30).
+pub const MAX_PRESSES: usize = 1000;
+
 pub fn read_annotations(path: &Path) -> Result<Vec<BallPress>, AnnotationError> {
     let shown = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| AnnotationError::Read {
@@ -51,10 +55,19 @@ pub fn read_annotations(path: &Path) -> Result<Vec<BallPress>, AnnotationError> 
             });
         }
     }
-    let mut out = Vec::new();
+    let mut out: Vec<BallPress> = Vec::new();
+    let mut first_line = std::collections::HashMap::new();
     for (k, line) in lines {
         if line.trim().is_empty() {
             continue;
+        }
+        if out.len() == MAX_PRESSES {
+            return Err(AnnotationError::Read {
+                path: shown,
+                message: format!(
+                    "more than {MAX_PRESSES} annotated presses, the most one calibration reads"
+                ),
+            });
         }
         let row = |message: String| AnnotationError::Row {
             path: shown.clone(),
@@ -89,6 +102,13 @@ pub fn read_annotations(path: &Path) -> Result<Vec<BallPress>, AnnotationError> 
             return Err(row(
                 "image must be a file name in the images directory".into()
             ));
+        }
+        // A press listed twice would count twice in the fit.
+        if let Some(first) = first_line.insert(press.image.clone(), k + 1) {
+            return Err(row(format!(
+                "image {} is annotated already on line {first}",
+                press.image
+            )));
         }
         out.push(press);
     }

@@ -109,7 +109,7 @@ impl FruitCatalog {
     pub fn parse(text: &str, path: &str) -> Result<Self, CatalogError> {
         let file: CatalogFile = toml::from_str(text).map_err(|e| CatalogError::Malformed {
             path: path.into(),
-            message: e.message().to_string(),
+            message: crate::file_failure::toml_failure(text, &e),
         })?;
         for f in &file.fruit {
             let bad = |message: String| CatalogError::Invalid {

@@ -101,6 +101,34 @@ impl Default for CameraIntrinsics {
 }
 
 impl CameraIntrinsics {
+    /// What makes these intrinsics unusable, if anything: a camera has 1 to 4096 pixels a side
+    /// (the most an image tactex reads has), positive finite focal lengths and a finite
+    /// principal point.
+    pub fn check(&self) -> Result<(), String> {
+        let side = 1..=crate::image_file::MAX_SIDE_PX;
+        let finite = [self.fx, self.fy, self.cx, self.cy]
+            .iter()
+            .all(|v| v.is_finite());
+        if !(finite
+            && self.fx > 0.0
+            && self.fy > 0.0
+            && side.contains(&self.width)
+            && side.contains(&self.height))
+        {
+            return Err(format!(
+                "need 0 < width, height <= {} and finite fx, fy > 0, cx, cy (got {}x{}, fx {}, fy {}, cx {}, cy {})",
+                crate::image_file::MAX_SIDE_PX,
+                self.width,
+                self.height,
+                crate::printable::short_number(self.fx),
+                crate::printable::short_number(self.fy),
+                crate::printable::short_number(self.cx),
+                crate::printable::short_number(self.cy)
+            ));
+        }
+        Ok(())
+    }
+
     /// Pixel coordinates of a point in the camera frame, or None behind the camera.
     pub fn project(&self, p: DVec3) -> Option<(f64, f64)> {
         (p.z > 1e-9).then(|| (self.fx * p.x / p.z + self.cx, self.fy * p.y / p.z + self.cy))

@@ -116,8 +116,12 @@ impl OnnxEstimator {
             path: card_label.to_string(),
             reason,
         };
-        let card: ModelCard = serde_json::from_str(card_json)
-            .map_err(|e| bad_card(format!("not a model card: {e}")))?;
+        let card: ModelCard = serde_json::from_str(card_json).map_err(|e| {
+            bad_card(format!(
+                "not a model card: {}",
+                crate::file_failure::json_failure(card_json, &e)
+            ))
+        })?;
         card.check().map_err(bad_card)?;
         let session = open_session(label, onnx)?;
         let bad_model = |reason: String| OnnxError::Model {

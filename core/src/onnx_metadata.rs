@@ -6,6 +6,10 @@ use prost::Message;
 
 #[derive(Clone, PartialEq, Message)]
 struct ModelProps {
+    /// Every ONNX model states its IR version; bytes without one (an empty file, most other
+    /// files that happen to decode as protobuf) are not a model.
+    #[prost(int64, tag = "1")]
+    ir_version: i64,
     #[prost(message, repeated, tag = "14")]
     metadata_props: Vec<Entry>,
 }
@@ -22,6 +26,13 @@ struct Entry {
 /// a protobuf message.
 pub fn metadata_props(onnx: &[u8]) -> Result<Vec<(String, String)>, String> {
     let props = ModelProps::decode(onnx).map_err(|e| format!("not an ONNX model: {e}"))?;
+    if props.ir_version <= 0 {
+        return Err(if onnx.is_empty() {
+            "not an ONNX model: the file is empty".into()
+        } else {
+            "not an ONNX model: it states no IR version".into()
+        });
+    }
     Ok(props
         .metadata_props
         .into_iter()
@@ -83,6 +94,7 @@ mod tests {
             value: "{0: 'a'}".into(),
         };
         let bytes = ModelProps {
+            ir_version: 8,
             metadata_props: vec![entry],
         }
         .encode_to_vec();
@@ -91,5 +103,6 @@ mod tests {
             vec![("names".to_string(), "{0: 'a'}".to_string())]
         );
         assert!(metadata_props(b"\xff\xff\xff garbage").is_err());
+        assert!(metadata_props(b"").unwrap_err().contains("empty"));
     }
 }

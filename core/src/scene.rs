@@ -225,13 +225,8 @@ impl Scene {
             field: field.to_string(),
             message,
         };
-        let raw: RawScene = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
-            let field = line.map_or("toml".to_string(), |l| format!("line {l}"));
-            err(&field, format!("malformed TOML: {}", e.message().trim()))
-        })?;
+        let raw: RawScene = toml::from_str(text)
+            .map_err(|e| err("toml", crate::file_failure::toml_failure(text, &e)))?;
 
         let (camera_pose, intrinsics) = Self::camera(raw.camera, &err)?;
         let table = Table {
@@ -255,8 +250,8 @@ impl Scene {
                 "table.size_m",
                 format!(
                     "[{}, {}] m: each side must be {} to {} m",
-                    show(table.size_m[0]),
-                    show(table.size_m[1]),
+                    crate::printable::short_number(table.size_m[0]),
+                    crate::printable::short_number(table.size_m[1]),
                     TABLE_SIZE_M[0],
                     TABLE_SIZE_M[1]
                 ),
@@ -264,6 +259,15 @@ impl Scene {
         }
         check_color(&table.color).map_err(|m| err("table.color", m))?;
 
+        if raw.objects.len() > MAX_OBJECTS {
+            return Err(err(
+                "objects",
+                format!(
+                    "{} objects; a scene has at most {MAX_OBJECTS} (each is simulated, seen and pressed)",
+                    raw.objects.len()
+                ),
+            ));
+        }
         let base = path.parent().unwrap_or(Path::new("."));
         let objects = raw
             .objects
@@ -320,20 +324,7 @@ impl Scene {
             ));
         }
         let k = raw.intrinsics.unwrap_or_default();
-        let finite = [k.fx, k.fy, k.cx, k.cy].iter().all(|v| v.is_finite());
-        if !finite
-            || k.fx <= 0.0
-            || k.fy <= 0.0
-            || k.width == 0
-            || k.height == 0
-            || k.width > 8192
-            || k.height > 8192
-        {
-            return Err(err(
-                "camera.intrinsics",
-                "need 0 < width, height <= 8192 and finite fx, fy > 0, cx, cy".into(),
-            ));
-        }
+        k.check().map_err(|m| err("camera.intrinsics", m))?;
         Ok((pose, k))
     }
 
@@ -355,7 +346,7 @@ impl Scene {
                     &field(name),
                     format!(
                         "{} m is not a size an object on a table has ({} to {} m)",
-                        show(v),
+                        crate::printable::short_number(v),
                         OBJECT_SIZE_M[0],
                         OBJECT_SIZE_M[1]
                     ),
@@ -451,6 +442,12 @@ impl Scene {
                             err(&field("mesh"), "required for kind 'mesh'".into())
                         })?;
                         let path = base.join(rel);
+                        if path.is_dir() {
+                            return Err(err(
+                                &field("mesh"),
+                                format!("'{}' is a directory, not a mesh file", path.display()),
+                            ));
+                        }
                         if !path.is_file() {
                             return Err(err(
                                 &field("mesh"),
@@ -468,7 +465,7 @@ impl Scene {
                                         &field("scale"),
                                         format!(
                                             "{} is not a mesh unit in metres ({} for millimetres to {})",
-                                            show(scale),
+                                            crate::printable::short_number(scale),
                                             MESH_SCALE[0] * 10.0,
                                             MESH_SCALE[1]
                                         ),
@@ -547,21 +544,14 @@ impl Scene {
     }
 }
 
+/// Objects one scene may have: a crowded table holds a few dozen fruit.
+pub const MAX_OBJECTS: usize = 64;
 /// An object's radius, radii or sides (m): from a 1 mm berry to a 1 m melon on a table.
 pub const OBJECT_SIZE_M: [f64; 2] = [1e-3, 1.0];
 /// A table's sides (m).
 pub const TABLE_SIZE_M: [f64; 2] = [0.05, 10.0];
 /// Mesh units in metres: from 0.1 mm (1e-4) to 10 m.
 pub const MESH_SCALE: [f64; 2] = [1e-4, 10.0];
-
-/// A number shown short: 1e308 as "1e308", not 309 digits.
-fn show(v: f64) -> String {
-    if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
-        format!("{v:e}")
-    } else {
-        format!("{v}")
-    }
-}
 
 fn check_color(c: &[f64; 3]) -> Result<(), String> {
     if c.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)) {
@@ -676,7 +666,10 @@ mod tests {
         );
         assert!(e.contains("objects[0].mesh: mesh file"), "{e}");
         let e = error_of("name = \"x\"\n[[objects]\nkind = 3\n");
-        assert!(e.starts_with("t.toml: line 2: malformed TOML"), "{e}");
+        assert!(
+            e.starts_with("t.toml: toml: line 2 (`[[objects]`): "),
+            "{e}"
+        );
         let e = error_of(
             "name = \"x\"\n[[objects]]\nkind = \"sphere\"\nposition_m = [0, 0]\nhardness = \"40A\"\n",
         );

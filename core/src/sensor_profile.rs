@@ -205,16 +205,8 @@ impl SensorProfile {
             field: field.into(),
             message,
         };
-        let mut raw: ProfileFile = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
-            let message = e.message().replace('\n', " ");
-            match line {
-                Some(l) => err("toml", format!("line {l}: {message}")),
-                None => err("toml", message),
-            }
-        })?;
+        let mut raw: ProfileFile = toml::from_str(text)
+            .map_err(|e| err("toml", crate::file_failure::toml_failure(text, &e)))?;
         if raw.format != PROFILE_FORMAT {
             return Err(err(
                 "format",
@@ -257,7 +249,7 @@ impl SensorProfile {
             SYNTHETIC => None,
             name => {
                 let at = dir.join(name);
-                let img = image::open(&at)
+                let img = crate::image_file::open(&at)
                     .map_err(|e| {
                         err(
                             "optics.background",

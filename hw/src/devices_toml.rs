@@ -83,13 +83,7 @@ impl DevicesConfig {
         })?;
         let config: DevicesConfig = toml::from_str(&text).map_err(|e| DevicesError::File {
             path: path.to_path_buf(),
-            // toml's messages span lines (a source excerpt); the first says what is wrong.
-            message: e
-                .message()
-                .lines()
-                .next()
-                .unwrap_or("invalid TOML")
-                .to_string(),
+            message: tactex_core::file_failure::toml_failure(&text, &e),
         })?;
         let field = |field: &str, message: &str| DevicesError::Field {
             path: path.to_path_buf(),
@@ -100,11 +94,8 @@ impl DevicesConfig {
             return Err(field("camera.depth_scale_m", "must be a positive number"));
         }
         let k = &config.camera.intrinsics;
-        if k.width == 0 || k.height == 0 || !(k.fx > 0.0 && k.fy > 0.0) {
-            return Err(field(
-                "camera.intrinsics",
-                "width, height, fx and fy must be positive",
-            ));
+        if let Err(why) = k.check() {
+            return Err(field("camera.intrinsics", &why));
         }
         if config.camera_pose().is_none() {
             return Err(field(

@@ -22,8 +22,8 @@ pub enum FrameError {
 
 /// One MJPG frame from the camera, decoded, cropped to the gel and resized to 320x240.
 pub fn frame_from_mjpg(jpeg: &[u8]) -> Result<RgbImage, FrameError> {
-    let decoded = image::load_from_memory_with_format(jpeg, image::ImageFormat::Jpeg)
-        .map_err(|e| FrameError::Decode(e.to_string()))?
+    let decoded = tactex_core::image_file::decode(jpeg, image::ImageFormat::Jpeg)
+        .map_err(FrameError::Decode)?
         .to_rgb8();
     crop_to_gel(&decoded)
 }

@@ -117,13 +117,26 @@ impl TriMesh {
 
     /// Rejects meshes that cannot be simulated: no triangles, bad indices, non-finite or flat.
     pub fn validate(&self, path: &str) -> Result<(), MeshError> {
-        if self.triangles.is_empty() || self.vertices.len() < 4 {
+        if self.triangles.is_empty() {
             return Err(MeshError::Empty { path: path.into() });
         }
         let bad = |message: &str| MeshError::Degenerate {
             path: path.into(),
             message: message.into(),
         };
+        if self.triangles.len() < 4 || self.vertices.len() < 4 {
+            return Err(bad(&format!(
+                "{} triangles on {} vertices; a solid needs a closed surface of at least 4 triangles",
+                self.triangles.len(),
+                self.vertices.len()
+            )));
+        }
+        if self.triangles.len() > MAX_TRIANGLES {
+            return Err(bad(&format!(
+                "{} triangles, over the {MAX_TRIANGLES} a mesh may have",
+                self.triangles.len()
+            )));
+        }
         if self.vertices.iter().any(|v| !v.is_finite()) {
             return Err(bad("non-finite vertex"));
         }
@@ -343,6 +356,32 @@ pub fn blob(size: DVec3, lobes: &[Lobe], detail: usize) -> TriMesh {
 }
 
 /// Loads an OBJ or glTF/GLB mesh (all its triangles, node transforms applied), in metres.
+/// The largest mesh file read (bytes) and the most triangles simulated: a fruit scanned at
+/// 0.1 mm is well inside both.
+pub const MAX_MESH_BYTES: u64 = 256 << 20;
+pub const MAX_TRIANGLES: usize = 2_000_000;
+
+/// Why a glTF did not import, naming the buffer file when that is what is missing (the
+/// importer's own message names neither).
+fn gltf_failure(path: &Path, e: gltf::Error) -> String {
+    if let Ok(doc) = gltf::Gltf::open(path) {
+        let dir = path.parent().unwrap_or(Path::new("."));
+        for buffer in doc.buffers() {
+            if let gltf::buffer::Source::Uri(uri) = buffer.source()
+                && !uri.starts_with("data:")
+                && !dir.join(uri).is_file()
+            {
+                return format!(
+                    "buffer {} file '{}' not found",
+                    buffer.index(),
+                    dir.join(uri).display()
+                );
+            }
+        }
+    }
+    e.to_string()
+}
+
 pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
     let shown = path.display().to_string();
     let ext = path
@@ -354,6 +393,16 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
         path: shown.clone(),
         message,
     };
+    let bytes = std::fs::metadata(path)
+        .map_err(|e| read_err(e.to_string()))?
+        .len();
+    if bytes > MAX_MESH_BYTES {
+        return Err(read_err(format!(
+            "{} MB, over the {} MB a mesh file may have",
+            bytes >> 20,
+            MAX_MESH_BYTES >> 20
+        )));
+    }
     let mesh = match ext.as_str() {
         "obj" => {
             let opts = tobj::LoadOptions {
@@ -383,7 +432,8 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
             m
         }
         "gltf" | "glb" => {
-            let (doc, buffers, _) = gltf::import(path).map_err(|e| read_err(e.to_string()))?;
+            let (doc, buffers, _) =
+                gltf::import(path).map_err(|e| read_err(gltf_failure(path, e)))?;
             let mut m = TriMesh::default();
             let scene = doc
                 .default_scene()

@@ -44,11 +44,17 @@ impl Default for Variation {
 pub enum RandomSceneError {
     #[error("random scene: unknown fruit kind '{kind}' (known: {known})")]
     UnknownKind { kind: String, known: String },
-    #[error("random scene: {count} fruits do not fit on the table without overlap")]
+    #[error(
+        "random scene: {count} fruits do not fit on the table without overlap (in 20 draws); ask for fewer"
+    )]
     NoRoom { count: usize },
     #[error(transparent)]
     Scene(#[from] SceneError),
 }
+
+/// Whole draws tried before a table is called too small for the fruits: placing one at a
+/// time can corner itself on a table that a fresh draw fills.
+const DRAWS: usize = 20;
 
 /// A scene of the given fruit kinds (catalog names, repeats allowed), drawn from `seed`.
 pub fn random_scene(
@@ -58,6 +64,23 @@ pub fn random_scene(
     variation: &Variation,
 ) -> Result<Scene, RandomSceneError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5ce7_e5eed);
+    for _ in 1..DRAWS {
+        match draw(kinds, catalog, seed, variation, &mut rng) {
+            Err(RandomSceneError::NoRoom { .. }) => continue,
+            done => return done,
+        }
+    }
+    draw(kinds, catalog, seed, variation, &mut rng)
+}
+
+/// One draw: every fruit placed in turn; no room for one fails the draw.
+fn draw(
+    kinds: &[&str],
+    catalog: &FruitCatalog,
+    seed: u64,
+    variation: &Variation,
+    rng: &mut ChaCha8Rng,
+) -> Result<Scene, RandomSceneError> {
     // The camera, table and defaults come from the scene parser, so they match scene files.
     let mut scene = Scene::parse(
         "name = \"random\"\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n",
@@ -83,12 +106,11 @@ pub fn random_scene(
             })?;
         let stage = fruit
             .stages
-            .choose(&mut rng)
+            .choose(rng)
             .expect("validated non-empty")
             .clone();
-        let scale: [f64; 3] = std::array::from_fn(|_| {
-            (1.0 + variation.size_sigma * normal(&mut rng)).clamp(0.8, 1.2)
-        });
+        let scale: [f64; 3] =
+            std::array::from_fn(|_| (1.0 + variation.size_sigma * normal(rng)).clamp(0.8, 1.2));
         let size_m: [f64; 3] = std::array::from_fn(|i| fruit.size_m[i] * scale[i]);
         let half = [
             size_m[0] / 2.0 + variation.gap_m / 2.0,
@@ -157,10 +179,10 @@ pub fn random_scene(
         };
         let position_m = footprint.centre;
         placed.push(footprint);
-        let brightness = 1.0 + variation.brightness_sigma * normal(&mut rng);
-        let color = stage.color.map(|c| {
-            (c * brightness + variation.channel_sigma * normal(&mut rng)).clamp(0.02, 0.98)
-        });
+        let brightness = 1.0 + variation.brightness_sigma * normal(rng);
+        let color = stage
+            .color
+            .map(|c| (c * brightness + variation.channel_sigma * normal(rng)).clamp(0.02, 0.98));
         let mut object = template.clone();
         object.label = fruit.name.clone();
         object.kind = ObjectKind::Fruit {

@@ -10,8 +10,9 @@ use crate::detector_choice::DetectorChoice;
 use anyhow::{Context, Result};
 use axum::Router;
 use axum::body::Bytes;
+use axum::extract::rejection::{BytesRejection, PathRejection};
 use axum::extract::{DefaultBodyLimit, Path as UrlPath, State};
-use axum::http::{StatusCode, header};
+use axum::http::{HeaderMap, StatusCode, header};
 use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::{get, post};
@@ -166,9 +167,46 @@ fn router(served: Shared) -> Router {
             get(tactile_frame),
         )
         .fallback(|| async { error(StatusCode::NOT_FOUND, "no such page") })
+        .method_not_allowed_fallback(|| async {
+            error(
+                StatusCode::METHOD_NOT_ALLOWED,
+                "method not allowed here (questions are POSTed to /api/ask; the rest is GET)",
+            )
+        })
         // A question is a line of text; anything much bigger is not one.
-        .layer(DefaultBodyLimit::max(16 * 1024))
+        .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
         .with_state(served)
+}
+
+const MAX_BODY_BYTES: usize = 16 * 1024;
+
+/// A URL whose parts do not parse (`/api/queries/abc/events`), answered as JSON like every
+/// other error.
+fn bad_url(e: PathRejection) -> Response {
+    error(StatusCode::BAD_REQUEST, &format!("URL: {}", e.body_text()))
+}
+
+/// Questions come only from this server's own page or from clients that send no Origin
+/// (curl, scripts): a page elsewhere that the user visits cannot queue them. Browsers send
+/// Origin on every cross-site POST, and a form or text/plain POST is refused anyway.
+fn refuse_foreign(headers: &HeaderMap) -> Option<Response> {
+    let origin = headers.get(header::ORIGIN)?;
+    let host = headers.get(header::HOST).and_then(|h| h.to_str().ok());
+    let authority = origin
+        .to_str()
+        .ok()
+        .and_then(|o| o.split_once("://"))
+        .map(|(_, a)| a);
+    if authority.is_some() && authority == host {
+        return None;
+    }
+    Some(error(
+        StatusCode::FORBIDDEN,
+        &format!(
+            "Origin {}: questions are taken from this server's own page only",
+            tactex_core::printable::printable(&String::from_utf8_lossy(origin.as_bytes()))
+        ),
+    ))
 }
 
 /// An error response: the status and `{"error": message}`.
@@ -244,7 +282,35 @@ struct AskRequest {
 
 /// Starts a question: 202 with its id and event stream, or an error saying what was wrong
 /// with the request (400 body, 422 prompt, 429 busy).
-async fn ask(State(s): State<Shared>, body: Bytes) -> Response {
+async fn ask(
+    State(s): State<Shared>,
+    headers: HeaderMap,
+    body: Result<Bytes, BytesRejection>,
+) -> Response {
+    if let Some(refusal) = refuse_foreign(&headers) {
+        return refusal;
+    }
+    let json = headers
+        .get(header::CONTENT_TYPE)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.split(';').next())
+        .is_some_and(|v| v.trim().eq_ignore_ascii_case("application/json"));
+    if !json {
+        return error(
+            StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            "request body: Content-Type must be application/json",
+        );
+    }
+    let body = match body {
+        Ok(body) => body,
+        Err(e) if e.status() == StatusCode::PAYLOAD_TOO_LARGE => {
+            return error(
+                StatusCode::PAYLOAD_TOO_LARGE,
+                &format!("request body: over the limit of {MAX_BODY_BYTES} bytes"),
+            );
+        }
+        Err(e) => return error(e.status(), &format!("request body: {}", e.body_text())),
+    };
     let request: AskRequest = match serde_json::from_slice(&body) {
         Ok(r) => r,
         Err(e) => {
@@ -326,7 +392,11 @@ fn answer_question(s: &Served, run: &QueryRun, prompt: &str) {
 }
 
 /// The question's events from the first on, live until it is done.
-async fn events(State(s): State<Shared>, UrlPath(id): UrlPath<u64>) -> Response {
+async fn events(State(s): State<Shared>, id: Result<UrlPath<u64>, PathRejection>) -> Response {
+    let UrlPath(id) = match id {
+        Ok(id) => id,
+        Err(e) => return bad_url(e),
+    };
     let Some(run) = lock(&s.queries).get(id) else {
         return error(StatusCode::NOT_FOUND, &format!("question {id}: not found"));
     };
@@ -364,8 +434,12 @@ fn replay(
 /// the reference, amplified, since the raw frames of a soft fruit look alike to the eye.
 async fn tactile_frame(
     State(s): State<Shared>,
-    UrlPath((id, object, frame)): UrlPath<(u64, usize, String)>,
+    parts: Result<UrlPath<(u64, usize, String)>, PathRejection>,
 ) -> Response {
+    let UrlPath((id, object, frame)) = match parts {
+        Ok(parts) => parts,
+        Err(e) => return bad_url(e),
+    };
     let Some(name) = frame.strip_suffix(".png") else {
         return error(
             StatusCode::NOT_FOUND,

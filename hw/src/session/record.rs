@@ -59,68 +59,6 @@ pub fn depth_from_u16(depth: &ImageBuffer<Luma<u16>, Vec<u16>>, scale_m: f64) ->
     })
 }
 
-/// The file in `DIR.partial` naming the process that records into it.
-const LOCK: &str = "recording.pid";
-
-/// Whether process `pid` runs (where /proc says; elsewhere assumed to).
-fn process_runs(pid: u32) -> bool {
-    if cfg!(target_os = "linux") {
-        Path::new(&format!("/proc/{pid}")).exists()
-    } else {
-        true
-    }
-}
-
-/// Creates `partial` for this process alone: the directory's creation is the lock, and its
-/// pid file says whose it is. One left by a process that no longer runs is removed first.
-fn claim(partial: &Path) -> Result<(), SessionError> {
-    for _ in 0..2 {
-        match std::fs::create_dir(partial) {
-            Ok(()) => {
-                let lock = partial.join(LOCK);
-                return std::fs::write(&lock, std::process::id().to_string())
-                    .map_err(|e| SessionError::file(&lock, e));
-            }
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                let owner = std::fs::read_to_string(partial.join(LOCK))
-                    .ok()
-                    .and_then(|t| t.trim().parse::<u32>().ok());
-                match owner {
-                    Some(pid) if process_runs(pid) => {
-                        return Err(SessionError::file(
-                            partial,
-                            format!("another tactex (pid {pid}) is recording a session here"),
-                        ));
-                    }
-                    // No pid file yet: its owner is between creating it and writing the file.
-                    None if partial_is_new(partial) => {
-                        return Err(SessionError::file(
-                            partial,
-                            "another tactex is recording a session here",
-                        ));
-                    }
-                    _ => std::fs::remove_dir_all(partial).map_err(|e| {
-                        SessionError::file(partial, format!("cannot remove a stale recording: {e}"))
-                    })?,
-                }
-            }
-            Err(e) => return Err(SessionError::file(partial, format!("cannot create: {e}"))),
-        }
-    }
-    Err(SessionError::file(
-        partial,
-        "another tactex keeps creating this recording",
-    ))
-}
-
-fn partial_is_new(partial: &Path) -> bool {
-    std::fs::metadata(partial)
-        .and_then(|m| m.modified())
-        .ok()
-        .and_then(|t| t.elapsed().ok())
-        .is_some_and(|age| age.as_secs() < 10)
-}
-
 impl SessionRecorder {
     /// Starts a session in `dir`, which must not exist yet. While it records, `DIR.partial`
     /// is this process's: a second recorder into the same directory is refused.
@@ -132,7 +70,8 @@ impl SessionRecorder {
             ));
         }
         let partial = partial_dir(dir);
-        claim(&partial)?;
+        tactex_core::dir_claim::claim_dir(&partial, "recording a session")
+            .map_err(|e| SessionError::file(&e.path, e.reason))?;
         for sub in ["camera", "tactile"] {
             std::fs::create_dir_all(partial.join(sub))
                 .map_err(|e| SessionError::file(&partial, format!("cannot create: {e}")))?;
@@ -260,7 +199,7 @@ impl SessionRecorder {
         let text =
             serde_json::to_string_pretty(&manifest).map_err(|e| SessionError::file(&path, e))?;
         std::fs::write(&path, text + "\n").map_err(|e| SessionError::file(&path, e))?;
-        let _ = std::fs::remove_file(log.partial.join(LOCK));
+        tactex_core::dir_claim::release_dir(&log.partial);
         std::fs::rename(&log.partial, &log.dir).map_err(|e| {
             SessionError::file(&log.dir, format!("cannot move the session here: {e}"))
         })?;
@@ -424,26 +363,5 @@ impl<A: Arm> Arm for RecordingArm<'_, A> {
     }
     fn sim_time_s(&self) -> Option<f64> {
         self.inner.sim_time_s()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_partial_directory_is_claimed_once_and_a_stale_one_taken_over() {
-        let tmp = tempfile::tempdir().unwrap();
-        let partial = tmp.path().join("s.partial");
-        claim(&partial).unwrap();
-        let second = claim(&partial).unwrap_err().to_string();
-        assert!(second.contains("is recording a session here"), "{second}");
-        // A pid no process has (above Linux's pid_max): left by a crash, taken over.
-        std::fs::write(partial.join(LOCK), "4294967295").unwrap();
-        std::fs::write(partial.join("leftover.png"), b"x").unwrap();
-        if cfg!(target_os = "linux") {
-            claim(&partial).unwrap();
-            assert!(!partial.join("leftover.png").exists());
-        }
     }
 }

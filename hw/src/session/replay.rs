@@ -32,8 +32,9 @@ pub fn open_session(
     }
     let path = dir.join(MANIFEST);
     let text = std::fs::read_to_string(&path).map_err(|e| SessionError::file(&path, e))?;
-    let manifest: Manifest =
-        serde_json::from_str(&text).map_err(|e| SessionError::file(&path, e))?;
+    let manifest: Manifest = serde_json::from_str(&text).map_err(|e| {
+        SessionError::file(&path, tactex_core::file_failure::json_failure(&text, &e))
+    })?;
     let field = |field: &str, message: String| SessionError::Field {
         path: path.clone(),
         field: field.into(),
@@ -45,6 +46,11 @@ pub fn open_session(
             format!("'{}' is not {FORMAT}", manifest.format),
         ));
     }
+    manifest
+        .camera
+        .intrinsics
+        .check()
+        .map_err(|m| field("camera.intrinsics", m))?;
     if !(manifest.camera.depth_scale_m.is_finite() && manifest.camera.depth_scale_m > 0.0) {
         return Err(field(
             "camera.depth_scale_m",
@@ -160,7 +166,7 @@ impl RgbdCamera for ReplayCamera {
         self.next += 1;
         let read = |file: &str| {
             let path = self.dir.join(file);
-            tactex_core::image::open(&path)
+            tactex_core::image_file::open(&path)
                 .map_err(|e| failure(&self.name, format!("{}: {e}", path.display())))
         };
         let color = read(&f.color)?.to_rgb8();
@@ -214,7 +220,7 @@ impl TactileSensor for ReplayTactile {
         };
         self.next += 1;
         let path = self.dir.join(&f.image);
-        let image = tactex_core::image::open(&path)
+        let image = tactex_core::image_file::open(&path)
             .map_err(|e| failure(&self.name, format!("{}: {e}", path.display())))?
             .to_rgb8();
         let spec = &self.record.spec;

@@ -449,6 +449,15 @@ impl XArm {
 
     pub fn tcp_pose(&self) -> Result<TcpPose, XArmError> {
         let p = frame::f32_values(&self.call(Register::GetTcpPose, &[])?);
+        // A controller that reports NaN or infinity knows no pose; moving from one would not
+        // be safe, and printing it would hide that.
+        if let Some(bad) = p.iter().take(6).find(|v| !v.is_finite()) {
+            return Err(XArmError::Protocol {
+                addr: self.config.addr.clone(),
+                register: Register::GetTcpPose,
+                message: format!("the pose has a value that is not a number ({bad})"),
+            });
+        }
         Ok(TcpPose::from_array([p[0], p[1], p[2], p[3], p[4], p[5]]))
     }
 

@@ -1,0 +1,68 @@
+//! Images read from files and devices with their work bounded before decoding: a small PNG
+//! can claim 10000 x 10000 pixels, and decoding it whole would take gigabytes. Every image
+//! tactex reads (frames, backgrounds, recorded sessions, camera JPEGs) comes through here.
+
+use image::{DynamicImage, ImageFormat, ImageReader, Limits};
+use std::io::Cursor;
+use std::path::Path;
+
+/// The widest or tallest image read: above any camera or GelSight frame tactex handles
+/// (the D435's 1920 x 1080, the GelSight Mini's 3280 x 2464).
+pub const MAX_SIDE_PX: u32 = 4096;
+
+fn limits() -> Limits {
+    let mut limits = Limits::default();
+    limits.max_image_width = Some(MAX_SIDE_PX);
+    limits.max_image_height = Some(MAX_SIDE_PX);
+    // A 4096 x 4096 16-bit RGBA image, with room for the decoder's own buffers.
+    limits.max_alloc = Some(256 << 20);
+    limits
+}
+
+fn say(e: image::ImageError) -> String {
+    match e {
+        image::ImageError::Limits(_) => {
+            format!("larger than {MAX_SIDE_PX} x {MAX_SIDE_PX} px, the most tactex reads")
+        }
+        e => e.to_string(),
+    }
+}
+
+/// The image at `path`, its format from its contents. The error is the reason alone; the
+/// caller names the file and what it was for.
+pub fn open(path: &Path) -> Result<DynamicImage, String> {
+    let mut reader = ImageReader::open(path)
+        .map_err(|e| e.to_string())?
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    reader.limits(limits());
+    reader.decode().map_err(say)
+}
+
+/// An image in memory in the given format (a camera's MJPG frame).
+pub fn decode(bytes: &[u8], format: ImageFormat) -> Result<DynamicImage, String> {
+    let mut reader = ImageReader::with_format(Cursor::new(bytes), format);
+    reader.limits(limits());
+    reader.decode().map_err(say)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_image_claiming_more_pixels_than_any_sensor_is_refused_before_decoding() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("big.png");
+        image::GrayImage::new(MAX_SIDE_PX + 1, 8)
+            .save(&path)
+            .unwrap();
+        let e = open(&path).unwrap_err();
+        assert!(e.contains("larger than 4096 x 4096 px"), "{e}");
+        let ok = tmp.path().join("ok.png");
+        image::RgbImage::new(320, 240).save(&ok).unwrap();
+        assert_eq!(open(&ok).unwrap().width(), 320);
+        let e = open(&tmp.path().join("none.png")).unwrap_err();
+        assert!(e.contains("No such file"), "{e}");
+    }
+}

@@ -1,0 +1,42 @@
+//! Text from outside (prompts, file contents, a model's or a peer's reply) made safe to
+//! print: control characters, terminal escape sequences among them, shown as escapes rather
+//! than acted on by the terminal; and numbers from outside shown short.
+
+/// `text` with every control character but tab written as its Rust escape (`\u{1b}`);
+/// line breaks too, so that an error stays one line.
+pub fn printable(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c.is_control() && c != '\t' {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// A number shown short: 1e308 as "1e308", not 309 digits; everyday values as written.
+pub fn short_number(v: f64) -> String {
+    if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escape_sequences_and_line_breaks_are_shown_not_acted_on() {
+        let shown = printable("soft \u{1b}[31mred\u{1b}[0m\r\nnext\u{7}");
+        assert_eq!(shown, "soft \\u{1b}[31mred\\u{1b}[0m\\r\\nnext\\u{7}");
+        assert!(!shown.chars().any(char::is_control));
+        assert_eq!(
+            printable("Which kiwi is softest?\tné"),
+            "Which kiwi is softest?\tné"
+        );
+    }
+}
