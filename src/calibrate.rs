@@ -75,6 +75,12 @@ pub struct CalibrateArgs {
     /// Attribution of the images, stored in the file.
     #[arg(long, default_value = "")]
     pub source: String,
+    /// A real frame of the sensor's marker grid, flat or pressed (FOTS's markers/press.png):
+    /// the profile's grid (columns, rows, pitch, dot size and darkness) is read from it. It
+    /// may be the background's size or that turned a quarter. Without it the profile has no
+    /// markers (ball presses carry none).
+    #[arg(long)]
+    pub markers: Option<PathBuf>,
     /// Fit no glow (light scattered in the gel round a contact): the table alone.
     #[arg(long)]
     pub no_glow: bool,
@@ -140,9 +146,48 @@ fn fit_glow(
     .context("fitting the glow")
 }
 
+/// The marker grid of a real marker frame, in the profile's orientation (a frame turned a
+/// quarter has its columns and rows swapped), and its dots' darkness.
+fn read_markers(
+    path: &std::path::Path,
+    (w, h): (u32, u32),
+    mm_per_px: f64,
+) -> Result<(tactex_core::tactile_spec::MarkerGrid, f64)> {
+    let frame = ball_presses::load_rgb(path)?;
+    let turned = match frame.dimensions() {
+        d if d == (w, h) => false,
+        d if d == (h, w) => true,
+        (fw, fh) => bail!(
+            "--markers {}: {fw} x {fh} px; the background is {w} x {h} (or turned, {h} x {w})",
+            path.display()
+        ),
+    };
+    let layout = tactex_core::perception::marker_grid::read_marker_grid(&frame)
+        .map_err(|e| anyhow::anyhow!("--markers {}: {e}", path.display()))?;
+    let (cols, rows) = if turned {
+        (layout.rows, layout.cols)
+    } else {
+        (layout.cols, layout.rows)
+    };
+    Ok((
+        tactex_core::tactile_spec::MarkerGrid {
+            cols,
+            rows,
+            pitch_mm: layout.pitch_px * mm_per_px,
+            radius_mm: layout.radius_px * mm_per_px,
+        },
+        layout.darkness,
+    ))
+}
+
 pub fn run(args: &CalibrateArgs) -> Result<()> {
     let (radius, scale) = (args.ball_radius_mm, args.mm_per_px);
     let background = ball_presses::load_rgb(&args.background)?;
+    // Before the fit: a marker frame that cannot be read fails first.
+    let markers = match &args.markers {
+        Some(path) => Some((path, read_markers(path, background.dimensions(), scale)?)),
+        None => None,
+    };
     let presses = ball_presses::load(
         &args.images,
         &args.annotations,
@@ -216,6 +261,29 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
             .unwrap_or_else(|| "calibrated sensor".into()),
     };
     let noise_sigma_grey = median(&mut noise).unwrap_or(0.0);
+    let (grid, marker_darkness) = match markers {
+        Some((path, (grid, darkness))) => {
+            println!(
+                "{}: markers {} x {}, pitch {:.3} mm, dot radius {:.3} mm, darkness {:.2}",
+                path.display(),
+                grid.cols,
+                grid.rows,
+                grid.pitch_mm,
+                grid.radius_mm,
+                darkness
+            );
+            (grid, darkness)
+        }
+        // The ball presses carry no markers: a profile without a marker grid.
+        None => (
+            tactex_core::tactile_spec::MarkerGrid {
+                cols: 0,
+                rows: 0,
+                ..stock.spec.markers
+            },
+            stock.marker_darkness,
+        ),
+    };
     let mut profile = SensorProfile {
         source: args.source.clone(),
         spec: TactileSpec {
@@ -224,12 +292,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
             height_px: h,
             mm_per_px: scale,
             gel,
-            // The ball presses carry no markers: a profile without a marker grid.
-            markers: tactex_core::tactile_spec::MarkerGrid {
-                cols: 0,
-                rows: 0,
-                ..stock.spec.markers
-            },
+            markers: grid,
             frame_rate_hz,
             table: Some(table),
             ..stock.spec.clone()
@@ -238,7 +301,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         noise_sigma_grey,
         // The real background carries the sensor's vignetting.
         vignette: 0.0,
-        marker_darkness: stock.marker_darkness,
+        marker_darkness,
         glow: None,
         fit: Some(CalibrationFit {
             images: presses.iter().map(|(p, _)| p.image.clone()).collect(),

@@ -54,6 +54,10 @@ pub struct RipenessEvalArgs {
     /// Fidelity level of the presses.
     #[arg(long, default_value = "layer")]
     fidelity: String,
+    /// Sensor profile the presses are rendered with and read through (TOML); default the
+    /// built-in GelSight Mini.
+    #[arg(long)]
+    sensor: Option<PathBuf>,
     #[arg(long)]
     json: bool,
     /// Write ripeness.json and ripeness.png (predictions by stage) here.
@@ -97,6 +101,8 @@ struct RipenessEval {
     presses: u32,
     spot_spread: f64,
     fidelity: String,
+    /// The sensor the presses were rendered with and read through.
+    sensor: tactex_core::sensor_profile::ProfileId,
     fruits: Vec<FruitResult>,
 }
 
@@ -149,6 +155,13 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         fruits.push(spec.clone());
     }
     let estimator = args.estimator.open("--estimator", fidelity.name(), None)?;
+    // The sensor as it is, unrandomised: a lab's validation run on one sensor.
+    let sensor = match &args.sensor {
+        Some(_) => SensorDraw::of(std::sync::Arc::new(crate::ask::load_sensor(
+            args.sensor.as_deref(),
+        )?)),
+        None => SensorDraw::nominal(),
+    };
     let protocol = PressProtocol::default();
     let jobs: Vec<Job> = fruits
         .iter()
@@ -192,7 +205,7 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
                     offset_mm: [rng.random_range(-5.0..=5.0), rng.random_range(-5.0..=5.0)],
                     yaw_deg: rng.random_range(0.0..=45.0),
                     fidelity,
-                    sensor: SensorDraw::nominal(),
+                    sensor: sensor.clone(),
                     phase_mm: rng.random_range(0.0..protocol.step_mm),
                     noise_seed: rng.random(),
                 }
@@ -284,6 +297,7 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         presses: args.presses,
         spot_spread: args.spot_spread,
         fidelity: fidelity.to_string(),
+        sensor: sensor.base.id(),
         fruits: results,
     };
     if let Some(out) = &args.out {
@@ -305,8 +319,8 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         println!(
-            "{} estimator, {} presses per stage, Shore A: median [q25, q75]",
-            report.estimator, args.presses
+            "{} estimator, {} presses per stage on {}, Shore A: median [q25, q75]",
+            report.estimator, args.presses, report.sensor
         );
         for f in &report.fruits {
             let stages: Vec<String> = f

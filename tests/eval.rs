@@ -149,8 +149,29 @@ fn the_trained_model_answers_alike_on_tract_and_onnx_runtime() {
 
 #[test]
 fn stages_are_told_apart_and_each_test_recomputes_from_the_predictions() {
-    let (dir, r) = eval_json(&["ripeness", "--fruits", "lime", "--presses", "4"]);
+    // Through a profile file (the built-in one renamed): the report names the sensor.
+    let profiles = tempfile::tempdir().unwrap();
+    let stock = tactex(&["sensor", "show", "--toml"]);
+    assert!(stock.status.success());
+    let text = String::from_utf8(stock.stdout).unwrap().replacen(
+        "name = \"GelSight Mini\"",
+        "name = \"lab mini\"",
+        1,
+    );
+    let profile = profiles.path().join("lab.toml");
+    std::fs::write(&profile, text).unwrap();
+    let (dir, r) = eval_json(&[
+        "ripeness",
+        "--fruits",
+        "lime",
+        "--presses",
+        "4",
+        "--sensor",
+        profile.to_str().unwrap(),
+    ]);
     assert_eq!(r["estimator"], "indentation");
+    assert_eq!(r["sensor"]["name"], "lab mini");
+    assert_eq!(r["sensor"]["sha256"].as_str().unwrap().len(), 64);
     let lime = &r["fruits"][0];
     assert_eq!(lime["fruit"], "lime");
     let stages = lime["stages"].as_array().unwrap();

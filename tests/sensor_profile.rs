@@ -242,3 +242,128 @@ fn datagen_draws_around_a_profile_and_keeps_one_profile_per_data_set() {
         "{err}"
     );
 }
+
+/// Median distance from each of `points` to its nearest other.
+fn nearest_spacing(points: &[(f64, f64)]) -> f64 {
+    let mut d: Vec<f64> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            points
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, q)| (p.0 - q.0).hypot(p.1 - q.1))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect();
+    d.sort_by(f64::total_cmp);
+    d[d.len() / 2]
+}
+
+#[test]
+fn calibrate_reads_the_marker_grid_from_a_real_marker_frame_and_press_draws_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = fixtures();
+    let presses = f.join("ball-presses");
+    let profile = dir.path().join("fots.toml");
+    let mm_per_px = 0.051072522982635343;
+    let out = tactex(&[
+        "calibrate",
+        "--images",
+        presses.to_str().unwrap(),
+        "--annotations",
+        presses.join("annotations.csv").to_str().unwrap(),
+        "--background",
+        f.join("background.png").to_str().unwrap(),
+        "--ball-radius-mm",
+        "2.35",
+        "--mm-per-px",
+        &mm_per_px.to_string(),
+        "--markers",
+        f.join("markers/press.png").to_str().unwrap(),
+        "--no-glow",
+        "--out",
+        profile.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // FOTS's authors annotated the frame's 11 x 9 grid (landscape; the presses are portrait).
+    let annotated: Vec<(f64, f64)> = std::fs::read_to_string(f.join("markers/press.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|c| c.trim().parse().unwrap()).collect();
+            (v[0] + v[2] + 0.5, v[1] + v[3] + 0.5)
+        })
+        .collect();
+    assert_eq!(annotated.len(), 99);
+    let pitch_px = nearest_spacing(&annotated);
+    let text = std::fs::read_to_string(&profile).unwrap();
+    let toml: toml::Value = toml::from_str(&text).unwrap();
+    let m = &toml["markers"];
+    assert_eq!(
+        (m["cols"].as_integer(), m["rows"].as_integer()),
+        (Some(9), Some(11))
+    );
+    let pitch_mm = m["pitch_mm"].as_float().unwrap();
+    assert!(
+        (pitch_mm / (pitch_px * mm_per_px) - 1.0).abs() < 0.02,
+        "pitch {pitch_mm} mm against the annotations' {} mm",
+        pitch_px * mm_per_px
+    );
+    // Dots of about a fifth of the pitch across, blocking most of the light.
+    let radius_mm = m["radius_mm"].as_float().unwrap();
+    assert!(
+        (0.15..0.3).contains(&(radius_mm / pitch_mm)),
+        "{radius_mm} mm"
+    );
+    let darkness = m["darkness"].as_float().unwrap();
+    assert!((0.5..=1.0).contains(&darkness), "{darkness}");
+
+    // The twin draws that grid: its no-contact frame shows 99 dots at the real pitch.
+    let pressed = dir.path().join("press");
+    let status = tactex(&[
+        "press",
+        "--shape",
+        "sphere",
+        "--radius-mm",
+        "2.35",
+        "--hardness",
+        "rigid",
+        "--depth-mm",
+        "0.4",
+        "--sensor",
+        profile.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "--out",
+        pressed.to_str().unwrap(),
+    ]);
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let found = json(&tactex(&[
+        "markers",
+        pressed.join("reference.png").to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(found["count"].as_u64(), Some(99), "{found}");
+    let drawn: Vec<(f64, f64)> = found["markers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect();
+    let drawn_pitch = nearest_spacing(&drawn);
+    assert!(
+        (drawn_pitch / pitch_px - 1.0).abs() < 0.03,
+        "{drawn_pitch} px vs {pitch_px} px"
+    );
+}

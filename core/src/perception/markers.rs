@@ -18,6 +18,23 @@ const BACKGROUND_RADIUS_PX: u8 = 8;
 /// a grey-level closing (the dots are small dark holes in a smooth bright field), so shading
 /// gradients and coloured glows around a contact do not bias the centroids.
 pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
+    detect_dots(img).into_iter().map(|d| d.centre_px).collect()
+}
+
+/// One marker dot as seen: where, how large and how dark.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dot {
+    pub centre_px: (f64, f64),
+    /// Pixels of its silhouette.
+    pub area_px: usize,
+    /// Whether the frame's edge cuts it (its area is then a part).
+    pub cut_by_frame: bool,
+    /// The share of the gel's light its darkest pixel blocks (0 none, 1 all).
+    pub darkness: f64,
+}
+
+/// The dots of `detect_markers`, with their size and darkness, in the same order.
+pub fn detect_dots(img: &RgbImage) -> Vec<Dot> {
     let (w, h) = img.dimensions();
     let lum = GrayImage::from_fn(w, h, |x, y| {
         let p = img.get_pixel(x, y);
@@ -40,7 +57,7 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
             blobs[l[0] as usize].push(Point::new(x as i32, y as i32));
         }
     }
-    let mut out: Vec<(f64, f64)> = blobs
+    let mut out: Vec<Dot> = blobs
         .into_iter()
         .skip(1)
         // Specks and smudges are not dots. A dot cut by the frame edge is kept: its centroid
@@ -50,10 +67,23 @@ pub fn detect_markers(img: &RgbImage) -> Vec<(f64, f64)> {
             let cut_by_frame = b
                 .iter()
                 .any(|p| p.x == 0 || p.y == 0 || p.x + 1 == w as i32 || p.y + 1 == h as i32);
-            dot_centre(&b, cut_by_frame)
+            let blocked = b
+                .iter()
+                .map(|p| {
+                    let (x, y) = (p.x as u32, p.y as u32);
+                    darkness(x, y) / (background.get_pixel(x, y)[0] as f64).max(1.0)
+                })
+                .fold(0.0, f64::max);
+            Dot {
+                centre_px: dot_centre(&b, cut_by_frame),
+                area_px: b.len(),
+                cut_by_frame,
+                darkness: blocked.clamp(0.0, 1.0),
+            }
         })
         .collect();
     out.sort_by(|p, q| {
+        let (p, q) = (p.centre_px, q.centre_px);
         (p.1.round(), p.0)
             .partial_cmp(&(q.1.round(), q.0))
             .unwrap_or(std::cmp::Ordering::Equal)

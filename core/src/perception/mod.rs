@@ -12,6 +12,7 @@ pub mod depth;
 pub mod detect;
 pub mod grounding;
 pub mod height_split;
+pub mod marker_grid;
 pub mod markers;
 pub mod mask;
 pub mod press_site;
