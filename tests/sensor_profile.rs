@@ -267,7 +267,7 @@ fn calibrate_reads_the_marker_grid_from_a_real_marker_frame_and_press_draws_it()
     let f = fixtures();
     let presses = f.join("ball-presses");
     let profile = dir.path().join("fots.toml");
-    let mm_per_px = 0.051072522982635343;
+    let mm_per_px = 0.05107252298263534;
     let out = tactex(&[
         "calibrate",
         "--images",
