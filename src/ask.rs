@@ -662,6 +662,11 @@ fn print_answer(a: &Answer) {
         for w in &o.warnings {
             println!("    warning: {w}");
         }
+        if let Some(tactex_core::estimate::Evidence::Learned(l)) = &o.evidence
+            && let Some(note) = &l.other_sensor
+        {
+            println!("    note: {note}");
+        }
     }
     println!("\n{:<10} {:>10} {:>12}", "stage", "wall (ms)", "robot (s)");
     for t in &a.timing {

@@ -367,3 +367,34 @@ fn calibrate_reads_the_marker_grid_from_a_real_marker_frame_and_press_draws_it()
         "{drawn_pitch} px vs {pitch_px} px"
     );
 }
+
+#[test]
+fn the_learned_model_says_so_when_it_reads_another_sensor_than_it_was_trained_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let stock = tactex(&["sensor", "show", "--toml"]);
+    assert!(stock.status.success());
+    let lab = String::from_utf8(stock.stdout).unwrap().replacen(
+        "name = \"GelSight Mini\"",
+        "name = \"lab mini\"",
+        1,
+    );
+    let profile = dir.path().join("lab.toml");
+    std::fs::write(&profile, lab).unwrap();
+    let ask = |extra: &[&str]| {
+        let mut args = vec!["ask", "How hard is the lime?", "--json"];
+        args.extend_from_slice(extra);
+        json(&tactex(&args))
+    };
+    let on_stock = ask(&[]);
+    let evidence = &on_stock["objects"][0]["evidence"];
+    assert_eq!(evidence["trained_on_sensor"], "GelSight Mini", "{evidence}");
+    assert!(evidence.get("other_sensor").is_none(), "{evidence}");
+    let on_lab = ask(&["--sensor", profile.to_str().unwrap()]);
+    let note = on_lab["objects"][0]["evidence"]["other_sensor"]
+        .as_str()
+        .expect("a note on the other sensor");
+    assert!(
+        note.contains("'lab mini'") && note.contains("trained on sensor 'GelSight Mini'"),
+        "{note}"
+    );
+}

@@ -51,6 +51,12 @@ pub struct LearnedEvidence {
     pub flip_spread_ln: f64,
     /// The model's RMSE in ln(E) on held-out shapes, from its model card.
     pub heldout_rmse_ln: f64,
+    /// The sensor its training data was drawn around, where its card says.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trained_on_sensor: Option<String>,
+    /// Set when the frames come from another sensor than that: what this means.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub other_sensor: Option<String>,
 }
 
 #[derive(Clone, Debug, Serialize, PartialEq)]

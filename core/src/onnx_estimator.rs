@@ -36,6 +36,18 @@ pub struct ModelCard {
     pub width: u32,
     /// RMSE of ln(E) on held-out shapes.
     pub ln_modulus_rmse: f64,
+    /// The sensor profile its training data was drawn around (`datagen tactile --sensor`
+    /// randomises around it): the family of sensors whose frames it has seen. Absent on
+    /// cards written before profiles.
+    #[serde(default)]
+    pub sensor: Option<CardSensor>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+pub struct CardSensor {
+    pub name: String,
+    #[serde(default)]
+    pub sha256: Option<String>,
 }
 
 impl ModelCard {
@@ -210,7 +222,7 @@ impl HardnessEstimator for OnnxEstimator {
     fn estimate(
         &self,
         press: &PressSequence,
-        _spec: &TactileSpec,
+        spec: &TactileSpec,
     ) -> Result<HardnessEstimate, EstimateError> {
         let last = *self.card.frame_picks.last().expect("checked at load");
         if press.frames.len() <= last {
@@ -261,6 +273,20 @@ impl HardnessEstimator for OnnxEstimator {
                 frames_used: self.card.frame_picks.clone(),
                 flip_spread_ln: spread,
                 heldout_rmse_ln: self.card.ln_modulus_rmse,
+                trained_on_sensor: self.card.sensor.as_ref().map(|s| s.name.clone()),
+                // The held-out RMSE was measured on the training sensor's family; on another
+                // sensor's frames it is not a measured figure, and the evidence says so.
+                other_sensor: self
+                    .card
+                    .sensor
+                    .as_ref()
+                    .filter(|s| s.name != spec.model)
+                    .map(|s| {
+                        format!(
+                            "reading frames of sensor '{}' with a model trained on sensor '{}'; its held-out error was not measured here",
+                            spec.model, s.name
+                        )
+                    }),
             }),
         })
     }

@@ -122,8 +122,26 @@ def write_atomic(path, text):
     tmp.replace(path)
 
 
+def training_sensor(dirs):
+    """The sensor profile (name, sha256) the training sets were drawn around, from their
+    dataset.json; one for all of them, or None for sets written before profiles."""
+    seen = set()
+    for d in dirs:
+        info_path = Path(d) / "dataset.json"
+        if not info_path.is_file():
+            raise SystemExit(f"{d}: no dataset.json (not a `tactex datagen tactile` directory)")
+        sensor = json.loads(info_path.read_text()).get("sensor")
+        seen.add(json.dumps(sensor, sort_keys=True) if sensor else None)
+    if len(seen) > 1:
+        raise SystemExit("--train: the data sets were drawn around different sensor profiles; a model card names one")
+    only = seen.pop()
+    return json.loads(only) if only else None
+
+
 def main():
     args = parse_args()
+    # Before any loading: a mix of sensors fails first.
+    sensor = training_sensor(args.train)
     torch.manual_seed(args.seed)
     torch.set_num_threads(args.threads)
     out = Path(args.out)
@@ -247,6 +265,8 @@ def main():
         # Uncertainty floor for the Rust estimator: the held-out spread, else the validation one.
         "ln_modulus_rmse": (metrics["heldout"][0] if metrics["heldout"] else metrics["validation"])["ln_modulus_rmse"],
         "onnx_vs_torch_max_abs": export_err,
+        # The family of sensors whose frames it has seen; tactex says so on another's frames.
+        **({"sensor": sensor} if sensor else {}),
         "recipe": recipe,
         "metrics": metrics,
     }
