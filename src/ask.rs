@@ -58,8 +58,8 @@ pub struct AskArgs {
     #[arg(long)]
     pub record: Option<PathBuf>,
     /// The sim GelSight's gel modulus (MPa) instead of the stock 0.3: what a softer or
-    /// harder gel would see (--backend sim).
-    #[arg(long)]
+    /// harder gel would see (--backend sim); 0.01 to 50 MPa.
+    #[arg(long, value_parser = crate::flag_range::within(0.01, 50.0))]
     pub gel_modulus_mpa: Option<f64>,
     /// The question.
     pub prompt: String,

@@ -41,8 +41,8 @@ pub struct AskBenchArgs {
     /// Mini.
     #[arg(long)]
     sensor: Option<PathBuf>,
-    /// Timed questions at each fidelity (the median is reported); one more, untimed, warms up.
-    #[arg(long, default_value_t = 5)]
+    /// Timed questions at each fidelity (the median is reported); one more, untimed, warms up; 1 to 1000.
+    #[arg(long, value_parser = crate::flag_range::count::<usize>(1, 1000), default_value_t = 5)]
     reps: usize,
     /// Seed of the sim devices.
     #[arg(long, default_value_t = 0)]
@@ -83,9 +83,6 @@ pub struct AskBench {
 }
 
 pub fn run(args: &AskBenchArgs) -> Result<()> {
-    if args.reps == 0 {
-        bail!("--reps: must be at least 1");
-    }
     if args.fidelity.is_empty() {
         bail!("--fidelity: name at least one of rigid, hertz, halfspace, layer");
     }

@@ -27,8 +27,8 @@ pub struct ContactBenchArgs {
     /// Write contact_bench.csv, contact_bench.md and contact_pareto.png here.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Timed repetitions of each 8-frame press (the median is reported).
-    #[arg(long, default_value_t = 5)]
+    /// Timed repetitions of each 8-frame press (the median is reported); 1 to 1000.
+    #[arg(long, value_parser = crate::flag_range::count::<usize>(1, 1000), default_value_t = 5)]
     reps: usize,
     /// Solver cells to time (mm, 0.02 to 5, or "auto" for the default grid).
     #[arg(long, value_delimiter = ',', default_value = "auto,0.4,0.2,0.1")]
@@ -144,7 +144,6 @@ fn rms_um(
 }
 
 pub fn run(args: &ContactBenchArgs) -> Result<()> {
-    anyhow::ensure!(args.reps >= 1, "--reps: must be at least 1");
     let spec = TactileSpec::gelsight_mini();
     let setup = Setup {
         surface: ObjectSurface::Sphere {

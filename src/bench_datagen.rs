@@ -14,8 +14,8 @@ use tactex_sim::gel_render::DeviceChoice;
 
 #[derive(Args, Debug)]
 pub struct DatagenBenchArgs {
-    /// Sequences generated per fidelity level.
-    #[arg(long, default_value_t = 48)]
+    /// Sequences generated per fidelity level; 1 to 100000.
+    #[arg(long, value_parser = crate::flag_range::count::<u64>(1, 100_000), default_value_t = 48)]
     count: u64,
     /// Fidelity levels to time (comma-separated).
     #[arg(
@@ -81,9 +81,6 @@ fn dir_bytes(dir: &std::path::Path) -> u64 {
 }
 
 pub fn run(args: &DatagenBenchArgs) -> Result<()> {
-    if args.count == 0 {
-        anyhow::bail!("--count: must be at least 1");
-    }
     let bar = ProgressBar::new(args.fidelity.len() as u64).with_style(
         ProgressStyle::with_template("bench datagen [{bar:30}] {pos}/{len} levels {msg}")
             .expect("a valid template"),

@@ -24,8 +24,8 @@ pub struct SceneBenchArgs {
     /// Scene file (TOML); default scenes/demo.toml.
     #[arg(long)]
     scene: Option<PathBuf>,
-    /// Timed repetitions of each measurement (the median is reported).
-    #[arg(long, default_value_t = 9)]
+    /// Timed repetitions of each measurement (the median is reported); 1 to 1000.
+    #[arg(long, value_parser = crate::flag_range::count::<usize>(1, 1000), default_value_t = 9)]
     reps: usize,
     /// Print the report as JSON.
     #[arg(long)]
@@ -60,7 +60,6 @@ pub struct SceneBench {
 }
 
 pub fn run(args: &SceneBenchArgs) -> Result<()> {
-    anyhow::ensure!(args.reps >= 1, "--reps: must be at least 1");
     let reps = args.reps;
     let path = args.scene.clone().unwrap_or_else(crate::default_scene);
     let scene = Scene::load(&path, &FruitCatalog::builtin())?;

@@ -60,11 +60,11 @@ pub struct CalibrateArgs {
     /// Which presses to fit: calib (all but every third), eval, or all.
     #[arg(long, value_enum, default_value_t = Split::Calib)]
     pub split: Split,
-    /// Table nodes over slope magnitude.
-    #[arg(long, default_value_t = 12)]
+    /// Table nodes over slope magnitude; 2 to 100.
+    #[arg(long, value_parser = crate::flag_range::count::<u32>(2, 100), default_value_t = 12)]
     pub mag_bins: u32,
-    /// Table nodes over slope direction.
-    #[arg(long, default_value_t = 24)]
+    /// Table nodes over slope direction; 4 to 360.
+    #[arg(long, value_parser = crate::flag_range::count::<u32>(4, 360), default_value_t = 24)]
     pub dir_bins: u32,
     /// Largest slope (dw/dr) the table covers (above 0 up to 100).
     #[arg(long, default_value_t = 2.5, value_parser = above(0.0, 100.0))]

@@ -51,8 +51,8 @@ const PREVIEW_SCENES: usize = 4;
 
 #[derive(Args, Debug)]
 pub struct SceneDatagenArgs {
-    /// Scenes in the data set.
-    #[arg(long)]
+    /// Scenes in the data set; 1 to 10000000.
+    #[arg(long, value_parser = crate::flag_range::count::<usize>(1, 10_000_000))]
     pub count: usize,
     /// Output directory.
     #[arg(long)]
@@ -65,7 +65,7 @@ pub struct SceneDatagenArgs {
     /// Fruit kinds to draw from (catalog names, comma-separated); all catalog fruits if unset.
     #[arg(long, value_delimiter = ',')]
     pub kinds: Vec<String>,
-    /// Share of scenes in the validation split, spread evenly over the indices.
+    /// Share of scenes in the validation split, 0 to under 1, spread evenly over the indices.
     #[arg(long, default_value_t = 0.2)]
     pub val_fraction: f64,
     /// Device that renders the scenes: cpu (the default, so that the data never depends on

@@ -18,11 +18,11 @@ pub struct DetectArgs {
     /// The YOLOv8-seg ONNX export.
     #[arg(long)]
     pub model: PathBuf,
-    /// Minimum class score (Ultralytics' default 0.25).
+    /// Minimum class score, 0 to under 1 (Ultralytics' default 0.25).
     #[arg(long, default_value_t = 0.25)]
     pub confidence: f64,
-    /// NMS IoU threshold (Ultralytics' default 0.7).
-    #[arg(long, default_value_t = 0.7)]
+    /// NMS IoU threshold, 0 to 1 (Ultralytics' default 0.7).
+    #[arg(long, default_value_t = 0.7, value_parser = crate::flag_range::within(0.0, 1.0))]
     pub iou: f64,
     /// Print one JSON object on stdout.
     #[arg(long)]
@@ -55,11 +55,6 @@ pub fn run(args: &DetectArgs) -> Result<()> {
         (0.0..1.0).contains(&args.confidence),
         "--confidence: {} is not in [0, 1)",
         args.confidence
-    );
-    anyhow::ensure!(
-        (0.0..=1.0).contains(&args.iou),
-        "--iou: {} is not in [0, 1]",
-        args.iou
     );
     let image = load_rgb(&args.image)?;
     let mut detector = YoloSegDetector::load(&args.model)?;

@@ -43,8 +43,8 @@ const TIE_RATIO: f64 = 1.01;
 
 #[derive(Args)]
 pub struct ExplanationEvalArgs {
-    /// Prompts to ask (the issue: 100).
-    #[arg(long, default_value_t = 100)]
+    /// Prompts to ask (the issue: 100); 1 to 100000.
+    #[arg(long, value_parser = crate::flag_range::count::<usize>(1, 100_000), default_value_t = 100)]
     pub prompts: usize,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -598,7 +598,6 @@ fn share(scores: &[&CaseScore], f: impl Fn(&CaseScore) -> bool) -> f64 {
 }
 
 pub fn run(args: &ExplanationEvalArgs) -> Result<()> {
-    anyhow::ensure!(args.prompts >= 1, "--prompts: must be at least 1");
     let catalog = FruitCatalog::builtin();
     let explainer: Box<dyn Explainer> = explainer(args.explainer, args.llm_config.as_ref())?;
     let cases = (0..args.prompts)

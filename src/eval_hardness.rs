@@ -5,7 +5,7 @@
 
 use crate::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::plot::{self, ScatterSeries};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -22,8 +22,8 @@ use tactex_sim::tactile_sample::ShapeFamily;
 
 #[derive(Args, Debug)]
 pub struct HardnessEvalArgs {
-    /// Held-out presses.
-    #[arg(long, default_value_t = 60)]
+    /// Held-out presses; 3 to 100000.
+    #[arg(long, value_parser = crate::flag_range::count::<u64>(3, 100_000), default_value_t = 60)]
     count: u64,
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -101,12 +101,6 @@ struct PressRecord {
 }
 
 pub fn run(args: &HardnessEvalArgs) -> Result<()> {
-    if args.count < 3 {
-        bail!(
-            "--count: need at least 3 presses to score, got {}",
-            args.count
-        );
-    }
     let mut space = crate::datagen_tactile::sample_space(&args.fidelity, &args.shapes)?;
     if args.sensor.is_some() {
         space = space.around(crate::ask::load_sensor(args.sensor.as_deref())?);

@@ -42,14 +42,14 @@ pub struct RipenessEvalArgs {
     estimator: EstimatorChoice,
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Presses per ripeness stage.
-    #[arg(long, default_value_t = 20)]
+    /// Presses per ripeness stage; 3 to 10000.
+    #[arg(long, value_parser = crate::flag_range::count::<u32>(3, 10_000), default_value_t = 20)]
     presses: u32,
     /// Fruits to press (catalog names; default the paper's Table III).
     #[arg(long, value_delimiter = ',')]
     fruits: Vec<String>,
-    /// Log-sd of the flesh modulus from spot to spot within a fruit.
-    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    /// Log-sd of the flesh modulus from spot to spot within a fruit; 0 to 1.
+    #[arg(long, value_parser = crate::flag_range::within(0.0, 1.0), default_value_t = 0.1, allow_negative_numbers = true)]
     spot_spread: f64,
     /// Fidelity level of the presses.
     #[arg(long, default_value = "layer")]
@@ -125,15 +125,6 @@ struct Job {
 }
 
 pub fn run(args: &RipenessEvalArgs) -> Result<()> {
-    if args.presses < 3 {
-        bail!("--presses: need at least 3 per stage, got {}", args.presses);
-    }
-    if !(args.spot_spread.is_finite() && (0.0..=1.0).contains(&args.spot_spread)) {
-        bail!(
-            "--spot-spread: {} is not a log-sd in [0, 1]",
-            args.spot_spread
-        );
-    }
     let fidelity: Fidelity = args
         .fidelity
         .parse()

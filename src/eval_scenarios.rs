@@ -46,8 +46,8 @@ const TIER2_DRAWS: u64 = 64;
 
 #[derive(Args)]
 pub struct ScenarioEvalArgs {
-    /// Runs per tier (the paper: 10).
-    #[arg(long, default_value_t = 10)]
+    /// Runs per tier (the paper: 10); 1 to 1000.
+    #[arg(long, value_parser = crate::flag_range::count::<usize>(1, 1000), default_value_t = 10)]
     pub runs: usize,
     /// Detectors to compare: classical, yolo:FILE.onnx, error-gsam, error-yolo.
     #[arg(
@@ -560,7 +560,6 @@ fn plots(dir: &std::path::Path, report: &ScenarioReport) -> Result<()> {
 }
 
 pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
-    anyhow::ensure!(args.runs >= 1, "--runs: must be at least 1");
     anyhow::ensure!(!args.detector.is_empty(), "--detector: name at least one");
     let tiers: Vec<u8> = if args.tiers.is_empty() {
         vec![1, 2, 3, 4]

@@ -37,6 +37,25 @@ pub fn above(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
     }
 }
 
+/// A whole number in [lo, hi]: a count, a repetition, a table's nodes.
+pub fn count<T: TryFrom<u64> + Clone + Send + Sync + 'static>(
+    lo: u64,
+    hi: u64,
+) -> impl Fn(&str) -> Result<T, String> + Clone {
+    move |text| {
+        let span = format!("[{lo}, {hi}]");
+        let v: u64 = text
+            .trim()
+            .parse()
+            .map_err(|_| format!("expected a whole number in {span}"))?;
+        if (lo..=hi).contains(&v) {
+            T::try_from(v).map_err(|_| format!("{v} is outside {span}"))
+        } else {
+            Err(format!("{v} is outside {span}"))
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -53,5 +72,10 @@ mod tests {
         let w = within(-360.0, 360.0);
         assert_eq!(w("-360"), Ok(-360.0));
         assert!(w("361").is_err());
+        let c = count::<u32>(1, 1000);
+        assert_eq!(c("5"), Ok(5));
+        assert_eq!(c("0").unwrap_err(), "0 is outside [1, 1000]");
+        assert!(c("-1").unwrap_err().contains("[1, 1000]"));
+        assert!(c("1e3").unwrap_err().contains("whole number"));
     }
 }

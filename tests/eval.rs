@@ -398,7 +398,7 @@ fn explanations_of_the_template_are_accurate_and_complete_on_every_prompt_kind()
     assert_eq!(&png[1..4], b"PNG");
     bad_arguments_are_named(
         "explanations",
-        &[(&["--prompts", "0"], "--prompts: must be at least 1")],
+        &[(&["--prompts", "0"], "0 is outside [1, 100000]")],
     );
 }
 

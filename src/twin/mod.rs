@@ -46,16 +46,17 @@ pub struct TwinArgs {
     /// the SDK's `XCONF.SocketConf.TCP_CONTROL_PORT` to it). 0 takes a free port.
     #[arg(long, default_value_t = 502)]
     pub port: u16,
-    /// Port of the rich report (the SDK's default report).
+    /// Port of the rich report (the SDK's default report); 0 to 65535, 0 a free port.
     #[arg(long, default_value_t = 30002)]
     pub report_port: u16,
-    /// Port of the normal report.
+    /// Port of the normal report; 0 to 65535, 0 a free port.
     #[arg(long, default_value_t = 30001)]
     pub normal_report_port: u16,
-    /// Port of the real-time report.
+    /// Port of the real-time report; 0 to 65535, 0 a free port.
     #[arg(long, default_value_t = 30003)]
     pub real_report_port: u16,
-    /// Port of the frames over HTTP (GelSight and RealSense PNGs, the controller's state).
+    /// Port of the frames over HTTP (GelSight and RealSense PNGs, the controller's state); 0
+    /// to 65535, 0 a free port.
     #[arg(long, default_value_t = 8090)]
     pub http_port: u16,
     /// Where the robot's base stands in the table frame, x,y,z in metres (the table's centre
