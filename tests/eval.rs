@@ -2,14 +2,9 @@
 //! and `eval explanations` end to end on small runs: their JSON contracts, plots and raw records, tests
 //! that recompute from the raw predictions, and bad input named.
 
+mod cli;
+use cli::tactex;
 use std::process::Command;
-
-fn tactex(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_tactex"))
-        .args(args)
-        .output()
-        .expect("tactex runs")
-}
 
 /// `tactex eval ARGS --json --out DIR` into a fresh DIR: the directory and stdout's JSON.
 fn eval_json(args: &[&str]) -> (tempfile::TempDir, serde_json::Value) {
@@ -151,15 +146,7 @@ fn the_trained_model_answers_alike_on_tract_and_onnx_runtime() {
 fn stages_are_told_apart_and_each_test_recomputes_from_the_predictions() {
     // Through a profile file (the built-in one renamed): the report names the sensor.
     let profiles = tempfile::tempdir().unwrap();
-    let stock = tactex(&["sensor", "show", "--toml"]);
-    assert!(stock.status.success());
-    let text = String::from_utf8(stock.stdout).unwrap().replacen(
-        "name = \"GelSight Mini\"",
-        "name = \"lab mini\"",
-        1,
-    );
-    let profile = profiles.path().join("lab.toml");
-    std::fs::write(&profile, text).unwrap();
+    let profile = cli::renamed_stock_profile(profiles.path(), "lab mini");
     let (dir, r) = eval_json(&[
         "ripeness",
         "--fruits",

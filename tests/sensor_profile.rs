@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 mod cli;
 
 use cli::{json, one_line_error, tactex};
+use tactex_core::perception::markers::grid_pitch_px;
 use tactex_core::perception::ssim::ssim_rgb;
 
 fn fixtures() -> PathBuf {
@@ -14,17 +15,23 @@ fn fixtures() -> PathBuf {
 
 /// `calibrate` on the fixtures' ball presses into `dir/fots.toml`.
 fn calibrated(dir: &Path) -> PathBuf {
+    calibrated_with(dir, &[])
+}
+
+/// The same with `extra` flags.
+fn calibrated_with(dir: &Path, extra: &[&str]) -> PathBuf {
     let f = fixtures();
     let presses = f.join("ball-presses");
     let profile = dir.join("fots.toml");
-    let out = tactex(&[
+    let (annotations, background) = (presses.join("annotations.csv"), f.join("background.png"));
+    let mut args = vec![
         "calibrate",
         "--images",
         presses.to_str().unwrap(),
         "--annotations",
-        presses.join("annotations.csv").to_str().unwrap(),
+        annotations.to_str().unwrap(),
         "--background",
-        f.join("background.png").to_str().unwrap(),
+        background.to_str().unwrap(),
         "--ball-radius-mm",
         "2.35",
         "--mm-per-px",
@@ -33,7 +40,9 @@ fn calibrated(dir: &Path) -> PathBuf {
         profile.to_str().unwrap(),
         "--source",
         "FOTS (Zhao et al., RA-L 2024), MIT",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let out = tactex(&args);
     assert!(
         out.status.success(),
         "{}",
@@ -243,54 +252,16 @@ fn datagen_draws_around_a_profile_and_keeps_one_profile_per_data_set() {
     );
 }
 
-/// Median distance from each of `points` to its nearest other.
-fn nearest_spacing(points: &[(f64, f64)]) -> f64 {
-    let mut d: Vec<f64> = points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            points
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i)
-                .map(|(_, q)| (p.0 - q.0).hypot(p.1 - q.1))
-                .fold(f64::INFINITY, f64::min)
-        })
-        .collect();
-    d.sort_by(f64::total_cmp);
-    d[d.len() / 2]
-}
-
 #[test]
 fn calibrate_reads_the_marker_grid_from_a_real_marker_frame_and_press_draws_it() {
     let dir = tempfile::tempdir().unwrap();
     let f = fixtures();
-    let presses = f.join("ball-presses");
-    let profile = dir.path().join("fots.toml");
-    let mm_per_px = 0.05107252298263534;
-    let out = tactex(&[
-        "calibrate",
-        "--images",
-        presses.to_str().unwrap(),
-        "--annotations",
-        presses.join("annotations.csv").to_str().unwrap(),
-        "--background",
-        f.join("background.png").to_str().unwrap(),
-        "--ball-radius-mm",
-        "2.35",
-        "--mm-per-px",
-        &mm_per_px.to_string(),
-        "--markers",
-        f.join("markers/press.png").to_str().unwrap(),
-        "--no-glow",
-        "--out",
-        profile.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let frame = f.join("markers/press.png");
+    let profile = calibrated_with(
+        dir.path(),
+        &["--markers", frame.to_str().unwrap(), "--no-glow"],
     );
+    let mm_per_px = 0.05107252298263534;
     // FOTS's authors annotated the frame's 11 x 9 grid (landscape; the presses are portrait).
     let annotated: Vec<(f64, f64)> = std::fs::read_to_string(f.join("markers/press.csv"))
         .unwrap()
@@ -302,7 +273,7 @@ fn calibrate_reads_the_marker_grid_from_a_real_marker_frame_and_press_draws_it()
         })
         .collect();
     assert_eq!(annotated.len(), 99);
-    let pitch_px = nearest_spacing(&annotated);
+    let pitch_px = grid_pitch_px(&annotated).unwrap();
     let text = std::fs::read_to_string(&profile).unwrap();
     let toml: toml::Value = toml::from_str(&text).unwrap();
     let m = &toml["markers"];
@@ -361,7 +332,7 @@ fn calibrate_reads_the_marker_grid_from_a_real_marker_frame_and_press_draws_it()
         .iter()
         .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
         .collect();
-    let drawn_pitch = nearest_spacing(&drawn);
+    let drawn_pitch = grid_pitch_px(&drawn).unwrap();
     assert!(
         (drawn_pitch / pitch_px - 1.0).abs() < 0.03,
         "{drawn_pitch} px vs {pitch_px} px"
@@ -371,15 +342,7 @@ fn calibrate_reads_the_marker_grid_from_a_real_marker_frame_and_press_draws_it()
 #[test]
 fn the_learned_model_says_so_when_it_reads_another_sensor_than_it_was_trained_on() {
     let dir = tempfile::tempdir().unwrap();
-    let stock = tactex(&["sensor", "show", "--toml"]);
-    assert!(stock.status.success());
-    let lab = String::from_utf8(stock.stdout).unwrap().replacen(
-        "name = \"GelSight Mini\"",
-        "name = \"lab mini\"",
-        1,
-    );
-    let profile = dir.path().join("lab.toml");
-    std::fs::write(&profile, lab).unwrap();
+    let profile = cli::renamed_stock_profile(dir.path(), "lab mini");
     let ask = |extra: &[&str]| {
         let mut args = vec!["ask", "How hard is the lime?", "--json"];
         args.extend_from_slice(extra);

@@ -39,3 +39,18 @@ pub fn one_line_error(out: &Output) -> String {
     assert!(out.stdout.is_empty());
     stderr
 }
+
+/// The built-in GelSight Mini profile under another name, written to `dir/NAME.toml`: the
+/// same sensor, which outputs must name as given.
+pub fn renamed_stock_profile(dir: &std::path::Path, name: &str) -> std::path::PathBuf {
+    let stock = tactex(&["sensor", "show", "--toml"]);
+    assert!(stock.status.success());
+    let text = String::from_utf8(stock.stdout).unwrap().replacen(
+        "name = \"GelSight Mini\"",
+        &format!("name = \"{name}\""),
+        1,
+    );
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
