@@ -19,7 +19,8 @@ struct RenderParams {
     mag_bins: u32,
     dir_bins: u32,
     mag_max: f32,
-    padding: u32,
+    // Gain on the light reaching the camera: after the marker dots, before the noise.
+    exposure: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: RenderParams;

@@ -1,5 +1,5 @@
-// Stage 4, exposure: the marker dots darken the shaded gel (anti-aliased over one pixel),
-// then seeded camera noise and 8-bit quantisation, packed as RGBA8.
+// Stage 4, exposure: the marker dots darken the shaded gel (anti-aliased over one pixel), the
+// camera's exposure gain, then seeded camera noise and 8-bit quantisation, packed as RGBA8.
 
 @group(0) @binding(1) var<storage, read> shaded: array<f32>;
 @group(0) @binding(2) var<storage, read> centres: array<vec2<f32>>;
@@ -69,6 +69,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             colour = colour * (1.0 - params.marker_darkness * min(reach - d, 1.0));
         }
     }
+    colour = colour * params.exposure;
     let noise = gaussian3(frame_seeds[id.z], pixel);
     var packed = 0xff000000u;
     for (var c = 0u; c < 3u; c = c + 1u) {

@@ -301,6 +301,8 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         noise_sigma_grey,
         // The real background carries the sensor's vignetting.
         vignette: 0.0,
+        // The presses' own exposure: the background was taken at it.
+        exposure: 1.0,
         marker_darkness,
         glow: None,
         fit: Some(CalibrationFit {

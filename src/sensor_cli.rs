@@ -60,6 +60,7 @@ struct Summary {
     frame_rate_hz: f64,
     noise_sigma_grey: f64,
     vignette: f64,
+    exposure: f64,
     gel_modulus_mpa: f64,
     gel_poisson: f64,
     gel_thickness_mm: f64,
@@ -83,6 +84,7 @@ fn summary(p: &SensorProfile) -> Summary {
         frame_rate_hz: s.frame_rate_hz,
         noise_sigma_grey: p.noise_sigma_grey,
         vignette: p.vignette,
+        exposure: p.exposure,
         gel_modulus_mpa: s.gel.modulus_mpa,
         gel_poisson: s.gel.poisson,
         gel_thickness_mm: s.gel.thickness_mm,
@@ -152,7 +154,7 @@ fn show(args: &ShowArgs) -> Result<()> {
         println!("  source      {}", s.source);
     }
     println!(
-        "  camera      {} x {} px at {} mm/px ({:.1} x {:.1} mm), {} Hz, noise {:.2} grey levels, vignette {}",
+        "  camera      {} x {} px at {} mm/px ({:.1} x {:.1} mm), {} Hz, noise {:.2} grey levels, vignette {}, exposure {}",
         s.width_px,
         s.height_px,
         s.mm_per_px,
@@ -160,7 +162,8 @@ fn show(args: &ShowArgs) -> Result<()> {
         s.pad_mm[1],
         s.frame_rate_hz,
         s.noise_sigma_grey,
-        s.vignette
+        s.vignette,
+        s.exposure
     );
     println!(
         "  gel         E {} MPa, nu {}, {} mm thick",

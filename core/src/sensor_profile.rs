@@ -55,6 +55,9 @@ pub struct SensorProfile {
     /// Relative darkening at the frame's corners (0 when the background is a real frame: it
     /// carries its own).
     pub vignette: f64,
+    /// Gain on the light reaching the camera, relative to the background's (1: the exposure the
+    /// profile was made at; 2: twice the exposure time or gain). Before the noise.
+    pub exposure: f64,
     /// Fraction of the light a marker dot's centre blocks.
     pub marker_darkness: f64,
     /// Light scattered in the gel round a contact (fitted by `calibrate`); None: no glow.
@@ -116,6 +119,17 @@ struct CameraSection {
     frame_rate_hz: f64,
     noise_sigma_grey: f64,
     vignette: f64,
+    /// Written only when not 1, so that a profile made before the field keeps its hash.
+    #[serde(default = "unit_exposure", skip_serializing_if = "is_unit_exposure")]
+    exposure: f64,
+}
+
+fn unit_exposure() -> f64 {
+    1.0
+}
+
+fn is_unit_exposure(v: &f64) -> bool {
+    *v == 1.0
 }
 
 #[derive(Serialize, Deserialize)]
@@ -179,6 +193,7 @@ impl SensorProfile {
             background: None,
             noise_sigma_grey: 0.5,
             vignette: 0.55,
+            exposure: 1.0,
             marker_darkness: 0.82,
             glow: None,
             fit: None,
@@ -287,6 +302,7 @@ impl SensorProfile {
             background,
             noise_sigma_grey: c.noise_sigma_grey,
             vignette: c.vignette,
+            exposure: c.exposure,
             marker_darkness: m.darkness,
             glow: raw.optics.glow,
             fit: raw.fit,
@@ -335,6 +351,15 @@ impl SensorProfile {
             return bad(
                 "camera.vignette",
                 format!("{}, expected 0..=1", self.vignette),
+            );
+        }
+        if !(self.exposure.is_finite() && self.exposure > 0.0 && self.exposure <= 4.0) {
+            return bad(
+                "camera.exposure",
+                format!(
+                    "{}, expected a gain in (0, 4]",
+                    crate::printable::short_number(self.exposure)
+                ),
             );
         }
         let g = &s.gel;
@@ -474,6 +499,7 @@ impl SensorProfile {
                 frame_rate_hz: s.frame_rate_hz,
                 noise_sigma_grey: self.noise_sigma_grey,
                 vignette: self.vignette,
+                exposure: self.exposure,
             },
             gel: GelSection {
                 modulus_mpa: s.gel.modulus_mpa,
@@ -603,6 +629,14 @@ mod tests {
         let mut softer = stock.clone();
         softer.spec.gel.modulus_mpa = 0.2;
         assert_ne!(softer.id().sha256, stock.id().sha256);
+        // The exposure field is written only when it is not 1: the stock text is unchanged.
+        assert!(!stock.to_toml("").contains("exposure"));
+        let mut brighter = stock.clone();
+        brighter.exposure = 1.5;
+        let text = brighter.to_toml("");
+        assert!(text.contains("exposure = 1.5"), "{text}");
+        let back = SensorProfile::from_toml(&text, "b.toml", Path::new(".")).unwrap();
+        assert_eq!(back.exposure, 1.5);
     }
 
     #[test]
@@ -611,6 +645,16 @@ mod tests {
         for (from, to, field) in [
             ("mm_per_px = 0.0634", "mm_per_px = -1.0", "camera.mm_per_px"),
             ("poisson = 0.49", "poisson = 0.7", "gel.poisson"),
+            (
+                "vignette = 0.55",
+                "vignette = 0.55\nexposure = 0.0",
+                "camera.exposure",
+            ),
+            (
+                "vignette = 0.55",
+                "vignette = 0.55\nexposure = 1e300",
+                "camera.exposure",
+            ),
             (
                 "thickness_mm = 4.0",
                 "thickness_mm = nan",

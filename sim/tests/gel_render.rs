@@ -172,6 +172,8 @@ fn gpu_and_cpu_paths_agree_on_a_set_of_presses() {
             colour: [0.3, 0.1, -0.2],
         }],
     });
+    // And a camera exposed 1.7 times as long: bright parts saturate on both paths alike.
+    glowing.exposure = 1.7;
     let fields = presses(&lights);
     for optics in [&lights, &table, &glowing] {
         let frames: Vec<PressFrame> = fields
@@ -194,6 +196,32 @@ fn gpu_and_cpu_paths_agree_on_a_set_of_presses() {
             assert!(max.iter().all(|m| *m <= 4), "press {k}: max {max:?}");
         }
     }
+}
+
+#[test]
+fn twice_the_exposure_doubles_every_grey_level_until_it_saturates() {
+    let mut once = SensorOptics::for_spec(&TactileSpec::gelsight_mini());
+    once.noise_sigma = 0.0;
+    let twice = SensorOptics {
+        exposure: 2.0,
+        ..once.clone()
+    };
+    let fields = &presses(&once)[1];
+    let render = |o: &SensorOptics| CpuRenderer.render_one(o, &PressFrame { fields, seed: 3 });
+    let (a, b) = (render(&once), render(&twice));
+    let mut saturated = 0;
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        for c in 0..3 {
+            // A linear camera: round(2 v) against 2 round(v), within the rounding.
+            let want = (2 * p[c] as i32).min(255);
+            assert!((q[c] as i32 - want).abs() <= 1, "{} -> {}", p[c], q[c]);
+            saturated += usize::from(q[c] == 255);
+        }
+    }
+    assert!(
+        saturated > 0,
+        "the stock gel's bright half saturates at twice the exposure"
+    );
 }
 
 #[test]

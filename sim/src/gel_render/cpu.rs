@@ -254,7 +254,7 @@ fn dot_reaches(p: &RenderParams, centres: &[[f32; 2]]) -> Vec<DotReach> {
         .collect()
 }
 
-/// Stage 4 on one row: marker dots, noise, quantisation (sensor_exposure.wgsl). A pixel
+/// Stage 4 on one row: marker dots, exposure gain, noise, quantisation (sensor_exposure.wgsl). A pixel
 /// takes its dots' factors in marker order.
 fn expose_row(
     p: &RenderParams,
@@ -278,6 +278,12 @@ fn expose_row(
                 let f = 1.0 - p.marker_darkness * (reach - d).min(1.0);
                 *px = px.map(|v| v * f);
             }
+        }
+    }
+    // The same product as the shader's, after the dots: the two paths keep equal bits.
+    if p.exposure != 1.0 {
+        for px in shaded.iter_mut() {
+            *px = px.map(|v| v * p.exposure);
         }
     }
     // No noise asked for: the draws would be multiplied by zero anyway.

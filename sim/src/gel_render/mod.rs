@@ -44,6 +44,9 @@ pub struct SensorOptics {
     /// Relative darkening at the frame's corners: gain 1 - vignette * (u^2 + v^2), u, v in
     /// [-1/2, 1/2]. Zero when the background is a real frame (it has the vignetting in it).
     pub vignette: f32,
+    /// Gain on the light reaching the camera (the profile's `camera.exposure`), applied after
+    /// the marker dots and before the noise.
+    pub exposure: f32,
     /// Camera noise per channel (grey levels, 1 sigma).
     pub noise_sigma: f32,
     /// Light scattered in the gel: the shading's change is replaced by its glow (before the
@@ -143,6 +146,7 @@ impl SensorOptics {
             marker_radius_px: (spec.markers.radius_mm / spec.mm_per_px) as f32,
             marker_darkness: profile.marker_darkness as f32,
             vignette: profile.vignette as f32,
+            exposure: profile.exposure as f32,
             noise_sigma: profile.noise_sigma_grey as f32,
             glow: profile.glow.clone(),
         }
@@ -180,6 +184,7 @@ impl SensorOptics {
         for (name, v) in [
             ("optics.marker_radius_px", self.marker_radius_px),
             ("optics.vignette", self.vignette),
+            ("optics.exposure", self.exposure),
             ("optics.noise_sigma", self.noise_sigma),
         ] {
             if !finite_nonneg(v) {
@@ -280,7 +285,7 @@ pub(crate) struct RenderParams {
     pub mag_bins: u32,
     pub dir_bins: u32,
     pub mag_max: f32,
-    pub padding: u32,
+    pub exposure: f32,
 }
 
 impl RenderParams {
@@ -323,7 +328,7 @@ impl RenderParams {
             mag_bins,
             dir_bins,
             mag_max,
-            padding: 0,
+            exposure: optics.exposure,
         }
     }
 }
