@@ -433,8 +433,11 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
         .out
         .canonicalize()
         .with_context(|| format!("{}: cannot resolve", args.out.display()))?;
-    let lock = LockDir::claim(&root.join(WRITER_LOCK), "writing this data set")
-        .map_err(|e| anyhow::anyhow!("--out {}: {e}", args.out.display()))?;
+    let lock = LockDir::claim(
+        &root.join(tactex_core::dir_claim::DATASET_LOCK),
+        "writing this data set",
+    )
+    .map_err(|e| anyhow::anyhow!("--out {}: {e}", args.out.display()))?;
     let result = fill(&root, args, &info, &catalog, &renderer, show_progress);
     drop(lock);
     if result.is_err() && !has_scenes(&root) {
@@ -454,9 +457,6 @@ pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDat
     }
     result
 }
-
-/// The directory whose existence says a tactex writes into the data set.
-pub const WRITER_LOCK: &str = ".tactex-writing";
 
 const SUBDIRS: [&str; 5] = ["images", "labels", "depth", "instances", "meta"];
 

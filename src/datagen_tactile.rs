@@ -383,7 +383,7 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
     // Shards of one data set run side by side; one shard has one writer.
     let lock_path = args.out.join(format!(
         "{}-shard-{}-of-{}",
-        crate::datagen_scenes::WRITER_LOCK,
+        tactex_core::dir_claim::DATASET_LOCK,
         shard.0,
         shard.1
     ));

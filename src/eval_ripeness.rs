@@ -148,9 +148,7 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
     let estimator = args.estimator.open("--estimator", fidelity.name(), None)?;
     // The sensor as it is, unrandomised: a lab's validation run on one sensor.
     let sensor = match &args.sensor {
-        Some(_) => SensorDraw::of(std::sync::Arc::new(crate::ask::load_sensor(
-            args.sensor.as_deref(),
-        )?)),
+        Some(path) => SensorDraw::of(std::sync::Arc::new(crate::ask::load_sensor(Some(path))?)),
         None => SensorDraw::nominal(),
     };
     let protocol = PressProtocol::default();

@@ -60,8 +60,8 @@ fn read_marker_annotations(path: &std::path::Path) -> Result<Vec<(f64, f64)>> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
     let mut out = Vec::new();
-    // The file line of each marker, for a repeated one.
-    let mut lines = Vec::new();
+    // Where each marker was first listed (its coordinates' bits -> file line).
+    let mut first_line = std::collections::HashMap::new();
     for (i, line) in text.lines().enumerate().skip(1) {
         if line.trim().is_empty() {
             continue;
@@ -104,17 +104,14 @@ fn read_marker_annotations(path: &std::path::Path) -> Result<Vec<(f64, f64)>> {
                 path.display()
             );
         }
-        let at = (x + 0.5, y + 0.5);
-        if let Some(j) = out.iter().position(|&p| p == at) {
+        if let Some(first) = first_line.insert((x.to_bits(), y.to_bits()), i + 1) {
             bail!(
-                "{}: line {}: the marker of line {} again",
+                "{}: line {}: the marker of line {first} again",
                 path.display(),
-                i + 1,
-                lines[j]
+                i + 1
             );
         }
-        out.push(at);
-        lines.push(i + 1);
+        out.push((x + 0.5, y + 0.5));
     }
     if out.is_empty() {
         bail!("{}: no annotated markers", path.display());

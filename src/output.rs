@@ -1,5 +1,5 @@
-//! Output files are written whole or not at all: into a temporary file beside the target,
-//! then renamed over it.
+//! Outputs are written whole or not at all: a file into a temporary file beside the target,
+//! then renamed over it; a directory of outputs into `DIR.partial`, moved in when complete.
 
 use anyhow::{Context, Result, bail};
 use std::io::Write;

@@ -51,6 +51,29 @@ fn calibrated_with(dir: &Path, extra: &[&str]) -> PathBuf {
     profile
 }
 
+/// `press --json` of the FOTS ball (radius 2.35 mm, rigid) 0.4 mm deep through `profile` on
+/// the CPU path, its maps and frames in `out`.
+fn rigid_ball_press(profile: &Path, out: &Path) -> serde_json::Value {
+    json(&tactex(&[
+        "press",
+        "--shape",
+        "sphere",
+        "--radius-mm",
+        "2.35",
+        "--hardness",
+        "rigid",
+        "--depth-mm",
+        "0.4",
+        "--sensor",
+        profile.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]))
+}
+
 #[test]
 fn a_calibrated_profile_renders_its_background_when_nothing_touches() {
     let dir = tempfile::tempdir().unwrap();
@@ -72,24 +95,7 @@ fn a_calibrated_profile_renders_its_background_when_nothing_touches() {
     assert!((0.2..3.0).contains(&noise), "{noise}");
 
     let out = dir.path().join("press");
-    let report = json(&tactex(&[
-        "press",
-        "--shape",
-        "sphere",
-        "--radius-mm",
-        "2.35",
-        "--hardness",
-        "rigid",
-        "--depth-mm",
-        "0.4",
-        "--sensor",
-        profile.to_str().unwrap(),
-        "--device",
-        "cpu",
-        "--out",
-        out.to_str().unwrap(),
-        "--json",
-    ]));
+    let report = rigid_ball_press(&profile, &out);
     assert_eq!(report["sensor"], shown["sensor"]);
     let open = |p: &Path| image::open(p).unwrap().to_rgb8();
     let (reference, tactile, bg) = (
@@ -298,28 +304,7 @@ fn calibrate_reads_the_marker_grid_from_a_real_marker_frame_and_press_draws_it()
 
     // The twin draws that grid: its no-contact frame shows 99 dots at the real pitch.
     let pressed = dir.path().join("press");
-    let status = tactex(&[
-        "press",
-        "--shape",
-        "sphere",
-        "--radius-mm",
-        "2.35",
-        "--hardness",
-        "rigid",
-        "--depth-mm",
-        "0.4",
-        "--sensor",
-        profile.to_str().unwrap(),
-        "--device",
-        "cpu",
-        "--out",
-        pressed.to_str().unwrap(),
-    ]);
-    assert!(
-        status.status.success(),
-        "{}",
-        String::from_utf8_lossy(&status.stderr)
-    );
+    rigid_ball_press(&profile, &pressed);
     let found = json(&tactex(&[
         "markers",
         pressed.join("reference.png").to_str().unwrap(),

@@ -7,6 +7,9 @@ use std::path::{Path, PathBuf};
 /// The file in a claimed directory naming the process that holds it.
 pub const PID_FILE: &str = "tactex.pid";
 
+/// The lock a data set's writer claims inside it (a tactile shard adds its shard).
+pub const DATASET_LOCK: &str = ".tactex-writing";
+
 #[derive(Debug, thiserror::Error)]
 #[error("{path}: {reason}")]
 pub struct ClaimError {

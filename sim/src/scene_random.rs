@@ -45,7 +45,7 @@ pub enum RandomSceneError {
     #[error("random scene: unknown fruit kind '{kind}' (known: {known})")]
     UnknownKind { kind: String, known: String },
     #[error(
-        "random scene: {count} fruits do not fit on the table without overlap (in 20 draws); ask for fewer"
+        "random scene: {count} fruits do not fit on the table without overlap (in {DRAWS} draws); ask for fewer"
     )]
     NoRoom { count: usize },
     #[error(transparent)]

@@ -49,13 +49,11 @@ pub fn read_marker_grid(frame: &RgbImage) -> Result<MarkerLayout, String> {
             dots.len()
         ));
     }
-    let whole_area = median(
-        dots.iter()
-            .filter(|d| !d.cut_by_frame)
-            .map(|d| d.area_px as f64)
-            .collect(),
-    )
-    .ok_or("every dot is cut by the frame's edge; no dot size to read")?;
+    // Size and darkness from the dots the frame's edge leaves whole.
+    let whole: Vec<&Dot> = dots.iter().filter(|d| !d.cut_by_frame).collect();
+    let whole_area = median(whole.iter().map(|d| d.area_px as f64).collect())
+        .ok_or("every dot is cut by the frame's edge; no dot size to read")?;
+    let darkness = median(whole.iter().map(|d| d.darkness).collect()).expect("whole dots");
     // A dot the frame cuts to less than half has its centre outside: not the frame's grid.
     let dots: Vec<Dot> = dots
         .into_iter()
@@ -73,14 +71,11 @@ pub fn read_marker_grid(frame: &RgbImage) -> Result<MarkerLayout, String> {
             cols * rows
         ));
     }
-    let whole: Vec<&Dot> = dots.iter().filter(|d| !d.cut_by_frame).collect();
-    let radius_px = (whole_area / std::f64::consts::PI).sqrt();
-    let darkness = median(whole.iter().map(|d| d.darkness).collect()).expect("whole dots");
     Ok(MarkerLayout {
         cols,
         rows,
         pitch_px,
-        radius_px,
+        radius_px: (whole_area / std::f64::consts::PI).sqrt(),
         darkness,
         count: dots.len(),
     })

@@ -254,8 +254,8 @@ fn dot_reaches(p: &RenderParams, centres: &[[f32; 2]]) -> Vec<DotReach> {
         .collect()
 }
 
-/// Stage 4 on one row: marker dots, exposure gain, noise, quantisation (sensor_exposure.wgsl). A pixel
-/// takes its dots' factors in marker order.
+/// Stage 4 on one row: marker dots, exposure gain, noise, quantisation (sensor_exposure.wgsl).
+/// A pixel takes its dots' factors in marker order.
 fn expose_row(
     p: &RenderParams,
     dots: &[DotReach],
