@@ -15,7 +15,7 @@ use crate::estimate::{
 use crate::gel_share_fit::{fit_gel_share, gel_share};
 use crate::hardness::Hardness;
 use crate::hertz::Elastic;
-use crate::layer_compliance::hertz_centre_compliance_ratio;
+use crate::layer_compliance::hertz_ellipse_centre_compliance_ratio;
 use crate::perception::depth::integrate_slopes;
 use crate::perception::slopes::recover_slopes;
 use crate::tactile_spec::TactileSpec;
@@ -43,6 +43,43 @@ fn peak(depth: &[f64]) -> f64 {
     let k = sorted.len() - n;
     sorted.select_nth_unstable_by(k, f64::total_cmp);
     sorted[k..].iter().sum::<f64>() / n as f64
+}
+
+/// The contact's semi-axes (mm, wide then narrow) from the imprint's half-depth region, taken
+/// as the half-depth ellipse of a Hertz dimple: its area fixes the scale (the half-depth
+/// ellipse's axes are 0.866 of the contact's) and its second moments the aspect, so an
+/// elongated imprint (a banana's) keeps its narrow side. Empty: [0, 0].
+fn contact_ellipse(depth: &[f64], w: usize, peak: f64, mm_per_px: f64) -> [f64; 2] {
+    let (mut n, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for (i, d) in depth.iter().enumerate() {
+        if *d > 0.5 * peak {
+            let (x, y) = ((i % w) as f64, (i / w) as f64);
+            n += 1.0;
+            sx += x;
+            sy += y;
+            sxx += x * x;
+            syy += y * y;
+            sxy += x * y;
+        }
+    }
+    if n == 0.0 {
+        return [0.0, 0.0];
+    }
+    let (mx, my) = (sx / n, sy / n);
+    let (cxx, cyy, cxy) = (sxx / n - mx * mx, syy / n - my * my, sxy / n - mx * my);
+    let mean = 0.5 * (cxx + cyy);
+    let spread = (0.25 * (cxx - cyy).powi(2) + cxy * cxy).sqrt();
+    // Eigenvalues of the covariance; a pixel's own 1/12 keeps a one-pixel line finite.
+    let (wide, narrow) = (
+        mean + spread + 1.0 / 12.0,
+        (mean - spread).max(0.0) + 1.0 / 12.0,
+    );
+    let aspect = (wide / narrow).sqrt();
+    let equal_area_radius = (n / PI).sqrt() * mm_per_px / 0.866;
+    [
+        equal_area_radius * aspect.sqrt(),
+        equal_area_radius / aspect.sqrt(),
+    ]
 }
 
 /// Whether the region `inside` holds reaches the outermost two pixels of the frame.
@@ -76,9 +113,8 @@ impl HardnessEstimator for IndentationEstimator {
             return Err(EstimateError::BadSequence("travel must be finite".into()));
         }
         let mut peaks = Vec::with_capacity(n);
-        let mut contact_radii = Vec::with_capacity(n);
+        let mut contact_axes = Vec::with_capacity(n);
         let mut within_frame = Vec::with_capacity(n);
-        let pixel_area = spec.mm_per_px * spec.mm_per_px;
         for frame in &press.frames {
             let slopes =
                 recover_slopes(&frame.image, &press.reference.image, spec).ok_or_else(|| {
@@ -86,11 +122,8 @@ impl HardnessEstimator for IndentationEstimator {
                 })?;
             let depth = integrate_slopes(&slopes, spec.mm_per_px);
             let p = peak(&depth);
-            // The half-depth area as a circle; the half-depth circle of a Hertz dimple is
-            // about 0.866 of the contact radius.
             let deep = |d: f64| d > 0.5 * p;
-            let half_depth_px = depth.iter().filter(|d| deep(**d)).count();
-            contact_radii.push((half_depth_px as f64 * pixel_area / PI).sqrt() / 0.866);
+            contact_axes.push(contact_ellipse(&depth, slopes.width, p, spec.mm_per_px));
             within_frame.push(!touches_border(&depth, slopes.width, slopes.height, deep));
             peaks.push(p);
         }
@@ -105,9 +138,10 @@ impl HardnessEstimator for IndentationEstimator {
             used = (0..n.min(3)).collect();
         }
         let pick = |v: &[f64]| used.iter().map(|k| v[*k]).collect::<Vec<f64>>();
-        let layer: Vec<f64> = contact_radii
+        let h = spec.gel.thickness_mm;
+        let layer: Vec<f64> = contact_axes
             .iter()
-            .map(|a| hertz_centre_compliance_ratio(a / spec.gel.thickness_mm, spec.gel.poisson))
+            .map(|[a, b]| hertz_ellipse_centre_compliance_ratio([a / h, b / h], spec.gel.poisson))
             .collect();
         let fit = fit_gel_share(&pick(&peaks), &pick(&press.travel_mm), &pick(&layer))
             .ok_or(EstimateError::NoImprint)?;
@@ -130,7 +164,8 @@ impl HardnessEstimator for IndentationEstimator {
         let last = *used.last().expect("at least two frames used");
         let share_at = |rho: f64| gel_share(layer[last], rho);
         let last_approach = fit.first_contact_approach_mm + press.travel_mm[last];
-        let contact_radius = contact_radii[last];
+        // The circle of the contact's area.
+        let contact_radius = (contact_axes[last][0] * contact_axes[last][1]).sqrt();
         Ok(HardnessEstimate {
             hardness,
             // A softer object has the larger compliance ratio.
@@ -154,5 +189,34 @@ impl HardnessEstimator for IndentationEstimator {
                 object_poisson: self.object_poisson,
             }),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_elongated_turned_imprint_keeps_its_two_semi_axes() {
+        // A paraboloid dimple 1 - (x'/A)^2 - (y'/B)^2 turned 30 degrees: its half-depth ellipse
+        // has semi-axes A/sqrt 2 and B/sqrt 2, the contact's are those over 0.866.
+        let (w, h, big, small) = (160usize, 120usize, 40.0f64, 12.0f64);
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let depth: Vec<f64> = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f64 - 80.0, (i / w) as f64 - 60.0);
+                let (xr, yr) = (c * x + s * y, -s * x + c * y);
+                (1.0 - (xr / big).powi(2) - (yr / small).powi(2)).max(0.0)
+            })
+            .collect();
+        let [a, b] = contact_ellipse(&depth, w, 1.0, 0.1);
+        let want = |axis: f64| axis / 2f64.sqrt() * 0.1 / 0.866;
+        assert!((a / want(big) - 1.0).abs() < 0.02, "{a} vs {}", want(big));
+        assert!(
+            (b / want(small) - 1.0).abs() < 0.03,
+            "{b} vs {}",
+            want(small)
+        );
+        assert_eq!(contact_ellipse(&[0.0; 4], 2, 1.0, 0.1), [0.0, 0.0]);
     }
 }
