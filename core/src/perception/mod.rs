@@ -15,6 +15,7 @@ pub mod height_split;
 pub mod marker_grid;
 pub mod markers;
 pub mod mask;
+pub mod neck_split;
 pub mod press_site;
 pub mod slopes;
 pub mod ssim;
