@@ -28,9 +28,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::{FruitCatalog, FruitSpec};
+use tactex_core::estimate::Evidence;
 use tactex_core::explain::TemplateExplainer;
 use tactex_core::hardness::Hardness;
-use tactex_core::interval_calibration::IntervalCalibration;
+use tactex_core::interval_calibration::{ELONGATED_ASPECT, HeldOutPress, IntervalCalibration};
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
 use tactex_sim::elastic::Fidelity;
@@ -117,6 +118,8 @@ pub struct FruitRow {
     pub position_error_mm: Option<f64>,
     pub placed: bool,
     pub estimate_mpa: Option<f64>,
+    /// Wide over narrow semi-axis of the first contact, as the estimator's evidence says.
+    pub first_contact_aspect: Option<f64>,
     /// ln(E_est / E_true).
     pub ln_error: Option<f64>,
     pub in_68: Option<bool>,
@@ -339,6 +342,10 @@ fn score(table: &Table, twin: &TwinAnswer) -> (Vec<FruitRow>, usize) {
                 position_error_mm,
                 placed: position_error_mm.is_some_and(|e| e <= PLACED_WITHIN_M * 1e3),
                 estimate_mpa,
+                first_contact_aspect: report.filter(|_| measured).and_then(|r| match &r.evidence {
+                    Some(Evidence::Physics(p)) => p.first_contact_aspect,
+                    _ => None,
+                }),
                 ln_error: estimate_mpa.map(|e| (e / truth).ln()),
                 in_68: interval
                     .filter(|_| measured)
@@ -604,11 +611,17 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
         PLACED_WITHIN_M * 1e3
     );
     if let Some(path) = &args.calibrate {
-        let samples: Vec<(f64, f64)> = rows
+        let samples: Vec<HeldOutPress> = rows
             .iter()
             .filter_map(|r| {
                 let e = r.estimate_mpa.filter(|e| e.is_finite() && *e > 0.0)?;
-                Some((e.ln(), (r.true_modulus_mpa / e).ln()))
+                Some(HeldOutPress {
+                    ln_estimate: e.ln(),
+                    residual: (r.true_modulus_mpa / e).ln(),
+                    elongated: r
+                        .first_contact_aspect
+                        .is_some_and(|a| a >= ELONGATED_ASPECT),
+                })
             })
             .collect();
         let command = format!(

@@ -107,7 +107,7 @@ fn demo_scene_answers_the_softest_fruit_with_positions_hardness_and_latency() {
     assert_eq!(a["fidelity"], "layer");
     assert_eq!(a["sensor"]["name"], "GelSight Mini");
     assert_eq!(a["sensor"]["sha256"].as_str().unwrap().len(), 64);
-    assert_eq!(a["estimator"], "onnx_small");
+    assert_eq!(a["estimator"], "indentation");
     assert!(
         a["contact_criterion"]
             .as_str()

@@ -412,7 +412,7 @@ fn fruits_scores_each_kind_and_writes_tables_that_ask_answers_again() {
         v["intervals"]
             .as_str()
             .unwrap()
-            .contains("learned-layer.json"),
+            .contains("indentation-layer.json"),
         "{v}"
     );
     let rows: serde_json::Value =

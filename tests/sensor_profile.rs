@@ -329,7 +329,13 @@ fn the_learned_model_says_so_when_it_reads_another_sensor_than_it_was_trained_on
     let dir = tempfile::tempdir().unwrap();
     let profile = cli::renamed_stock_profile(dir.path(), "lab mini");
     let ask = |extra: &[&str]| {
-        let mut args = vec!["ask", "How hard is the lime?", "--json"];
+        let mut args = vec![
+            "ask",
+            "How hard is the lime?",
+            "--json",
+            "--estimator",
+            "learned",
+        ];
         args.extend_from_slice(extra);
         json(&tactex(&args))
     };

@@ -81,6 +81,11 @@ pub struct PhysicsEvidence {
     pub fit_residual_unit: &'static str,
     /// Poisson's ratio assumed for the object.
     pub object_poisson: f64,
+    /// Wide over narrow semi-axis of the contact at the first frame the fit used (1: round; a
+    /// banana's touches as a line across the pad), which the interval calibration reads
+    /// apart; None where the estimator does not look.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_contact_aspect: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -376,6 +381,7 @@ impl HardnessEstimator for HertzSlopeEstimator {
                 fit_residual_rms: (rss.max(0.0) / samples.len() as f64).sqrt(),
                 fit_residual_unit: "slope",
                 object_poisson: self.object_poisson,
+                first_contact_aspect: None,
             }),
         })
     }

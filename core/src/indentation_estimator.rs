@@ -187,6 +187,10 @@ impl HardnessEstimator for IndentationEstimator {
                 fit_residual_rms: fit.residual_rms_mm,
                 fit_residual_unit: "mm",
                 object_poisson: self.object_poisson,
+                first_contact_aspect: Some({
+                    let [a, b] = contact_axes[used[0]];
+                    a / b.max(1e-9)
+                }),
             }),
         })
     }

@@ -10,9 +10,14 @@
 //! which holds the truth on new presses as often as on the held-out ones when both come from
 //! the same kind of scene. The quantile levels are widened by (n + 1) / n, the finite-sample
 //! correction.
+//!
+//! Elongated contacts (a banana's first touch is a line across the pad, its imprint runs off
+//! the frame) are read with another bias than round ones: when the held-out set has enough of
+//! them they get bins of their own, chosen by the contact's aspect in the estimate's evidence.
 
 use crate::estimate::{
-    EstimateError, HardnessEstimate, HardnessEstimator, ModulusInterval, PressSequence,
+    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval, PhysicsEvidence,
+    PressSequence,
 };
 use crate::hardness::Hardness;
 use crate::stats::quantile;
@@ -22,6 +27,9 @@ use serde::{Deserialize, Serialize};
 pub const FORMAT: &str = "tactex-interval-calibration/1";
 /// The two-sided levels: 68% and 95%.
 const LEVELS: [f64; 4] = [0.025, 0.16, 0.84, 0.975];
+/// A first contact this many times longer than wide is elongated. On the held-out presses of
+/// seed 101 every banana's was 3.3-8.1 and every other fruit's at most 1.8.
+pub const ELONGATED_ASPECT: f64 = 2.5;
 /// The fewest held-out presses a bin may rest on: below about 40 the 2.5% and 97.5%
 /// quantiles are each one press.
 pub const MIN_PER_BIN: usize = 40;
@@ -35,6 +43,18 @@ pub struct IntervalCalibration {
     pub fidelity: String,
     /// How the held-out presses were made (the command), so that anyone can make them again.
     pub protocol: String,
+    /// The presses `bins` rest on: all of them, or the round contacts when `elongated_contact`
+    /// holds the others.
+    pub presses: usize,
+    pub bins: Vec<ResidualBin>,
+    /// The bins of presses whose first contact was elongated (`ELONGATED_ASPECT`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elongated_contact: Option<ResidualGroup>,
+}
+
+/// One group of held-out presses and its bins.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ResidualGroup {
     pub presses: usize,
     pub bins: Vec<ResidualBin>,
 }
@@ -52,6 +72,15 @@ pub struct ResidualBin {
     pub residual_quantiles: [f64; 4],
 }
 
+/// One held-out press: the estimator's raw ln(E_est / MPa), the residual ln(E_true / E_est),
+/// and whether its first contact was elongated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeldOutPress {
+    pub ln_estimate: f64,
+    pub residual: f64,
+    pub elongated: bool,
+}
+
 #[derive(Debug, thiserror::Error)]
 pub enum CalibrationError {
     #[error("{source_name}: {message}")]
@@ -61,14 +90,27 @@ pub enum CalibrationError {
     },
 }
 
+/// Whether an estimate's first contact was elongated, as its evidence says (None: its
+/// evidence does not say).
+pub fn elongated_contact(evidence: &Evidence) -> Option<bool> {
+    match evidence {
+        Evidence::Physics(PhysicsEvidence {
+            first_contact_aspect: Some(aspect),
+            ..
+        }) => Some(*aspect >= ELONGATED_ASPECT),
+        _ => None,
+    }
+}
+
 impl IntervalCalibration {
-    /// Fits the bins from held-out `(ln E_est, ln(E_true / E_est))` pairs: as many equal-count
-    /// bins as hold `MIN_PER_BIN` presses each, up to `max_bins`.
+    /// Fits the bins from held-out presses: as many equal-count bins as hold `MIN_PER_BIN`
+    /// presses each, up to `max_bins`; the elongated contacts apart when both groups have
+    /// `MIN_PER_BIN`.
     pub fn fit(
         estimator: &str,
         fidelity: &str,
         protocol: &str,
-        samples: &[(f64, f64)],
+        samples: &[HeldOutPress],
         max_bins: usize,
     ) -> Result<Self, CalibrationError> {
         let invalid = |message: String| CalibrationError::Invalid {
@@ -77,7 +119,7 @@ impl IntervalCalibration {
         };
         if samples
             .iter()
-            .any(|(a, b)| !(a.is_finite() && b.is_finite()))
+            .any(|s| !(s.ln_estimate.is_finite() && s.residual.is_finite()))
         {
             return Err(invalid("a residual or estimate is not finite".into()));
         }
@@ -87,50 +129,31 @@ impl IntervalCalibration {
                 samples.len()
             )));
         }
-        let mut sorted = samples.to_vec();
-        sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let bins = (sorted.len() / MIN_PER_BIN).clamp(1, max_bins.max(1));
-        let n = sorted.len();
-        let mut out = Vec::with_capacity(bins);
-        let range = |b: usize| (b * n / bins, (b + 1) * n / bins);
-        let median = |v: Vec<f64>| quantile(&v, 0.5).expect("a bin is not empty");
-        let centres: Vec<(f64, f64)> = (0..bins)
-            .map(|b| {
-                let (lo, hi) = range(b);
-                let part = &sorted[lo..hi];
-                (
-                    median(part.iter().map(|s| s.0).collect()),
-                    median(part.iter().map(|s| s.1).collect()),
-                )
-            })
-            .collect();
-        for (b, &(ln_modulus_median, median_residual)) in centres.iter().enumerate() {
-            let (lo, hi) = range(b);
-            let residuals: Vec<f64> = sorted[lo..hi]
+        let pairs = |elongated: Option<bool>| -> Vec<(f64, f64)> {
+            samples
                 .iter()
-                .map(|s| s.1 - shift_at(&centres, s.0))
-                .collect();
-            let m = residuals.len() as f64;
-            let widen = |q: f64| (0.5 + (q - 0.5) * (m + 1.0) / m).clamp(0.0, 1.0);
-            let residual_quantiles = LEVELS.map(|q| {
-                quantile(&residuals, widen(q)).expect("non-empty, finite, level in [0, 1]")
-            });
-            let ln_modulus_below = (b + 1 < bins).then(|| (sorted[hi - 1].0 + sorted[hi].0) / 2.0);
-            out.push(ResidualBin {
-                ln_modulus_below,
-                presses: residuals.len(),
-                ln_modulus_median,
-                median_residual,
-                residual_quantiles,
-            });
-        }
+                .filter(|s| elongated.is_none_or(|e| s.elongated == e))
+                .map(|s| (s.ln_estimate, s.residual))
+                .collect()
+        };
+        let (round, long) = (pairs(Some(false)), pairs(Some(true)));
+        let (main, elongated_contact) = if round.len() >= MIN_PER_BIN && long.len() >= MIN_PER_BIN {
+            let group = ResidualGroup {
+                presses: long.len(),
+                bins: fit_bins(long, max_bins),
+            };
+            (round, Some(group))
+        } else {
+            (pairs(None), None)
+        };
         Ok(Self {
             format: FORMAT.into(),
             estimator: estimator.into(),
             fidelity: fidelity.into(),
             protocol: protocol.into(),
-            presses: n,
-            bins: out,
+            presses: main.len(),
+            bins: fit_bins(main, max_bins),
+            elongated_contact,
         })
     }
 
@@ -144,87 +167,43 @@ impl IntervalCalibration {
         if c.format != FORMAT {
             return Err(invalid(format!("format: {:?} is not {FORMAT:?}", c.format)));
         }
-        if c.bins.is_empty() {
-            return Err(invalid("bins: none".into()));
-        }
-        for (i, b) in c.bins.iter().enumerate() {
-            let q = b.residual_quantiles;
-            if q.iter().any(|v| !v.is_finite()) || q.windows(2).any(|w| w[0] > w[1]) {
-                return Err(invalid(format!(
-                    "bins[{i}].residual_quantiles: must be finite and rising"
-                )));
-            }
-            let last = i + 1 == c.bins.len();
-            match (b.ln_modulus_below, last) {
-                (Some(_), true) => {
-                    return Err(invalid(format!(
-                        "bins[{i}].ln_modulus_below: the last bin has no edge"
-                    )));
-                }
-                (None, false) => {
-                    return Err(invalid(format!("bins[{i}].ln_modulus_below: missing")));
-                }
-                (Some(e), false) if !e.is_finite() => {
-                    return Err(invalid(format!("bins[{i}].ln_modulus_below: not finite")));
-                }
-                _ => {}
-            }
-        }
-        let edges: Vec<f64> = c.bins.iter().filter_map(|b| b.ln_modulus_below).collect();
-        if edges.windows(2).any(|w| w[0] >= w[1]) {
-            return Err(invalid("bins: edges must rise".into()));
-        }
-        let centres = c.centres();
-        if centres
-            .iter()
-            .any(|(a, b)| !(a.is_finite() && b.is_finite()))
-            || centres.windows(2).any(|w| w[0].0 >= w[1].0)
-        {
-            return Err(invalid(
-                "bins: ln_modulus_median and median_residual must be finite, medians rising".into(),
-            ));
-        }
-        // Recentring must keep the order of estimates: ln E + shift(ln E) must rise.
-        if centres
-            .windows(2)
-            .any(|w| (w[1].1 - w[0].1) / (w[1].0 - w[0].0) <= -1.0)
-        {
-            return Err(invalid(
-                "bins: the recentring would reverse the order of estimates".into(),
-            ));
+        check_bins(&c.bins, "bins").map_err(invalid)?;
+        if let Some(group) = &c.elongated_contact {
+            check_bins(&group.bins, "elongated_contact.bins").map_err(invalid)?;
         }
         Ok(c)
     }
 
-    fn centres(&self) -> Vec<(f64, f64)> {
-        self.bins
-            .iter()
-            .map(|b| (b.ln_modulus_median, b.median_residual))
-            .collect()
+    /// The bins for a press, with the presses they rest on and what sets them apart.
+    fn group(&self, elongated: bool) -> (&[ResidualBin], usize, &'static str) {
+        match (&self.elongated_contact, elongated) {
+            (Some(g), true) => (&g.bins, g.presses, " with an elongated contact"),
+            _ => (&self.bins, self.presses, ""),
+        }
     }
 
     /// The recentred estimate of a raw `modulus_mpa`.
-    pub fn recentred(&self, modulus_mpa: f64) -> f64 {
-        modulus_mpa * shift_at(&self.centres(), modulus_mpa.ln()).exp()
+    pub fn recentred(&self, modulus_mpa: f64, elongated: bool) -> f64 {
+        let (bins, _, _) = self.group(elongated);
+        modulus_mpa * shift_at(&centres(bins), modulus_mpa.ln()).exp()
     }
 
     /// The calibrated intervals for a raw estimate of `modulus_mpa`, around its recentred
     /// value.
-    pub fn interval(&self, modulus_mpa: f64) -> ModulusInterval {
+    pub fn interval(&self, modulus_mpa: f64, elongated: bool) -> ModulusInterval {
+        let (bins, presses, group) = self.group(elongated);
         let ln = modulus_mpa.ln();
-        let bin = self
-            .bins
+        let bin = bins
             .iter()
             .find(|b| b.ln_modulus_below.is_none_or(|edge| ln < edge))
             .expect("the last bin has no edge");
-        let e = self.recentred(modulus_mpa);
+        let e = self.recentred(modulus_mpa, elongated);
         let [a, b, c, d] = bin.residual_quantiles.map(|q| Some(e * q.exp()));
         ModulusInterval {
             p68_mpa: [b, c],
             p95_mpa: [a, d],
             source: format!(
-                "calibrated on {} held-out presses at {} ({} in this bin; the estimator's {:.3} MPa recentred by {:+.0}%)",
-                self.presses,
+                "calibrated on {presses} held-out presses{group} at {} ({} in this bin; the estimator's {:.3} MPa recentred by {:+.0}%)",
                 self.fidelity,
                 bin.presses,
                 modulus_mpa,
@@ -232,6 +211,104 @@ impl IntervalCalibration {
             ),
         }
     }
+}
+
+/// Equal-count bins of `(ln E_est, residual)` pairs (at least `MIN_PER_BIN` of them).
+fn fit_bins(mut sorted: Vec<(f64, f64)>, max_bins: usize) -> Vec<ResidualBin> {
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let bins = (sorted.len() / MIN_PER_BIN).clamp(1, max_bins.max(1));
+    let n = sorted.len();
+    let mut out = Vec::with_capacity(bins);
+    let range = |b: usize| (b * n / bins, (b + 1) * n / bins);
+    let median = |v: Vec<f64>| quantile(&v, 0.5).expect("a bin is not empty");
+    let centres: Vec<(f64, f64)> = (0..bins)
+        .map(|b| {
+            let (lo, hi) = range(b);
+            let part = &sorted[lo..hi];
+            (
+                median(part.iter().map(|s| s.0).collect()),
+                median(part.iter().map(|s| s.1).collect()),
+            )
+        })
+        .collect();
+    for (b, &(ln_modulus_median, median_residual)) in centres.iter().enumerate() {
+        let (lo, hi) = range(b);
+        let residuals: Vec<f64> = sorted[lo..hi]
+            .iter()
+            .map(|s| s.1 - shift_at(&centres, s.0))
+            .collect();
+        let m = residuals.len() as f64;
+        let widen = |q: f64| (0.5 + (q - 0.5) * (m + 1.0) / m).clamp(0.0, 1.0);
+        let residual_quantiles = LEVELS
+            .map(|q| quantile(&residuals, widen(q)).expect("non-empty, finite, level in [0, 1]"));
+        let ln_modulus_below = (b + 1 < bins).then(|| (sorted[hi - 1].0 + sorted[hi].0) / 2.0);
+        out.push(ResidualBin {
+            ln_modulus_below,
+            presses: residuals.len(),
+            ln_modulus_median,
+            median_residual,
+            residual_quantiles,
+        });
+    }
+    out
+}
+
+/// Checks one set of bins as read from a file; `field` names it in the message.
+fn check_bins(bins: &[ResidualBin], field: &str) -> Result<(), String> {
+    if bins.is_empty() {
+        return Err(format!("{field}: none"));
+    }
+    for (i, b) in bins.iter().enumerate() {
+        let q = b.residual_quantiles;
+        if q.iter().any(|v| !v.is_finite()) || q.windows(2).any(|w| w[0] > w[1]) {
+            return Err(format!(
+                "{field}[{i}].residual_quantiles: must be finite and rising"
+            ));
+        }
+        let last = i + 1 == bins.len();
+        match (b.ln_modulus_below, last) {
+            (Some(_), true) => {
+                return Err(format!(
+                    "{field}[{i}].ln_modulus_below: the last bin has no edge"
+                ));
+            }
+            (None, false) => return Err(format!("{field}[{i}].ln_modulus_below: missing")),
+            (Some(e), false) if !e.is_finite() => {
+                return Err(format!("{field}[{i}].ln_modulus_below: not finite"));
+            }
+            _ => {}
+        }
+    }
+    let edges: Vec<f64> = bins.iter().filter_map(|b| b.ln_modulus_below).collect();
+    if edges.windows(2).any(|w| w[0] >= w[1]) {
+        return Err(format!("{field}: edges must rise"));
+    }
+    let centres = centres(bins);
+    if centres
+        .iter()
+        .any(|(a, b)| !(a.is_finite() && b.is_finite()))
+        || centres.windows(2).any(|w| w[0].0 >= w[1].0)
+    {
+        return Err(format!(
+            "{field}: ln_modulus_median and median_residual must be finite, medians rising"
+        ));
+    }
+    // Recentring must keep the order of estimates: ln E + shift(ln E) must rise.
+    if centres
+        .windows(2)
+        .any(|w| (w[1].1 - w[0].1) / (w[1].0 - w[0].0) <= -1.0)
+    {
+        return Err(format!(
+            "{field}: the recentring would reverse the order of estimates"
+        ));
+    }
+    Ok(())
+}
+
+fn centres(bins: &[ResidualBin]) -> Vec<(f64, f64)> {
+    bins.iter()
+        .map(|b| (b.ln_modulus_median, b.median_residual))
+        .collect()
 }
 
 /// The recentring ln(E_true / E_est) at `ln_modulus`: linear between the bins' medians,
@@ -269,10 +346,11 @@ impl<E: HardnessEstimator> HardnessEstimator for Calibrated<E> {
         spec: &TactileSpec,
     ) -> Result<HardnessEstimate, EstimateError> {
         let mut estimate = self.inner.estimate(press, spec)?;
+        let elongated = elongated_contact(&estimate.evidence) == Some(true);
         // A rigid reading keeps the estimator's own bound: no held-out press was rigid.
         if let Some(e) = estimate.hardness.modulus_mpa().filter(|e| *e > 0.0) {
-            estimate.interval = self.calibration.interval(e);
-            let recentred = Hardness::from_modulus_mpa(self.calibration.recentred(e))
+            estimate.interval = self.calibration.interval(e, elongated);
+            let recentred = Hardness::from_modulus_mpa(self.calibration.recentred(e, elongated))
                 .map_err(|err| EstimateError::Model(format!("recentred estimate: {err}")))?;
             estimate.hardness = recentred;
         }
@@ -294,6 +372,17 @@ mod tests {
             .collect()
     }
 
+    fn held_out(pairs: impl IntoIterator<Item = (f64, f64)>, elongated: bool) -> Vec<HeldOutPress> {
+        pairs
+            .into_iter()
+            .map(|(ln_estimate, residual)| HeldOutPress {
+                ln_estimate,
+                residual,
+                elongated,
+            })
+            .collect()
+    }
+
     #[test]
     fn normal_residuals_give_the_normal_intervals_and_each_bin_its_own() {
         // Soft estimates scatter by 0.1 in ln E and read 5% low; hard ones scatter by 0.3.
@@ -308,18 +397,20 @@ mod tests {
                 .enumerate()
                 .map(|(i, r)| (1.0 + 0.001 * i as f64, r)),
         );
-        let c = IntervalCalibration::fit("test", "layer", "test", &samples, 2).unwrap();
+        let c = IntervalCalibration::fit("test", "layer", "test", &held_out(samples, false), 2)
+            .unwrap();
         assert_eq!(c.bins.len(), 2);
+        assert!(c.elongated_contact.is_none());
         // Below the first bin's median the bias applies whole: the soft read is raised 5%.
         let soft_e = (-1.0f64).exp();
-        assert!((c.recentred(soft_e) / soft_e - 0.05f64.exp()).abs() < 0.005);
-        let soft = c.interval(soft_e);
+        assert!((c.recentred(soft_e, false) / soft_e - 0.05f64.exp()).abs() < 0.005);
+        let soft = c.interval(soft_e, false);
         let [lo, hi] = soft.p68_mpa.map(|v| (v.unwrap() / soft_e).ln());
         assert!(
             (lo - (0.05 - 0.1)).abs() < 0.01 && (hi - (0.05 + 0.1)).abs() < 0.01,
             "{lo} {hi}"
         );
-        let hard = c.interval(3.0);
+        let hard = c.interval(3.0, false);
         let [lo, hi] = hard.p95_mpa.map(|v| (v.unwrap() / 3.0).ln());
         assert!(
             (lo + 1.96 * 0.3).abs() < 0.02 && (hi - 1.96 * 0.3).abs() < 0.02,
@@ -336,16 +427,14 @@ mod tests {
 
     #[test]
     fn too_few_presses_and_broken_files_are_refused_with_the_field() {
-        let few: Vec<(f64, f64)> = (0..10).map(|i| (i as f64, 0.0)).collect();
+        let few = held_out((0..10).map(|i| (i as f64, 0.0)), false);
         let e = IntervalCalibration::fit("learned", "layer", "", &few, 3).unwrap_err();
         assert!(e.to_string().contains("at least 40"), "{e}");
         let ok = IntervalCalibration::fit(
             "learned",
             "layer",
             "",
-            &(0..80)
-                .map(|i| (i as f64, 0.01 * i as f64))
-                .collect::<Vec<_>>(),
+            &held_out((0..80).map(|i| (i as f64, 0.01 * i as f64)), false),
             2,
         )
         .unwrap();
@@ -366,5 +455,45 @@ mod tests {
         );
         let e = IntervalCalibration::parse("{}", "c.json").unwrap_err();
         assert!(e.to_string().starts_with("c.json: "), "{e}");
+    }
+
+    #[test]
+    fn elongated_contacts_get_their_own_recentring() {
+        // Round contacts read 25% soft; elongated ones 5% hard.
+        let mut samples = held_out(
+            normal_residuals(200, 0.1, 0.25)
+                .into_iter()
+                .enumerate()
+                .map(|(i, r)| (0.005 * i as f64, r)),
+            false,
+        );
+        samples.extend(held_out(
+            normal_residuals(60, 0.1, -0.05)
+                .into_iter()
+                .enumerate()
+                .map(|(i, r)| (0.01 * i as f64, r)),
+            true,
+        ));
+        let c = IntervalCalibration::fit("indentation", "layer", "", &samples, 1).unwrap();
+        assert_eq!(
+            (c.presses, c.elongated_contact.as_ref().unwrap().presses),
+            (200, 60)
+        );
+        let shift = |elongated| (c.recentred(1.5, elongated) / 1.5).ln();
+        assert!((shift(false) - 0.25).abs() < 0.01, "{}", shift(false));
+        assert!((shift(true) + 0.05).abs() < 0.01, "{}", shift(true));
+        assert!(c.interval(1.5, true).source.contains("elongated contact"));
+        let back =
+            IntervalCalibration::parse(&serde_json::to_string(&c).unwrap(), "c.json").unwrap();
+        let (a, b) = (
+            back.elongated_contact.unwrap(),
+            c.elongated_contact.clone().unwrap(),
+        );
+        assert_eq!(a.presses, b.presses);
+        assert!((a.bins[0].median_residual - b.bins[0].median_residual).abs() < 1e-12);
+        // Too few elongated contacts for bins of their own: one set for all.
+        let c = IntervalCalibration::fit("indentation", "layer", "", &samples[..230], 1).unwrap();
+        assert!(c.elongated_contact.is_none());
+        assert_eq!(c.presses, 230);
     }
 }

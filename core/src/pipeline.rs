@@ -1048,6 +1048,7 @@ mod tests {
                     fit_residual_rms: 0.0,
                     fit_residual_unit: "mm",
                     object_poisson: 0.35,
+                    first_contact_aspect: None,
                 }),
             })
         }
