@@ -31,7 +31,7 @@ use tactex_core::catalog::{FruitCatalog, FruitSpec};
 use tactex_core::estimate::Evidence;
 use tactex_core::explain::TemplateExplainer;
 use tactex_core::hardness::Hardness;
-use tactex_core::interval_calibration::{ELONGATED_ASPECT, HeldOutPress, IntervalCalibration};
+use tactex_core::interval_calibration::{HeldOutPress, IntervalCalibration, is_elongated};
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
 use tactex_sim::elastic::Fidelity;
@@ -618,9 +618,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
                 Some(HeldOutPress {
                     ln_estimate: e.ln(),
                     residual: (r.true_modulus_mpa / e).ln(),
-                    elongated: r
-                        .first_contact_aspect
-                        .is_some_and(|a| a >= ELONGATED_ASPECT),
+                    elongated: r.first_contact_aspect.is_some_and(is_elongated),
                 })
             })
             .collect();

@@ -45,14 +45,20 @@ fn peak(depth: &[f64]) -> f64 {
     sorted[k..].iter().sum::<f64>() / n as f64
 }
 
-/// The contact's semi-axes (mm, wide then narrow) from the imprint's half-depth region, taken
+/// The contact's semi-axes (mm, wide then narrow) from the imprint's half-depth region (where
+/// `inside` holds), taken
 /// as the half-depth ellipse of a Hertz dimple: its area fixes the scale (the half-depth
 /// ellipse's axes are 0.866 of the contact's) and its second moments the aspect, so an
 /// elongated imprint (a banana's) keeps its narrow side. Empty: [0, 0].
-fn contact_ellipse(depth: &[f64], w: usize, peak: f64, mm_per_px: f64) -> [f64; 2] {
+fn contact_ellipse(
+    depth: &[f64],
+    w: usize,
+    inside: impl Fn(f64) -> bool,
+    mm_per_px: f64,
+) -> [f64; 2] {
     let (mut n, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     for (i, d) in depth.iter().enumerate() {
-        if *d > 0.5 * peak {
+        if inside(*d) {
             let (x, y) = ((i % w) as f64, (i / w) as f64);
             n += 1.0;
             sx += x;
@@ -123,7 +129,7 @@ impl HardnessEstimator for IndentationEstimator {
             let depth = integrate_slopes(&slopes, spec.mm_per_px);
             let p = peak(&depth);
             let deep = |d: f64| d > 0.5 * p;
-            contact_axes.push(contact_ellipse(&depth, slopes.width, p, spec.mm_per_px));
+            contact_axes.push(contact_ellipse(&depth, slopes.width, deep, spec.mm_per_px));
             within_frame.push(!touches_border(&depth, slopes.width, slopes.height, deep));
             peaks.push(p);
         }
@@ -213,7 +219,7 @@ mod tests {
                 (1.0 - (xr / big).powi(2) - (yr / small).powi(2)).max(0.0)
             })
             .collect();
-        let [a, b] = contact_ellipse(&depth, w, 1.0, 0.1);
+        let [a, b] = contact_ellipse(&depth, w, |d| d > 0.5, 0.1);
         let want = |axis: f64| axis / 2f64.sqrt() * 0.1 / 0.866;
         assert!((a / want(big) - 1.0).abs() < 0.02, "{a} vs {}", want(big));
         assert!(
@@ -221,6 +227,6 @@ mod tests {
             "{b} vs {}",
             want(small)
         );
-        assert_eq!(contact_ellipse(&[0.0; 4], 2, 1.0, 0.1), [0.0, 0.0]);
+        assert_eq!(contact_ellipse(&[0.0; 4], 2, |d| d > 0.5, 0.1), [0.0, 0.0]);
     }
 }

@@ -90,6 +90,11 @@ pub enum CalibrationError {
     },
 }
 
+/// Whether a first contact of this aspect (wide over narrow) is elongated.
+pub fn is_elongated(first_contact_aspect: f64) -> bool {
+    first_contact_aspect >= ELONGATED_ASPECT
+}
+
 /// Whether an estimate's first contact was elongated, as its evidence says (None: its
 /// evidence does not say).
 pub fn elongated_contact(evidence: &Evidence) -> Option<bool> {
@@ -97,7 +102,7 @@ pub fn elongated_contact(evidence: &Evidence) -> Option<bool> {
         Evidence::Physics(PhysicsEvidence {
             first_contact_aspect: Some(aspect),
             ..
-        }) => Some(*aspect >= ELONGATED_ASPECT),
+        }) => Some(is_elongated(*aspect)),
         _ => None,
     }
 }

@@ -162,10 +162,13 @@ impl<'a> ClassicalDetector<'a> {
             .filter(|m| m.len() >= self.min_pixels)
             .flat_map(|blob| split_by_height(&blob, self.split_prominence_m))
             .map(|group| group.iter().map(|p| (p.u, p.v)).collect::<Vec<_>>())
-            .flat_map(|group| self.part_at_necks(group, &describe, 0))
             .filter(|m| m.len() >= self.min_pixels)
             .filter_map(|pixels| {
                 let (size_m, fit) = describe(&pixels)?;
+                Some((pixels, size_m, fit))
+            })
+            .flat_map(|region| self.part_at_necks(region, &describe, 0))
+            .map(|(pixels, size_m, fit)| {
                 let mut mask = GrayImage::new(w, h);
                 let mut bbox = [u32::MAX, u32::MAX, 0, 0];
                 for &(u, v) in &pixels {
@@ -177,13 +180,13 @@ impl<'a> ClassicalDetector<'a> {
                         bbox[3].max(v),
                     ];
                 }
-                Some(Detection {
+                Detection {
                     label: fit.label,
                     score: fit.score,
                     bbox,
                     mask,
                     size_m,
-                })
+                }
             })
             .collect()
     }
@@ -191,32 +194,36 @@ impl<'a> ClassicalDetector<'a> {
     /// A region cut where two touching fruits meet (`neck_split`) when two catalog fruits fit
     /// its parts better than one fits the whole, by more than `SPLIT_PENALTY`; the parts are
     /// tried again, a few levels deep.
-    fn part_at_necks<F>(
-        &self,
-        pixels: Vec<(u32, u32)>,
-        describe: &F,
-        level: usize,
-    ) -> Vec<Vec<(u32, u32)>>
+    fn part_at_necks<F>(&self, region: Region, describe: &F, level: usize) -> Vec<Region>
     where
         F: Fn(&[(u32, u32)]) -> Option<([f64; 3], Fit)>,
     {
-        let distance = |pixels: &[(u32, u32)]| describe(pixels).map(|(_, fit)| fit.distance);
         // A whole that fits within the penalty cannot be bettered by two fruits.
-        let whole = distance(&pixels).filter(|d| *d > SPLIT_PENALTY && level < 3);
-        let (Some(whole), Some(parts)) = (whole, whole.and_then(|_| cut_at_neck(&pixels))) else {
-            return vec![pixels];
-        };
-        let parted = parts.iter().try_fold(SPLIT_PENALTY, |sum, p| {
-            (p.len() >= self.min_pixels).then_some(())?;
-            Some(sum + distance(p)?)
+        let whole = region.2.distance;
+        let parts = (whole > SPLIT_PENALTY && level < 3)
+            .then(|| cut_at_neck(&region.0))
+            .flatten();
+        let described: Option<Vec<Region>> = parts.and_then(|parts| {
+            parts
+                .into_iter()
+                .map(|p| {
+                    (p.len() >= self.min_pixels).then_some(())?;
+                    let (size_m, fit) = describe(&p)?;
+                    Some((p, size_m, fit))
+                })
+                .collect()
         });
-        if !parted.is_some_and(|d| d < whole) {
-            return vec![pixels];
+        match described {
+            Some(parts)
+                if SPLIT_PENALTY + parts.iter().map(|r| r.2.distance).sum::<f64>() < whole =>
+            {
+                parts
+                    .into_iter()
+                    .flat_map(|r| self.part_at_necks(r, describe, level + 1))
+                    .collect()
+            }
+            _ => vec![region],
         }
-        parts
-            .into_iter()
-            .flat_map(|p| self.part_at_necks(p, describe, level + 1))
-            .collect()
     }
 
     /// Nearest catalog fruit (over all its ripeness colours) in chromaticity, log brightness
@@ -275,6 +282,9 @@ struct Fit {
     score: f64,
     distance: f64,
 }
+
+/// A detector region: its pixels, its size (m) and the catalog fruit that fits it best.
+type Region = (Vec<(u32, u32)>, [f64; 3], Fit);
 
 /// How much better (in squared feature distance) two catalog fruits must fit a region's parts
 /// than one fits the whole before the region is taken for two. On the 376 tables of `eval

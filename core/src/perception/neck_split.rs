@@ -10,6 +10,11 @@
 //! detector keeps the cut only when the two parts look like catalog fruit and the whole does
 //! not.
 
+use image::{GrayImage, Luma};
+use imageproc::geometry;
+use imageproc::point::Point;
+use imageproc::region_labelling::{Connectivity, connected_components};
+
 /// Notches shallower than this (pixels) are the ragged edge of one fruit's depth mask (the
 /// depth camera's edge noise makes notches of up to about 4 px on a single fruit).
 pub const MIN_NOTCH_PX: f64 = 5.0;
@@ -30,7 +35,7 @@ pub fn cut_at_neck(pixels: &[(u32, u32)]) -> Option<[Vec<(u32, u32)>; 2]> {
         region[at(u, v)] = true;
     }
     let filled = fill_holes(&region, w, h);
-    let hull = convex_hull(&filled, w, h);
+    let hull = convex_hull(&filled, w);
     if hull.len() < 3 {
         return None;
     }
@@ -53,70 +58,43 @@ pub fn cut_at_neck(pixels: &[(u32, u32)]) -> Option<[Vec<(u32, u32)>; 2]> {
     (!left.is_empty() && !right.is_empty()).then_some([left, right])
 }
 
-/// The region with its holes (a specular highlight with no depth) filled: everything the
-/// background outside cannot reach.
+/// The region with its holes (a specular highlight with no depth) filled: every pixel whose
+/// background component does not reach the frame's border.
 fn fill_holes(region: &[bool], w: usize, h: usize) -> Vec<bool> {
-    let mut outside = vec![false; w * h];
-    let mut stack = vec![0usize];
-    outside[0] = true;
-    while let Some(i) = stack.pop() {
-        let (x, y) = (i % w, i / w);
-        let mut visit = |j: usize| {
-            if !region[j] && !outside[j] {
-                outside[j] = true;
-                stack.push(j);
-            }
-        };
-        if x > 0 {
-            visit(i - 1);
-        }
-        if x + 1 < w {
-            visit(i + 1);
-        }
-        if y > 0 {
-            visit(i - w);
-        }
-        if y + 1 < h {
-            visit(i + w);
-        }
-    }
-    outside.iter().map(|o| !o).collect()
+    let background = GrayImage::from_fn(w as u32, h as u32, |x, y| {
+        Luma([if region[y as usize * w + x as usize] {
+            0
+        } else {
+            255
+        }])
+    });
+    let labels = connected_components(&background, Connectivity::Four, Luma([0u8]));
+    // The border is background all round, so its one label is the outside.
+    let outside = labels.get_pixel(0, 0)[0];
+    labels.pixels().map(|l| l[0] != outside).collect()
 }
 
-/// Convex hull (counter-clockwise in image coordinates, x right and y down) of the set
-/// pixels' centres, by Andrew's monotone chain over each row's end pixels.
-fn convex_hull(set: &[bool], w: usize, h: usize) -> Vec<[f64; 2]> {
-    let mut points: Vec<[f64; 2]> = Vec::new();
-    for y in 0..h {
-        let row = &set[y * w..(y + 1) * w];
-        if let (Some(a), Some(b)) = (row.iter().position(|s| *s), row.iter().rposition(|s| *s)) {
-            points.push([a as f64, y as f64]);
-            if b != a {
-                points.push([b as f64, y as f64]);
-            }
-        }
-    }
-    points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
-        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    };
-    let mut hull: Vec<[f64; 2]> = Vec::with_capacity(points.len() + 1);
-    for pass in 0..2 {
-        let start = hull.len();
-        let ordered: Box<dyn Iterator<Item = &[f64; 2]>> = if pass == 0 {
-            Box::new(points.iter())
-        } else {
-            Box::new(points.iter().rev())
-        };
-        for &p in ordered {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
+/// Convex hull of the set pixels' centres (imageproc's Graham scan), counter-clockwise as
+/// seen with y up.
+fn convex_hull(set: &[bool], w: usize) -> Vec<[f64; 2]> {
+    let points: Vec<Point<i32>> = set
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| **s)
+        .map(|(i, _)| Point::new((i % w) as i32, (i / w) as i32))
+        .collect();
+    let mut hull: Vec<[f64; 2]> = geometry::convex_hull(points)
+        .into_iter()
+        .map(|p| [p.x as f64, p.y as f64])
+        .collect();
+    let twice_area: f64 = (0..hull.len())
+        .map(|i| {
+            let (a, b) = (hull[i], hull[(i + 1) % hull.len()]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum();
+    if twice_area < 0.0 {
+        hull.reverse();
     }
     hull
 }
@@ -147,41 +125,25 @@ fn notch_depths(filled: &[bool], w: usize, h: usize, hull: &[[f64; 2]]) -> Vec<(
             })
             .fold(f64::INFINITY, f64::min)
     };
-    let gap: Vec<bool> = (0..w * h)
-        .map(|i| !filled[i] && inside([(i % w) as f64, (i / w) as f64]))
-        .collect();
-    let mut seen = vec![false; w * h];
-    let mut notches = Vec::new();
-    for start in 0..w * h {
-        if !gap[start] || seen[start] {
+    let gap = GrayImage::from_fn(w as u32, h as u32, |x, y| {
+        let i = y as usize * w + x as usize;
+        Luma([u8::from(!filled[i] && inside([x as f64, y as f64])) * 255])
+    });
+    let labels = connected_components(&gap, Connectivity::Four, Luma([0u8]));
+    let mut notches: Vec<(f64, [f64; 2])> = Vec::new();
+    for (x, y, l) in labels.enumerate_pixels() {
+        let label = l[0] as usize;
+        if label == 0 {
             continue;
         }
-        seen[start] = true;
-        let mut stack = vec![start];
-        let mut deepest = (0.0f64, [0.0; 2]);
-        while let Some(i) = stack.pop() {
-            let p = [(i % w) as f64, (i / w) as f64];
-            let d = depth(p);
-            if d > deepest.0 {
-                deepest = (d, p);
-            }
-            let (x, y) = (i % w, i / w);
-            for j in [
-                (x > 0).then(|| i - 1),
-                (x + 1 < w).then(|| i + 1),
-                (y > 0).then(|| i - w),
-                (y + 1 < h).then(|| i + w),
-            ]
-            .into_iter()
-            .flatten()
-            {
-                if gap[j] && !seen[j] {
-                    seen[j] = true;
-                    stack.push(j);
-                }
-            }
+        if notches.len() < label {
+            notches.resize(label, (0.0, [0.0; 2]));
         }
-        notches.push(deepest);
+        let p = [x as f64, y as f64];
+        let d = depth(p);
+        if d > notches[label - 1].0 {
+            notches[label - 1] = (d, p);
+        }
     }
     notches
 }
