@@ -210,9 +210,12 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             profile_path.display()
         );
     };
-    // The rebuilt presses are compared with single real frames: no added camera noise.
+    // The rebuilt presses are compared with single real frames: no added camera noise; and
+    // ball presses are taken on a gel without marker dots, as `calibrate` reads them, even
+    // when the profile has the sensor's grid from a marker frame.
     let mut optics = SensorOptics {
         noise_sigma: 0.0,
+        markers: Vec::new(),
         ..SensorOptics::for_profile(&profile)
     };
     if args.no_glow {

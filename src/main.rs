@@ -14,6 +14,7 @@ mod compare;
 mod compare_session;
 mod contact_circle_score;
 mod contact_cli;
+mod datagen_ball_presses;
 mod datagen_scenes;
 mod datagen_tactile;
 mod detect_image;
@@ -160,6 +161,9 @@ enum DatagenCommand {
     /// RGB-D scenes of random fruits with YOLO segmentation labels and a data.yaml that
     /// Ultralytics trains on as is; depth, instance masks and ground truth beside them.
     Scenes(datagen_scenes::SceneDatagenArgs),
+    /// A sensor's ball-press calibration set made in the twin, as `calibrate` reads a real
+    /// one, with each press's truth.
+    BallPresses(datagen_ball_presses::BallPressDatagenArgs),
 }
 
 #[derive(Subcommand)]
@@ -292,6 +296,9 @@ fn main() -> ExitCode {
         Command::Datagen {
             command: DatagenCommand::Scenes(args),
         } => datagen_scenes::run(&args),
+        Command::Datagen {
+            command: DatagenCommand::BallPresses(args),
+        } => datagen_ball_presses::run(&args),
         Command::Bench {
             command: BenchCommand::Contact(args),
         } => bench_contact::run(&args),

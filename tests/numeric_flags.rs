@@ -39,10 +39,10 @@ fn base(sub: &str, flag: &str, out: &str) -> Vec<String> {
         _ => vec![],
     };
     let mut v: Vec<String> = args.into_iter().map(String::from).collect();
-    if matches!(sub, "calibrate" | "datagen scenes") {
+    if matches!(sub, "calibrate" | "datagen scenes" | "datagen ball-presses") {
         v.extend(["--out".to_string(), out.to_string()]);
     }
-    if sub == "datagen scenes" && flag != "--count" {
+    if matches!(sub, "datagen scenes" | "datagen ball-presses") && flag != "--count" {
         v.extend(["--count".to_string(), "1".to_string()]);
     }
     v
@@ -109,6 +109,10 @@ const NUMERIC_FLAGS: &[(&str, &str)] = &[
     ("datagen scenes", "--count"),
     ("datagen scenes", "--seed"),
     ("datagen scenes", "--val-fraction"),
+    ("datagen ball-presses", "--count"),
+    ("datagen ball-presses", "--seed"),
+    ("datagen ball-presses", "--ball-radius-mm"),
+    ("datagen ball-presses", "--contact-share"),
     ("bench contact", "--reps"),
     ("bench contact", "--reference-cell-mm"),
     ("bench contact", "--tolerances"),

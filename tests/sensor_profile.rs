@@ -352,3 +352,100 @@ fn the_learned_model_says_so_when_it_reads_another_sensor_than_it_was_trained_on
         "{note}"
     );
 }
+
+/// `calibrate` checked against a sensor whose truth is known: the twin's GelSight Mini makes
+/// a ball-press set (`datagen ball-presses`), and the profile calibrated from it gives the
+/// Mini back: its marker grid from the set's marker frame, and its held-out presses rendered
+/// through the fitted table as the Mini's analytic lights rendered them, to a few grey levels
+/// (camera noise 0.5).
+#[test]
+fn calibrating_the_twins_own_mini_gives_the_mini_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = dir.path().join("set");
+    let out = tactex(&[
+        "datagen",
+        "ball-presses",
+        "--count",
+        "9",
+        "--seed",
+        "3",
+        "--out",
+        set.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let truth: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(set.join("presses.json")).unwrap()).unwrap();
+    assert_eq!(truth["presses"].as_array().unwrap().len(), 9);
+    assert_eq!(truth["sensor"]["name"], "GelSight Mini");
+
+    let profile = dir.path().join("mini.toml");
+    let file = |name: &str| set.join(name).to_str().unwrap().to_string();
+    let out = tactex(&[
+        "calibrate",
+        "--images",
+        set.to_str().unwrap(),
+        "--annotations",
+        &file("annotations.csv"),
+        "--background",
+        &file("background.png"),
+        "--markers",
+        &file("markers.png"),
+        "--ball-radius-mm",
+        "2.35",
+        "--mm-per-px",
+        "0.0634",
+        "--no-glow",
+        "--out",
+        profile.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let fitted = tactex_core::sensor_profile::SensorProfile::load(&profile).unwrap();
+    let stock = tactex_core::sensor_profile::SensorProfile::gelsight_mini();
+    let (m, s) = (fitted.spec.markers, stock.spec.markers);
+    assert_eq!((m.cols, m.rows), (s.cols, s.rows));
+    assert!(
+        (m.pitch_mm / s.pitch_mm - 1.0).abs() < 0.01,
+        "pitch {}",
+        m.pitch_mm
+    );
+    assert!(
+        (m.radius_mm / s.radius_mm - 1.0).abs() < 0.1,
+        "dot radius {}",
+        m.radius_mm
+    );
+
+    let out = tactex(&[
+        "compare",
+        "--sensor",
+        profile.to_str().unwrap(),
+        "--images",
+        set.to_str().unwrap(),
+        "--annotations",
+        &file("annotations.csv"),
+        "--json",
+    ]);
+    let report = json(&out);
+    let (ssim, mae) = (
+        report["mean"]["ssim_contact"].as_f64().unwrap(),
+        report["mean"]["mae_contact"].as_f64().unwrap(),
+    );
+    let bare = report["background_only_mean"]["mae_contact"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        ssim >= 0.97 && mae <= 3.0,
+        "held-out contact SSIM {ssim}, MAE {mae}"
+    );
+    assert!(
+        bare > 3.0 * mae,
+        "the bare background scores {bare}, the presses {mae}"
+    );
+}
