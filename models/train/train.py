@@ -140,8 +140,10 @@ def training_sensor(dirs):
 
 def main():
     args = parse_args()
-    # Before any loading: a mix of sensors fails first.
+    # Before any loading: a mix of sensors fails first, and so does a missing onnxruntime,
+    # which the export after training checks the graph with.
     sensor = training_sensor(args.train)
+    import onnxruntime  # noqa: F401
     torch.manual_seed(args.seed)
     torch.set_num_threads(args.threads)
     out = Path(args.out)
