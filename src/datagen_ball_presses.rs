@@ -55,6 +55,9 @@ pub struct BallPressDatagenArgs {
     pub device: DeviceChoice,
 }
 
+/// The smallest contact radius drawn (pixels).
+const MIN_CONTACT_RADIUS_PX: f64 = 3.0;
+
 #[derive(Clone, Copy, Debug)]
 pub struct ShareRange(f64, f64);
 
@@ -121,6 +124,15 @@ pub fn run(args: &BallPressDatagenArgs) -> Result<()> {
         markers: Vec::new(),
         ..with_markers.clone()
     };
+    // `calibrate` reads slopes from the pixels inside a contact: a few pixels at least.
+    let smallest_px = args.contact_share.0 * args.ball_radius_mm / optics.mm_per_px;
+    if smallest_px < MIN_CONTACT_RADIUS_PX {
+        bail!(
+            "--ball-radius-mm {}: its smallest contact is {smallest_px:.2} px in radius at {} mm/px; at least {MIN_CONTACT_RADIUS_PX} px is needed",
+            args.ball_radius_mm,
+            optics.mm_per_px
+        );
+    }
     let reach_px = args.contact_share.1 * args.ball_radius_mm / optics.mm_per_px + 1.0;
     if 2.0 * reach_px >= optics.width.min(optics.height) as f64 {
         bail!(

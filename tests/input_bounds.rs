@@ -169,3 +169,27 @@ fn unclear_causes_are_said_plainly_naming_the_flag_file_or_field() {
         "{err}"
     );
 }
+
+/// A ball-press set whose contacts would be under a few pixels (nothing to calibrate from,
+/// and a solver grid sized for a speck) or wider than the frame is refused before any press,
+/// naming the flag, and leaves no output directory.
+#[test]
+fn ball_presses_too_small_or_too_large_for_the_frame_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for radius in ["0.01", "100"] {
+        let out_dir = dir.path().join(format!("set-{radius}"));
+        let out = tactex(&[
+            "datagen",
+            "ball-presses",
+            "--count",
+            "2",
+            "--ball-radius-mm",
+            radius,
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        let err = one_line_error(&out);
+        assert!(err.contains("--ball-radius-mm"), "{err}");
+        assert!(!out_dir.exists());
+    }
+}
