@@ -10,6 +10,8 @@ fn atomic(path: &Path, write: impl FnOnce(&mut std::fs::File) -> Result<()>) -> 
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
+    // `--out profiles/mine.toml` makes its folder, as `--out DIR` does.
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     let mut tmp = tempfile::NamedTempFile::new_in(dir)
         .with_context(|| format!("{}: cannot write there", dir.display()))?;
     write(tmp.as_file_mut()).with_context(|| format!("{}: write failed", path.display()))?;

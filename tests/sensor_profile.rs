@@ -382,7 +382,8 @@ fn calibrating_the_twins_own_mini_gives_the_mini_back() {
     assert_eq!(truth["presses"].as_array().unwrap().len(), 9);
     assert_eq!(truth["sensor"]["name"], "GelSight Mini");
 
-    let profile = dir.path().join("mini.toml");
+    // In a folder that does not exist yet: `calibrate --out` makes it.
+    let profile = dir.path().join("profiles/mini.toml");
     let file = |name: &str| set.join(name).to_str().unwrap().to_string();
     let out = tactex(&[
         "calibrate",
