@@ -1,5 +1,5 @@
 //! `tactex detect` and `--detector yolo:FILE` from the command line, against the YOLOv8-seg
-//! probe model (core/tests/fixtures, written by models/train/make_yolo_probe.py): its apple
+//! probe model (learned/tests/fixtures, written by models/train/make_yolo_probe.py): its apple
 //! and lime boxes sit on a red and a green disk drawn here.
 
 use image::{Rgb, RgbImage};
@@ -15,7 +15,7 @@ fn tactex(args: &[&str]) -> std::process::Output {
 
 fn probe(name: &str) -> String {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("core/tests/fixtures")
+        .join("learned/tests/fixtures")
         .join(name)
         .display()
         .to_string()

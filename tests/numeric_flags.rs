@@ -32,7 +32,7 @@ fn base(sub: &str, flag: &str, out: &str) -> Vec<String> {
         ],
         "detect" => vec![
             "--model",
-            "core/tests/fixtures/yolo-seg-probe.onnx",
+            "learned/tests/fixtures/yolo-seg-probe.onnx",
             "tests/fixtures/fots/ball-presses/0001.png",
         ],
         "sensor check" => vec!["no-such-profile.toml"],

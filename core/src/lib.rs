@@ -4,7 +4,11 @@
 //! real (`tactex-hw`) and replay backends implement, the fruit catalog and scene format,
 //! Hertz contact theory, perception (detection, mask refinement, centroids, tactile
 //! helpers), hardness estimation, explanation (template, groundedness check, LLM prompt) and
-//! the question pipeline that is generic over the device traits. Nothing in here knows which backend it runs against.
+//! the question pipeline that is generic over the device traits. Nothing in here knows which
+//! backend it runs against,
+//! and nothing here runs a neural network: learned models live in `tactex-learned`.
+
+#![forbid(unsafe_code)]
 
 pub mod ball_calibration;
 pub mod catalog;
@@ -23,9 +27,6 @@ pub mod image_file;
 pub mod indentation_estimator;
 pub mod interval_calibration;
 pub mod layer_compliance;
-pub mod onnx_estimator;
-pub mod onnx_metadata;
-pub mod onnx_runtime;
 pub mod perception;
 pub mod photometric;
 pub mod pipeline;

@@ -5,8 +5,8 @@
 
 mod queries;
 
-use crate::ask::{OpenedTwin, Twin, TwinOptions};
-use crate::detector_choice::DetectorChoice;
+use crate::app::detector_choice::DetectorChoice;
+use crate::app::{OpenedTwin, Twin, TwinOptions};
 use anyhow::{Context, Result};
 use axum::Router;
 use axum::body::Bytes;
@@ -94,8 +94,8 @@ pub fn run(args: &ServeArgs) -> Result<()> {
         );
     }
     let catalog = FruitCatalog::builtin();
-    let path = args.scene.clone().unwrap_or_else(crate::default_scene);
-    let (scene, _) = crate::ask::load_scene(&path, &catalog)?;
+    let path = args.scene.clone().unwrap_or_else(crate::app::default_scene);
+    let (scene, _) = crate::app::load_scene(&path, &catalog)?;
     let OpenedTwin {
         detector,
         renderer,
@@ -258,7 +258,7 @@ async fn live_view(State(s): State<Shared>) -> Response {
                 .map_err(|_| anyhow::anyhow!("live camera lock poisoned"))?;
             camera.capture()?.color
         };
-        crate::output::png_bytes(&color)
+        crate::report::output::png_bytes(&color)
     })
     .await;
     match frame {
@@ -473,7 +473,7 @@ async fn tactile_frame(
             }
         }
     };
-    match crate::output::png_bytes(&image) {
+    match crate::report::output::png_bytes(&image) {
         Ok(bytes) => png(bytes),
         Err(e) => error(StatusCode::INTERNAL_SERVER_ERROR, &format!("{e:#}")),
     }

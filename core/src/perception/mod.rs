@@ -19,4 +19,3 @@ pub mod neck_split;
 pub mod press_site;
 pub mod slopes;
 pub mod ssim;
-pub mod yolo_seg;

@@ -1,0 +1,22 @@
+//! The application layer every front end shares (the commands, the chat page, the xArm
+//! twin, the evaluations and, next, the Python package): loading scenes and sensor profiles,
+//! choosing the detector, estimator and explainer, and answering a question on the twin, on
+//! the real devices or from a recorded session.
+
+pub mod detector_choice;
+pub mod estimator_choice;
+pub mod explainer_choice;
+pub mod hardware;
+pub mod image_input;
+pub mod question;
+pub mod replay;
+pub mod scene;
+pub mod sensor;
+pub mod twin;
+pub mod twin_options;
+
+pub use image_input::load_rgb;
+pub use scene::{default_scene, load_scene, scene_renderer};
+pub use sensor::{load_sensor, with_gel_modulus};
+pub use twin::{Twin, TwinAnswer};
+pub use twin_options::{DEFAULT_ESTIMATOR, OpenedTwin, TwinOptions};

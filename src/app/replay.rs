@@ -1,0 +1,62 @@
+//! A question answered from a recorded session, and the detector for devices without truth.
+
+use crate::app::detector_choice::DetectorChoice;
+use crate::app::question::Question;
+use crate::app::twin_options::OpenedTwin;
+use anyhow::{Context, Result, bail};
+use std::path::Path;
+use tactex_core::catalog::FruitCatalog;
+use tactex_core::perception::detect::Detector;
+use tactex_core::pipeline::{Answer, Devices, PipelineConfig};
+use tactex_hw::session::open_session;
+
+/// Answers `prompt` from the recorded session in `dir`: its frames in the order they were
+/// taken, its moves checked against the pipeline's.
+pub fn answer_on_replay(
+    dir: &Path,
+    opened: &OpenedTwin,
+    prompt: &str,
+    config: &PipelineConfig,
+) -> Result<Answer> {
+    let (choice, explainer) = (&opened.detector, opened.explainer.as_ref());
+    let catalog = FruitCatalog::builtin();
+    let (manifest, mut camera, mut tactile, mut arm) = open_session(dir).context("--session")?;
+    let detector = detector_without_truth(choice, &catalog)?;
+    let question = Question {
+        prompt,
+        catalog: &catalog,
+        detector: detector.as_ref(),
+        estimator: opened.estimator.as_ref(),
+        explainer,
+        config,
+        fidelity: None,
+        sensor: None,
+    };
+    let mut answer = question.ask(
+        Devices {
+            camera: &mut camera,
+            tactile: &mut tactile,
+            arm: &mut arm,
+        },
+        None,
+    )?;
+    // A session recorded on the twin replays the twin's frames: it says at which fidelity.
+    if let Some(twin) = manifest.twin {
+        answer.fidelity = twin.fidelity;
+        answer.sensor = twin.sensor;
+    }
+    Ok(answer)
+}
+
+/// The detector for devices that know no ground truth (real ones, or a replay of them).
+pub fn detector_without_truth<'a>(
+    choice: &'a DetectorChoice,
+    catalog: &'a FruitCatalog,
+) -> Result<Box<dyn Detector + 'a>> {
+    if matches!(choice, DetectorChoice::PerceptionError(_)) {
+        bail!(
+            "--detector: the perception-error models need the twin's ground truth; use classical or yolo:FILE"
+        );
+    }
+    choice.detector(catalog, None, 0)
+}

@@ -1,0 +1,28 @@
+//! The tactile sensor's profile: the built-in GelSight Mini, a profile file, a what-if gel.
+
+use anyhow::{Result, bail};
+use std::path::Path;
+use tactex_core::sensor_profile::SensorProfile;
+
+/// The profile at `path` (`--sensor`), or the built-in GelSight Mini.
+pub fn load_sensor(path: Option<&Path>) -> Result<SensorProfile> {
+    match path {
+        Some(p) => SensorProfile::load(p).map_err(|e| anyhow::anyhow!("--sensor: {e}")),
+        None => Ok(SensorProfile::gelsight_mini()),
+    }
+}
+
+/// `sensor` with its gel's modulus replaced when one is given (`--gel-modulus-mpa`).
+pub fn with_gel_modulus(
+    mut sensor: SensorProfile,
+    gel_modulus_mpa: Option<f64>,
+) -> Result<SensorProfile> {
+    if let Some(e) = gel_modulus_mpa {
+        // Beyond these the gel is no gel: a foam or a rubber outside the layer model's range.
+        if !(e.is_finite() && (0.01..=50.0).contains(&e)) {
+            bail!("--gel-modulus-mpa: {e} is outside 0.01..50 MPa");
+        }
+        sensor.spec.gel.modulus_mpa = e;
+    }
+    Ok(sensor)
+}

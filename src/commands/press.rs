@@ -1,0 +1,435 @@
+//! `tactex press`: one press of the GelSight gel into a primitive or a mesh at a chosen
+//! fidelity, reported as JSON or text, with the gel maps written as 16-bit PNGs.
+
+use crate::cli::flag_range::{above, within};
+use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic, write_png16_atomic};
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use glam::{DVec2, DVec3};
+use serde::Serialize;
+use std::path::PathBuf;
+use tactex_core::hardness::Hardness;
+use tactex_core::hertz::Elastic;
+use tactex_sim::elastic::{
+    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
+};
+use tactex_sim::gel_render::{
+    DeviceChoice, GelImageFields, PressFrame, SensorOptics, image_fields, open_renderer,
+};
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum Shape {
+    Sphere,
+    Ellipsoid,
+    Box,
+    Mesh,
+}
+
+#[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
+pub struct PressArgs {
+    /// The object's shape.
+    #[arg(long, value_enum)]
+    shape: Shape,
+    /// Sphere radius (mm, above 0 up to 500).
+    #[arg(long, default_value_t = 10.0, value_parser = above(0.0, 500.0))]
+    radius_mm: f64,
+    /// Ellipsoid or box size X,Y,Z (mm, full extents, each above 0 up to 1000); default a
+    /// cube or ball of 2 radii.
+    #[arg(long, value_delimiter = ',', value_parser = above(0.0, 1000.0))]
+    size_mm: Option<Vec<f64>>,
+    /// Turn of an ellipsoid or box about the pressing axis (degrees, -360 to 360).
+    #[arg(long, default_value_t = 0.0, value_parser = within(-360.0, 360.0))]
+    yaw_deg: f64,
+    /// Mesh file (.obj, .gltf, .glb) for --shape mesh, pressed at the middle of its top.
+    #[arg(long)]
+    mesh: Option<PathBuf>,
+    /// Mesh units to metres (scenes use metres; above 0 up to 1000).
+    #[arg(long, default_value_t = 1.0, value_parser = above(0.0, 1000.0))]
+    mesh_scale: f64,
+    /// Object hardness as in scene files: "35A", "55 00", "rigid".
+    #[arg(long, conflicts_with = "modulus_mpa")]
+    hardness: Option<String>,
+    /// Object Young's modulus instead of a Shore value (MPa, above 0 up to 1e6).
+    #[arg(long, value_parser = above(0.0, 1e6))]
+    modulus_mpa: Option<f64>,
+    /// Object Poisson ratio (0 to 0.5).
+    #[arg(long, default_value_t = 0.45, value_parser = within(0.0, 0.5))]
+    object_poisson: f64,
+    /// The sensor's travel past first touch (mm, 0 to 30): total approach of gel and object.
+    #[arg(long, value_parser = within(0.0, 30.0))]
+    depth_mm: f64,
+    /// Contact model.
+    #[arg(long, default_value = "layer")]
+    fidelity: String,
+    /// Solver cell (mm, 0.02 to 5: a pad of 1,000 cells across down to 4); default from the
+    /// contact's size.
+    #[arg(long, value_parser = within(0.02, 5.0))]
+    grid_mm: Option<f64>,
+    /// The contact solve stops when one step changes the pressure by less than this
+    /// (relative, 1e-12 to 0.5); `bench contact` measures what looser values trade.
+    #[arg(long, default_value_t = 1e-6, value_parser = within(1e-12, 0.5))]
+    tolerance: f64,
+    /// Gel thickness (mm, above 0 up to 50); GelSight Mini ~4.
+    #[arg(long, value_parser = above(0.0, 50.0))]
+    gel_thickness_mm: Option<f64>,
+    /// Gel Young's modulus (MPa, above 0 up to 1000); GelSight Mini ~0.15-0.45.
+    #[arg(long, value_parser = above(0.0, 1000.0))]
+    gel_modulus_mpa: Option<f64>,
+    /// Write the gel displacement and pressure maps (16-bit PNG + JSON sidecar), the
+    /// rendered GelSight Mini frame (tactile.png) and a no-contact frame (reference.png) here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Device that renders tactile.png: auto (a hardware GPU if there is one, else the
+    /// CPU), gpu (any Vulkan adapter, software included) or cpu.
+    #[arg(long, default_value = "auto")]
+    device: DeviceChoice,
+    /// Sensor profile whose gel, frame and optics the press uses (TOML); default the
+    /// built-in GelSight Mini. The gel and marker flags override its values.
+    #[arg(long)]
+    sensor: Option<PathBuf>,
+    /// Marker grid of the rendered frame, COLSxROWS (the Mini prints 9x7; 11x9 and others
+    /// are common on other gels); 0x0 for none. Default: the profile's.
+    #[arg(long)]
+    marker_grid: Option<String>,
+    /// Marker pitch (mm, above 0 up to 20). Default: the profile's.
+    #[arg(long, value_parser = above(0.0, 20.0))]
+    marker_pitch_mm: Option<f64>,
+    /// Seed of the rendered frame's camera noise.
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct GridReport {
+    cell_mm: f64,
+    nx: usize,
+    ny: usize,
+    origin_mm: [f64; 2],
+}
+
+impl From<&Grid> for GridReport {
+    fn from(g: &Grid) -> Self {
+        Self {
+            cell_mm: g.cell_mm,
+            nx: g.nx,
+            ny: g.ny,
+            origin_mm: [g.origin_mm.x, g.origin_mm.y],
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct PressReport {
+    fidelity: String,
+    /// The sensor profile (after the gel and marker flags) the press used.
+    sensor: tactex_core::sensor_profile::ProfileId,
+    shape: String,
+    depth_mm: f64,
+    force_n: f64,
+    contact_radius_mm: f64,
+    contact_area_mm2: f64,
+    max_pressure_mpa: f64,
+    gel_max_indentation_mm: f64,
+    object_max_indentation_mm: f64,
+    gel_modulus_mpa: f64,
+    gel_poisson: f64,
+    gel_thickness_mm: f64,
+    object_modulus_mpa: Option<f64>,
+    object_poisson: f64,
+    object_shore_a: f64,
+    object_shore_00: f64,
+    grid: GridReport,
+    iterations: usize,
+    residual: f64,
+    warnings: Vec<String>,
+}
+
+fn surface(args: &PressArgs) -> Result<ObjectSurface> {
+    let size = |default: f64| -> Result<DVec3> {
+        match &args.size_mm {
+            Some(v) => {
+                if v.len() != 3 {
+                    bail!("--size-mm: give three sizes X,Y,Z in mm, got {}", v.len());
+                }
+                Ok(DVec3::new(v[0], v[1], v[2]))
+            }
+            None => Ok(DVec3::splat(2.0 * default)),
+        }
+    };
+    Ok(match args.shape {
+        Shape::Sphere => ObjectSurface::Sphere {
+            radius_mm: args.radius_mm,
+            centre_mm: DVec2::ZERO,
+        },
+        Shape::Ellipsoid => ObjectSurface::Ellipsoid {
+            semi_axes_mm: size(args.radius_mm)? / 2.0,
+            centre_mm: DVec2::ZERO,
+            yaw_rad: args.yaw_deg.to_radians(),
+        },
+        Shape::Box => ObjectSurface::Box {
+            size_mm: size(args.radius_mm)?.truncate(),
+            centre_mm: DVec2::ZERO,
+            yaw_rad: args.yaw_deg.to_radians(),
+        },
+        Shape::Mesh => {
+            let path = args
+                .mesh
+                .as_ref()
+                .context("--shape mesh needs --mesh FILE")?;
+            let mesh = tactex_sim::mesh::load(path)?;
+            mesh.validate(&path.display().to_string())?;
+            ObjectSurface::from_mesh_top(&mesh, args.mesh_scale * 1e3)
+        }
+    })
+}
+
+fn object(args: &PressArgs) -> Result<Hardness> {
+    match (&args.hardness, args.modulus_mpa) {
+        (Some(text), _) => Hardness::parse(text).with_context(|| format!("--hardness {text:?}")),
+        (None, Some(e)) => Ok(Hardness::ModulusMpa(e)),
+        (None, None) => bail!("give the object's --hardness (e.g. \"35A\") or --modulus-mpa"),
+    }
+}
+
+pub fn run(args: &PressArgs) -> Result<()> {
+    let fidelity: Fidelity = args
+        .fidelity
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--fidelity: {e}"))?;
+    let hardness = object(args)?;
+    let surface = surface(args)?;
+    let mut profile = crate::app::load_sensor(args.sensor.as_deref())?;
+    let spec = &mut profile.spec;
+    if let Some(grid) = &args.marker_grid {
+        let (cols, rows) = grid
+            .split_once(['x', 'X'])
+            .and_then(|(c, r)| Some((c.trim().parse::<u32>().ok()?, r.trim().parse::<u32>().ok()?)))
+            .with_context(|| {
+                format!("--marker-grid: '{grid}' is not COLSxROWS (e.g. 9x7, 11x9)")
+            })?;
+        let markers = u64::from(cols) * u64::from(rows);
+        if markers == 0 || markers > 10_000 {
+            bail!(
+                "--marker-grid: {cols}x{rows} is {markers} markers; a gel has 1 to 10000 (e.g. 9x7, 11x9)"
+            );
+        }
+        spec.markers.cols = cols;
+        spec.markers.rows = rows;
+    }
+    if let Some(pitch) = args.marker_pitch_mm {
+        spec.markers.pitch_mm = pitch;
+    }
+    let mut gel = spec.gel;
+    if let Some(t) = args.gel_thickness_mm {
+        gel.thickness_mm = t;
+    }
+    if let Some(e) = args.gel_modulus_mpa {
+        gel.modulus_mpa = e;
+    }
+    spec.gel = gel;
+    let pad = Rect::centred(DVec2::from(spec.pad_size_mm()) / 2.0);
+    let problem = ContactProblem {
+        surface: &surface,
+        object: Elastic {
+            modulus_mpa: hardness.modulus_mpa(),
+            poisson: args.object_poisson,
+        },
+        gel,
+        pad,
+        approach_mm: args.depth_mm,
+        cell_mm: args.grid_mm,
+    };
+    let mut solver = ContactSolver::new();
+    solver.settings.tolerance = args.tolerance;
+    let solution = solver.solve(&problem, fidelity)?;
+    let shown = tactex_core::hardness::HardnessReport::from(hardness);
+    let report = PressReport {
+        fidelity: fidelity.to_string(),
+        sensor: profile.id(),
+        shape: format!("{:?}", args.shape).to_lowercase(),
+        depth_mm: args.depth_mm,
+        force_n: solution.force_n,
+        contact_radius_mm: solution.contact_radius_mm,
+        contact_area_mm2: solution.contact_area_mm2,
+        max_pressure_mpa: solution.max_pressure_mpa,
+        gel_max_indentation_mm: solution.gel_max_indentation_mm,
+        object_max_indentation_mm: solution.object_max_indentation_mm,
+        gel_modulus_mpa: gel.modulus_mpa,
+        gel_poisson: gel.poisson,
+        gel_thickness_mm: gel.thickness_mm,
+        object_modulus_mpa: hardness.modulus_mpa(),
+        object_poisson: args.object_poisson,
+        object_shore_a: shown.shore_a,
+        object_shore_00: shown.shore_00,
+        grid: (&solution.grid).into(),
+        iterations: solution.iterations,
+        residual: solution.residual,
+        warnings: solution.warnings.clone(),
+    };
+    if let Some(out) = &args.out {
+        // The renderer first: a missing device fails before any file is written.
+        let choice = open_renderer(args.device)?;
+        let out = OutputDir::create("--out", out)?;
+        let dir = out.path();
+        if let Some(note) = &choice.note {
+            eprintln!("note: {note}");
+        }
+        let mut renderer = choice.renderer;
+        write_maps(dir, &mut solver, &solution, &pad, &report)?;
+        let optics = SensorOptics::for_profile(&profile);
+        let fields = image_fields(&mut solver, &solution, &gel, &optics);
+        let flat = GelImageFields::flat(optics.width, optics.height);
+        // The no-contact frame draws its own camera noise, as a real one taken before the
+        // press would.
+        let mut frames = renderer.render_batch(
+            &optics,
+            &[
+                PressFrame {
+                    fields: &fields,
+                    seed: args.seed,
+                },
+                PressFrame {
+                    fields: &flat,
+                    seed: args.seed.wrapping_add(1),
+                },
+            ],
+        )?;
+        let reference = frames.pop().expect("two frames rendered");
+        let frame = frames.pop().expect("two frames rendered");
+        write_png_atomic(&dir.join("tactile.png"), &frame)?;
+        write_png_atomic(&dir.join("reference.png"), &reference)?;
+        out.finish()?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_report(&report);
+    }
+    Ok(())
+}
+
+fn print_report(r: &PressReport) {
+    let object = r
+        .object_modulus_mpa
+        .map_or("rigid".to_string(), |e| format!("{e:.3} MPa"));
+    println!(
+        "{} press of a {} ({object}, {:.1} Shore A) {:.3} mm past first touch:",
+        r.fidelity, r.shape, r.object_shore_a, r.depth_mm
+    );
+    println!("  force            {:>10.4} N", r.force_n);
+    println!(
+        "  contact          {:>10.4} mm radius, {:.3} mm^2",
+        r.contact_radius_mm, r.contact_area_mm2
+    );
+    println!("  max pressure     {:>10.4} MPa", r.max_pressure_mpa);
+    println!(
+        "  gel indentation  {:>10.4} mm (of a {:.2} mm gel)",
+        r.gel_max_indentation_mm, r.gel_thickness_mm
+    );
+    println!(
+        "  object indent.   {:>10.4} mm",
+        r.object_max_indentation_mm
+    );
+    println!(
+        "  solver           {} x {} cells of {:.4} mm, {} iterations, residual {:.1e}",
+        r.grid.nx, r.grid.ny, r.grid.cell_mm, r.iterations, r.residual
+    );
+    for w in &r.warnings {
+        println!("  warning: {w}");
+    }
+}
+
+/// Scales a field to 16 bits: value = offset_mm + png * scale; the sidecar says how.
+fn quantise(field: &[f64]) -> (Vec<u16>, f64, f64) {
+    let lo = field.iter().copied().fold(f64::INFINITY, f64::min).min(0.0);
+    let hi = field
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max)
+        .max(0.0);
+    let scale = if hi > lo { (hi - lo) / 65535.0 } else { 1.0 };
+    let data = field
+        .iter()
+        .map(|v| ((v - lo) / scale).round().clamp(0.0, 65535.0) as u16)
+        .collect();
+    (data, lo, scale)
+}
+
+#[derive(Serialize)]
+struct MapEntry {
+    file: String,
+    quantity: &'static str,
+    unit: &'static str,
+    /// value = offset + png_value * scale
+    offset: f64,
+    scale: f64,
+    grid: GridReport,
+}
+
+fn write_maps(
+    dir: &std::path::Path,
+    solver: &mut ContactSolver,
+    solution: &ContactSolution,
+    pad: &Rect,
+    report: &PressReport,
+) -> Result<()> {
+    // The gel moves beyond the solver grid: map it over the pad, at the solver's cell unless
+    // that would exceed 1024 cells a side.
+    let cells = pad.size().max_element() / solution.grid.cell_mm;
+    let fields: GelFields = if cells <= 1024.0 {
+        solver.fields_over(solution, pad)
+    } else {
+        solution.gel.clone()
+    };
+    let maps: [(&str, &'static str, &'static str, &[f64], &Grid); 4] = [
+        (
+            "gel_normal.png",
+            "gel normal displacement (into the gel)",
+            "mm",
+            &fields.normal_mm,
+            &fields.grid,
+        ),
+        (
+            "gel_lateral_x.png",
+            "gel lateral displacement along x (image columns)",
+            "mm",
+            &fields.lateral_x_mm,
+            &fields.grid,
+        ),
+        (
+            "gel_lateral_y.png",
+            "gel lateral displacement along y (image rows)",
+            "mm",
+            &fields.lateral_y_mm,
+            &fields.grid,
+        ),
+        (
+            "pressure.png",
+            "contact pressure",
+            "MPa",
+            &solution.pressure_mpa,
+            &solution.grid,
+        ),
+    ];
+    let mut entries = Vec::new();
+    for (file, quantity, unit, field, grid) in maps {
+        let (data, offset, scale) = quantise(field);
+        write_png16_atomic(&dir.join(file), grid.nx as u32, grid.ny as u32, data)?;
+        entries.push(MapEntry {
+            file: file.into(),
+            quantity,
+            unit,
+            offset,
+            scale,
+            grid: grid.into(),
+        });
+    }
+    write_json_atomic(
+        &dir.join("maps.json"),
+        &serde_json::json!({ "press": report, "maps": entries }),
+    )
+}

@@ -1,0 +1,9 @@
+//! What the commands write: files that appear whole or not at all (`output`), plots
+//! (`plot`), NumPy archives (`npz`), comparison images, overlay colours and summaries.
+
+pub mod npz;
+pub mod output;
+pub mod palette;
+pub mod plot;
+pub mod side_by_side;
+pub mod summary;

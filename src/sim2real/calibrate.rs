@@ -1,0 +1,338 @@
+//! `tactex calibrate`: fits the gradient -> colour table from annotated ball presses, then the
+//! glow round a contact from the same presses rebuilt in the twin, measures the camera's
+//! noise, and writes a sensor profile (TOML + its background PNG beside it).
+
+use crate::cli::flag_range::{above, within};
+use crate::report::output::write_profile_atomic;
+use crate::sim2real::ball_presses::{self, Split, contact_box, rebuild};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use image::RgbImage;
+use std::path::PathBuf;
+use tactex_core::ball_calibration::{
+    BallPress, SampleRule, camera_noise_sigma, samples_from_ball_press,
+};
+use tactex_core::gel_glow::{GelGlow, GlowPress};
+use tactex_core::perception::centroid::median;
+use tactex_core::sensor_profile::{CalibrationFit, SensorProfile};
+use tactex_core::shading_table::{ShadingTable, frame_position};
+use tactex_core::tactile_spec::{GelSpec, TactileSpec};
+use tactex_sim::elastic::{ContactSolver, Fidelity};
+use tactex_sim::gel_render::{CpuRenderer, SensorOptics};
+
+#[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
+pub struct CalibrateArgs {
+    /// Directory of the ball-press images.
+    #[arg(long)]
+    pub images: PathBuf,
+    /// CSV: image,center_x_px,center_y_px,contact_radius_px; at most 1000 presses, each image once.
+    #[arg(long)]
+    pub annotations: PathBuf,
+    /// The sensor's no-contact frame.
+    #[arg(long)]
+    pub background: PathBuf,
+    /// The ball's radius (mm, above 0 up to 100).
+    #[arg(long, value_parser = above(0.0, 100.0))]
+    pub ball_radius_mm: f64,
+    /// The frames' scale (mm per pixel, above 0 up to 1).
+    #[arg(long, value_parser = above(0.0, 1.0))]
+    pub mm_per_px: f64,
+    /// The sensor profile to write (TOML; its background goes beside it as
+    /// NAME.background.png).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The profile's name (default: the output file's stem).
+    #[arg(long)]
+    pub name: Option<String>,
+    /// The gel's Young's modulus (MPa, above 0 up to 1000); default the GelSight Mini's.
+    #[arg(long, value_parser = above(0.0, 1000.0))]
+    pub gel_modulus_mpa: Option<f64>,
+    /// The gel's thickness (mm, above 0 up to 50); default the GelSight Mini's.
+    #[arg(long, value_parser = above(0.0, 50.0))]
+    pub gel_thickness_mm: Option<f64>,
+    /// The gel's Poisson ratio (0 to 0.5); default the GelSight Mini's.
+    #[arg(long, value_parser = within(0.0, 0.5))]
+    pub gel_poisson: Option<f64>,
+    /// The camera's frame rate (Hz, above 0 up to 1000); default the GelSight Mini's.
+    #[arg(long, value_parser = above(0.0, 1000.0))]
+    pub frame_rate_hz: Option<f64>,
+    /// Which presses to fit: calib (all but every third), eval, or all.
+    #[arg(long, value_enum, default_value_t = Split::Calib)]
+    pub split: Split,
+    /// Table nodes over slope magnitude; 2 to 100.
+    #[arg(long, value_parser = crate::cli::flag_range::count::<u32>(2, 100), default_value_t = 12)]
+    pub mag_bins: u32,
+    /// Table nodes over slope direction; 4 to 360.
+    #[arg(long, value_parser = crate::cli::flag_range::count::<u32>(4, 360), default_value_t = 24)]
+    pub dir_bins: u32,
+    /// Largest slope (dw/dr) the table covers (above 0 up to 100).
+    #[arg(long, default_value_t = 2.5, value_parser = above(0.0, 100.0))]
+    pub mag_max: f64,
+    /// Weight tying neighbouring table nodes together (0 to 1e6).
+    #[arg(long, default_value_t = 20.0, value_parser = within(0.0, 1e6))]
+    pub smoothness: f64,
+    /// Attribution of the images, stored in the file.
+    #[arg(long, default_value = "")]
+    pub source: String,
+    /// A real frame of the sensor's marker grid, flat or pressed (FOTS's markers/press.png):
+    /// the profile's grid (columns, rows, pitch, dot size and darkness) is read from it. It
+    /// may be the background's size or that turned a quarter. Without it the profile has no
+    /// markers (ball presses carry none).
+    #[arg(long)]
+    pub markers: Option<PathBuf>,
+    /// Fit no glow (light scattered in the gel round a contact): the table alone.
+    #[arg(long)]
+    pub no_glow: bool,
+    /// Contact model that rebuilds the presses the glow is fitted to.
+    #[arg(long, default_value = "layer")]
+    pub fidelity: Fidelity,
+}
+
+/// The glow's blurs (pixels): colour changes spread over 3-27 px, and a wider brightening
+/// that follows the change's magnitude (chosen on the FOTS presses, docs/sensor_profile.md).
+const GLOW_COLOUR_SIGMAS_PX: [f32; 4] = [0.0, 3.0, 9.0, 27.0];
+const GLOW_MAGNITUDE_SIGMAS_PX: [f32; 3] = [9.0, 27.0, 81.0];
+
+/// The glow that maps the twin's renders of the presses onto the real frames: each press
+/// rebuilt and shaded without glow, its change from the flat gel's shading fitted to the
+/// real frame's, over the box of four contact radii.
+fn fit_glow(
+    profile: &SensorProfile,
+    presses: &[(BallPress, RgbImage)],
+    ball_radius_mm: f64,
+    fidelity: Fidelity,
+) -> Result<GelGlow> {
+    let optics = SensorOptics {
+        noise_sigma: 0.0,
+        glow: None,
+        ..SensorOptics::for_profile(profile)
+    };
+    let (w, h) = (optics.width, optics.height);
+    let mut solver = ContactSolver::new();
+    let mut changes = Vec::new();
+    for (press, real) in presses {
+        let (_, _, fields, _) = rebuild(
+            &mut solver,
+            press,
+            ball_radius_mm,
+            &profile.spec.gel,
+            &optics,
+            fidelity,
+        )?;
+        let (flat, change) = CpuRenderer.shading_change(&optics, &fields);
+        let target: Vec<[f32; 3]> = real
+            .pixels()
+            .zip(&flat)
+            .map(|(p, f)| std::array::from_fn(|c| f32::from(p[c]) - f[c]))
+            .collect();
+        changes.push((change, target, contact_box(press, w, h)));
+    }
+    let fitted: Vec<GlowPress> = changes
+        .iter()
+        .map(|(change, target, window)| GlowPress {
+            change,
+            target,
+            window: *window,
+        })
+        .collect();
+    GelGlow::fit(
+        &fitted,
+        w as usize,
+        h as usize,
+        &GLOW_COLOUR_SIGMAS_PX,
+        &GLOW_MAGNITUDE_SIGMAS_PX,
+    )
+    .context("fitting the glow")
+}
+
+/// The marker grid of a real marker frame, in the profile's orientation (a frame turned a
+/// quarter has its columns and rows swapped), and its dots' darkness.
+fn read_markers(
+    path: &std::path::Path,
+    (w, h): (u32, u32),
+    mm_per_px: f64,
+) -> Result<(tactex_core::tactile_spec::MarkerGrid, f64)> {
+    let frame = crate::app::load_rgb(path)?;
+    let turned = match frame.dimensions() {
+        d if d == (w, h) => false,
+        d if d == (h, w) => true,
+        (fw, fh) => bail!(
+            "--markers {}: {fw} x {fh} px; the background is {w} x {h} (or turned, {h} x {w})",
+            path.display()
+        ),
+    };
+    let layout = tactex_core::perception::marker_grid::read_marker_grid(&frame)
+        .map_err(|e| anyhow::anyhow!("--markers {}: {e}", path.display()))?;
+    let (cols, rows) = if turned {
+        (layout.rows, layout.cols)
+    } else {
+        (layout.cols, layout.rows)
+    };
+    Ok((
+        tactex_core::tactile_spec::MarkerGrid {
+            cols,
+            rows,
+            pitch_mm: layout.pitch_px * mm_per_px,
+            radius_mm: layout.radius_px * mm_per_px,
+        },
+        layout.darkness,
+    ))
+}
+
+pub fn run(args: &CalibrateArgs) -> Result<()> {
+    let (radius, scale) = (args.ball_radius_mm, args.mm_per_px);
+    let background = crate::app::load_rgb(&args.background)?;
+    // Before the fit: a marker frame that cannot be read fails first.
+    let markers = match &args.markers {
+        Some(path) => Some((path, read_markers(path, background.dimensions(), scale)?)),
+        None => None,
+    };
+    let presses = ball_presses::load(
+        &args.images,
+        &args.annotations,
+        args.split,
+        background.dimensions(),
+    )?;
+    let rule = SampleRule::default();
+    let mut samples = Vec::new();
+    let mut noise = Vec::new();
+    for (press, img) in &presses {
+        if press.contact_radius_px * scale >= radius {
+            bail!(
+                "{}: {} has a contact radius of {:.2} mm, not smaller than the ball's {radius} mm",
+                args.annotations.display(),
+                press.image,
+                press.contact_radius_px * scale
+            );
+        }
+        samples.extend(samples_from_ball_press(
+            img,
+            &background,
+            press,
+            radius,
+            scale,
+            &rule,
+        ));
+        noise.extend(camera_noise_sigma(img, &background, press, &rule));
+    }
+    let table = ShadingTable::fit(
+        &samples,
+        args.mag_bins,
+        args.dir_bins,
+        args.mag_max as f32,
+        args.smoothness,
+    )
+    .context("fitting the shading table")?;
+    let mut sq = [0.0f64; 3];
+    for s in &samples {
+        let got = table.change(s.gx, s.gy, s.u, s.v);
+        for c in 0..3 {
+            sq[c] += ((got[c] - s.change[c]) as f64).powi(2);
+        }
+    }
+    let rms = sq.map(|v| (v / samples.len() as f64).sqrt());
+    // The presses' flat gel drifts from the recorded background (the same smooth change in
+    // every press: the table's zero-slope value); the profile's background is the flat gel
+    // as the presses saw it, so that its no-contact frame is its background.
+    let (w, h) = background.dimensions();
+    let flat_gel = image::RgbImage::from_fn(w, h, |x, y| {
+        let (u, v) = frame_position(x, y, w, h);
+        let drift = table.flat_change(u, v);
+        let b = background.get_pixel(x, y);
+        image::Rgb(std::array::from_fn(|c| {
+            (f32::from(b[c]) + drift[c]).round().clamp(0.0, 255.0) as u8
+        }))
+    });
+    let table = table.split_flat();
+    let stock = SensorProfile::gelsight_mini();
+    let gel = GelSpec {
+        modulus_mpa: args.gel_modulus_mpa.unwrap_or(stock.spec.gel.modulus_mpa),
+        poisson: args.gel_poisson.unwrap_or(stock.spec.gel.poisson),
+        thickness_mm: args.gel_thickness_mm.unwrap_or(stock.spec.gel.thickness_mm),
+    };
+    let frame_rate_hz = args.frame_rate_hz.unwrap_or(stock.spec.frame_rate_hz);
+    let name = match &args.name {
+        Some(n) => n.clone(),
+        None => args
+            .out
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "calibrated sensor".into()),
+    };
+    let noise_sigma_grey = median(&mut noise).unwrap_or(0.0);
+    let (grid, marker_darkness) = match markers {
+        Some((path, (grid, darkness))) => {
+            println!(
+                "{}: markers {} x {}, pitch {:.3} mm, dot radius {:.3} mm, darkness {:.2}",
+                path.display(),
+                grid.cols,
+                grid.rows,
+                grid.pitch_mm,
+                grid.radius_mm,
+                darkness
+            );
+            (grid, darkness)
+        }
+        // The ball presses carry no markers: a profile without a marker grid.
+        None => (
+            tactex_core::tactile_spec::MarkerGrid {
+                cols: 0,
+                rows: 0,
+                ..stock.spec.markers
+            },
+            stock.marker_darkness,
+        ),
+    };
+    let mut profile = SensorProfile {
+        source: args.source.clone(),
+        spec: TactileSpec {
+            model: name,
+            width_px: w,
+            height_px: h,
+            mm_per_px: scale,
+            gel,
+            markers: grid,
+            frame_rate_hz,
+            table: Some(table),
+            ..stock.spec.clone()
+        },
+        background: Some(flat_gel),
+        noise_sigma_grey,
+        // The real background carries the sensor's vignetting.
+        vignette: 0.0,
+        // The presses' own exposure: the background was taken at it.
+        exposure: 1.0,
+        marker_darkness,
+        glow: None,
+        fit: Some(CalibrationFit {
+            images: presses.iter().map(|(p, _)| p.image.clone()).collect(),
+            samples: samples.len(),
+            rms_grey: rms,
+            ball_radius_mm: radius,
+        }),
+    };
+    if !args.no_glow {
+        profile.glow = Some(fit_glow(&profile, &presses, radius, args.fidelity)?);
+    }
+    profile
+        .validate()
+        .map_err(|(field, message)| anyhow::anyhow!("the fitted profile: {field}: {message}"))?;
+    write_profile_atomic(&args.out, &profile)?;
+    println!(
+        "{}: fitted {} x {} bins to {} pixels of {} presses; rms residual R {:.2} G {:.2} B {:.2} grey levels",
+        args.out.display(),
+        args.mag_bins,
+        args.dir_bins,
+        samples.len(),
+        presses.len(),
+        rms[0],
+        rms[1],
+        rms[2]
+    );
+    println!(
+        "camera noise {noise_sigma_grey:.2} grey levels (1 sigma); profile {}",
+        profile.id()
+    );
+    Ok(())
+}

@@ -1,0 +1,363 @@
+//! `tactex compare`: sim-to-real on annotated ball presses (a recorded session's presses:
+//! `compare_session`). Each press is rebuilt in the twin
+//! (the ball at the annotated centre, pressed until the contact solver's contact radius is the
+//! annotated one, since the depth was not recorded), rendered through the calibration, and
+//! scored against the real frame: SSIM (grey, 7x7 uniform window, data range 255, as
+//! scikit-image) and mean absolute intensity error, over the whole frame and over the contact
+//! (a box of four contact radii around it), next to the score of the bare background. The
+//! contact circle is estimated on the real frame and on the rendered one and scored against
+//! the marked circle.
+
+use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic};
+use crate::report::side_by_side::side_by_side;
+use crate::sim2real::ball_presses::{self, Split, contact_box, rebuild};
+use crate::sim2real::compare_session::SessionCompare;
+use crate::sim2real::contact_circle_score::{CircleScore, CircleSummary, score_circle, summarise};
+use anyhow::{Result, bail};
+use clap::Args;
+use image::RgbImage;
+use serde::Serialize;
+use std::path::PathBuf;
+use tactex_core::ball_calibration::BallPress;
+use tactex_core::perception::ssim::{gray, ssim};
+use tactex_sim::elastic::{ContactSolver, Fidelity};
+use tactex_sim::gel_render::{
+    DeviceChoice, GelImageFields, PressFrame, SensorOptics, open_renderer,
+};
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// Sensor profile: for ball presses, the calibrated one (`tactex calibrate`) whose
+    /// background and table render the rebuilt presses; with --session, the twin's sensor
+    /// (default the built-in GelSight Mini).
+    #[arg(long, required_unless_present = "session")]
+    pub sensor: Option<PathBuf>,
+    /// Folder of the real ball-press frames.
+    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    pub images: Option<PathBuf>,
+    /// CSV of the annotated contact circles.
+    #[arg(long, required_unless_present = "session", conflicts_with = "session")]
+    pub annotations: Option<PathBuf>,
+    /// Instead of ball presses: a recorded session (`ask --record`), every press rebuilt in
+    /// the twin and scored recorded against rebuilt.
+    #[arg(long)]
+    pub session: Option<PathBuf>,
+    /// With --session: the objects as they stood, for a session that carries no scene (one
+    /// recorded on real devices).
+    #[arg(long, conflicts_with_all = ["images", "annotations"])]
+    pub scene: Option<PathBuf>,
+    /// With --session: the twin's seed (default: the session's).
+    #[arg(long, conflicts_with_all = ["images", "annotations"])]
+    pub seed: Option<u64>,
+    /// With --session: the twin's gel modulus (MPa) instead of the stock 0.3.
+    #[arg(long, conflicts_with_all = ["images", "annotations"])]
+    pub gel_modulus_mpa: Option<f64>,
+    /// Which presses to score: eval (every third, held out of calibration), calib, or all.
+    /// With --session: the hardness estimator that reads both presses (learned,
+    /// indentation, hertz or FILE.onnx).
+    #[arg(long, conflicts_with_all = ["images", "annotations"], default_value = crate::app::DEFAULT_ESTIMATOR)]
+    pub estimator: crate::app::estimator_choice::EstimatorChoice,
+    #[arg(long, value_enum, default_value_t = Split::Eval)]
+    pub split: Split,
+    /// Contact model that rebuilds each press.
+    #[arg(long, default_value = "layer")]
+    pub fidelity: Fidelity,
+    /// Rendering device: auto, gpu or cpu.
+    #[arg(long, default_value = "auto")]
+    pub device: DeviceChoice,
+    /// Render without the profile's glow (light scattered in the gel), to see what it adds.
+    #[arg(long, conflicts_with = "session")]
+    pub no_glow: bool,
+    /// Write real | rendered | difference images per press here.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Serialize, Debug, Clone, Copy, Default)]
+pub struct Scores {
+    pub ssim: f64,
+    pub mae: f64,
+    pub ssim_contact: f64,
+    pub mae_contact: f64,
+}
+
+#[derive(Serialize, Debug)]
+pub struct PressComparison {
+    pub image: String,
+    pub contact_radius_px: f64,
+    /// Travel past first touch that gives the annotated contact radius.
+    pub depth_mm: f64,
+    pub force_n: f64,
+    pub rendered: Scores,
+    /// The bare no-contact frame scored the same way: what rendering the press adds.
+    pub background_only: Scores,
+    /// The contact circle estimated on the real frame (against the calibration's no-contact
+    /// frame) and on the rendered one (against the rendered no-contact frame).
+    pub circle_real: Option<CircleScore>,
+    pub circle_rendered: Option<CircleScore>,
+    pub warnings: Vec<String>,
+}
+
+#[derive(Serialize, Debug)]
+pub struct CompareReport {
+    /// The calibrated profile the presses were rendered through.
+    pub sensor: tactex_core::sensor_profile::ProfileId,
+    pub split: String,
+    pub fidelity: String,
+    /// Whether the presses were rendered with the profile's glow.
+    pub glow: bool,
+    pub device: String,
+    pub presses: Vec<PressComparison>,
+    pub mean: Scores,
+    pub background_only_mean: Scores,
+    pub circle_real: CircleSummary,
+    pub circle_rendered: CircleSummary,
+}
+
+/// Mean absolute difference over all channels (grey levels).
+fn mae(a: &RgbImage, b: &RgbImage, window: [u32; 4]) -> f64 {
+    let [x0, y0, x1, y1] = window;
+    let mut sum = 0.0;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
+            sum += (0..3).map(|c| p[c].abs_diff(q[c]) as f64).sum::<f64>();
+        }
+    }
+    sum / (3 * (x1 - x0) * (y1 - y0)) as f64
+}
+
+fn ssim_in(a: &RgbImage, b: &RgbImage, window: [u32; 4]) -> f64 {
+    let [x0, y0, x1, y1] = window;
+    let w = a.width() as usize;
+    let crop = |g: &[f64]| -> Vec<f64> {
+        (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .map(|(x, y)| g[y as usize * w + x as usize])
+            .collect()
+    };
+    let (ga, gb) = (crop(&gray(a)), crop(&gray(b)));
+    ssim(&ga, &gb, (x1 - x0) as usize, (y1 - y0) as usize, 255.0).unwrap_or(f64::NAN)
+}
+
+fn scores(real: &RgbImage, rendered: &RgbImage, press: &BallPress) -> Scores {
+    let (w, h) = real.dimensions();
+    let full = [0, 0, w, h];
+    let contact = contact_box(press, w, h);
+    Scores {
+        ssim: ssim_in(real, rendered, full),
+        mae: mae(real, rendered, full),
+        ssim_contact: ssim_in(real, rendered, contact),
+        mae_contact: mae(real, rendered, contact),
+    }
+}
+
+fn mean(all: impl Iterator<Item = Scores>) -> Scores {
+    let v: Vec<Scores> = all.collect();
+    let n = v.len().max(1) as f64;
+    Scores {
+        ssim: v.iter().map(|s| s.ssim).sum::<f64>() / n,
+        mae: v.iter().map(|s| s.mae).sum::<f64>() / n,
+        ssim_contact: v.iter().map(|s| s.ssim_contact).sum::<f64>() / n,
+        mae_contact: v.iter().map(|s| s.mae_contact).sum::<f64>() / n,
+    }
+}
+
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let (Some(profile_path), Some(images), Some(annotations)) =
+        (&args.sensor, &args.images, &args.annotations)
+    else {
+        let Some(session) = &args.session else {
+            bail!("compare: needs --sensor, --images and --annotations, or --session DIR");
+        };
+        return crate::sim2real::compare_session::run(&SessionCompare {
+            session,
+            scene: args.scene.as_deref(),
+            seed: args.seed,
+            gel_modulus_mpa: args.gel_modulus_mpa,
+            sensor: args.sensor.as_deref(),
+            fidelity: args.fidelity,
+            estimator: &args.estimator,
+            out: args.out.as_deref(),
+            json: args.json,
+        });
+    };
+    let profile = crate::app::load_sensor(Some(profile_path))?;
+    let (Some(real_background), Some(fit)) = (&profile.background, &profile.fit) else {
+        bail!(
+            "--sensor {}: not a calibrated profile (no background frame or no ball-press fit); `tactex calibrate` writes one",
+            profile_path.display()
+        );
+    };
+    // The rebuilt presses are compared with single real frames: no added camera noise; and
+    // ball presses are taken on a gel without marker dots, as `calibrate` reads them, even
+    // when the profile has the sensor's grid from a marker frame.
+    let mut optics = SensorOptics {
+        noise_sigma: 0.0,
+        markers: Vec::new(),
+        ..SensorOptics::for_profile(&profile)
+    };
+    if args.no_glow {
+        optics.glow = None;
+    }
+    let spec = &profile.spec;
+    let presses = ball_presses::load(
+        images,
+        annotations,
+        args.split,
+        (spec.width_px, spec.height_px),
+    )?;
+    let choice = open_renderer(args.device)?;
+    if let Some(note) = &choice.note {
+        eprintln!("note: {note}");
+    }
+    let mut renderer = choice.renderer;
+    let mut solver = ContactSolver::new();
+    let mut rebuilt = Vec::new();
+    for (press, _) in &presses {
+        rebuilt.push(rebuild(
+            &mut solver,
+            press,
+            fit.ball_radius_mm,
+            &spec.gel,
+            &optics,
+            args.fidelity,
+        )?);
+    }
+    let flat = GelImageFields::flat(optics.width, optics.height);
+    let mut frames: Vec<PressFrame> = rebuilt
+        .iter()
+        .map(|(_, _, fields, _)| PressFrame { fields, seed: 0 })
+        .collect();
+    frames.push(PressFrame {
+        fields: &flat,
+        seed: 0,
+    });
+    let mut images = renderer.render_batch(&optics, &frames)?;
+    let background = images.pop().expect("the flat frame was rendered last");
+    let out_dir = args
+        .out
+        .as_deref()
+        .map(|dir| OutputDir::create("--out", dir))
+        .transpose()?;
+    let mut out = Vec::new();
+    for (((press, real), (depth, force, _, warnings)), rendered) in
+        presses.iter().zip(&rebuilt).zip(&images)
+    {
+        if let Some(dir) = &out_dir {
+            write_png_atomic(
+                &dir.path().join(&press.image),
+                &side_by_side(real, rendered),
+            )?;
+        }
+        out.push(PressComparison {
+            image: press.image.clone(),
+            contact_radius_px: press.contact_radius_px,
+            depth_mm: *depth,
+            force_n: *force,
+            rendered: scores(real, rendered, press),
+            background_only: scores(real, &background, press),
+            circle_real: score_circle(real, real_background, press),
+            circle_rendered: score_circle(rendered, &background, press),
+            warnings: warnings.clone(),
+        });
+    }
+    let report = CompareReport {
+        sensor: profile.id(),
+        split: format!("{:?}", args.split).to_lowercase(),
+        fidelity: args.fidelity.name().into(),
+        glow: optics.glow.is_some(),
+        device: renderer.name(),
+        mean: mean(out.iter().map(|p| p.rendered)),
+        background_only_mean: mean(out.iter().map(|p| p.background_only)),
+        circle_real: summarise(out.iter().map(|p| &p.circle_real)),
+        circle_rendered: summarise(out.iter().map(|p| &p.circle_rendered)),
+        presses: out,
+    };
+    if let Some(dir) = out_dir {
+        write_json_atomic(&dir.path().join("compare.json"), &report)?;
+        dir.finish()?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    println!(
+        "{:<10} {:>6} {:>9} {:>8} | {:>6} {:>6} {:>8} {:>8} | background only: {:>6} {:>6} {:>8} {:>8}",
+        "image",
+        "a (px)",
+        "depth mm",
+        "force N",
+        "SSIM",
+        "MAE",
+        "SSIM(c)",
+        "MAE(c)",
+        "SSIM",
+        "MAE",
+        "SSIM(c)",
+        "MAE(c)"
+    );
+    let line = |name: &str, a: String, d: String, f: String, r: &Scores, b: &Scores| {
+        println!(
+            "{name:<10} {a:>6} {d:>9} {f:>8} | {:>6.3} {:>6.2} {:>8.3} {:>8.2} |                   {:>6.3} {:>6.2} {:>8.3} {:>8.2}",
+            r.ssim,
+            r.mae,
+            r.ssim_contact,
+            r.mae_contact,
+            b.ssim,
+            b.mae,
+            b.ssim_contact,
+            b.mae_contact
+        )
+    };
+    for p in &report.presses {
+        line(
+            &p.image,
+            format!("{:.0}", p.contact_radius_px),
+            format!("{:.3}", p.depth_mm),
+            format!("{:.2}", p.force_n),
+            &p.rendered,
+            &p.background_only,
+        );
+        for w in &p.warnings {
+            println!("    warning: {w}");
+        }
+    }
+    line(
+        "mean",
+        String::new(),
+        String::new(),
+        String::new(),
+        &report.mean,
+        &report.background_only_mean,
+    );
+    println!(
+        "{} presses ({} split), {} contact, {}, rendered on {}; (c): the box of 4 contact radii around the press",
+        report.presses.len(),
+        report.split,
+        report.fidelity,
+        if report.glow {
+            "with the profile's glow"
+        } else {
+            "no glow"
+        },
+        report.device
+    );
+    for (frames, c) in [
+        ("real", &report.circle_real),
+        ("rendered", &report.circle_rendered),
+    ] {
+        println!(
+            "contact circle on the {frames} frames vs the marked one: found {}/{}, centre error median {:.1} px, radius error median {:+.1} px, mean |error| {:.1} px",
+            c.found,
+            c.presses,
+            c.centre_error_median_px,
+            c.radius_error_median_px,
+            c.radius_error_mean_abs_px
+        );
+    }
+    Ok(())
+}
