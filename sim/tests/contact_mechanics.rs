@@ -138,7 +138,7 @@ fn halfspace_sphere_matches_sneddon_and_hertz_at_the_default_grid() {
             }
         }
     }
-    // Shown with --nocapture: the figures quoted in the README.
+    // Shown with --nocapture: the figures quoted in docs/contact-mechanics.md.
     println!(
         "halfspace vs Sneddon, worst over the matrix: force {:.3}%, contact radius {:.3}%",
         100.0 * worst_force,

@@ -60,7 +60,7 @@ pub struct TwinOptions {
 }
 
 /// The estimator `ask`, `serve`, `compare --session` and `eval scenarios` use unless told:
-/// chosen by the per-kind evaluation on the twin's scene fruit (README, "Hardness").
+/// chosen by the per-kind evaluation on the twin's scene fruit (docs/performance.md).
 pub const DEFAULT_ESTIMATOR: &str = "indentation";
 
 /// What `TwinOptions` name, opened once: a YOLO model is loaded, a GPU adapter found, an

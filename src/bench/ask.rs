@@ -6,7 +6,8 @@
 
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::app::{Twin, load_sensor};
-use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
+use crate::report::output::{OutputDir, write_json_atomic};
+use crate::report::provenance::write_markdown_report;
 use crate::report::summary::median;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -169,7 +170,7 @@ pub fn run(args: &AskBenchArgs) -> Result<()> {
     if let Some(out) = &args.out {
         let out = OutputDir::create("--out", out)?;
         let dir = out.path();
-        write_bytes_atomic(&dir.join("ask_bench.md"), markdown(&report).as_bytes())?;
+        write_markdown_report(&dir.join("ask_bench.md"), &markdown(&report))?;
         write_json_atomic(&dir.join("ask_bench.json"), &report)?;
         out.finish()?;
     }

@@ -6,6 +6,7 @@
 
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::report::plot;
+use crate::report::provenance::write_markdown_report;
 use crate::report::summary::median;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -338,7 +339,7 @@ pub fn run(args: &ContactBenchArgs) -> Result<()> {
         let out = OutputDir::create("--out", out)?;
         let dir = out.path();
         write_bytes_atomic(&dir.join("contact_bench.csv"), csv(&rows).as_bytes())?;
-        write_bytes_atomic(&dir.join("contact_bench.md"), markdown(&rows).as_bytes())?;
+        write_markdown_report(&dir.join("contact_bench.md"), &markdown(&rows))?;
         write_json_atomic(&dir.join("contact_bench.json"), &rows)?;
         let points: Vec<plot::ParetoPoint> = rows
             .iter()

@@ -5,6 +5,7 @@
 //! the shading alone are timed on their own too.
 
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
+use crate::report::provenance::write_markdown_report;
 use crate::report::summary::median;
 use anyhow::Result;
 use clap::Args;
@@ -205,7 +206,7 @@ pub fn run(args: &RenderBenchArgs) -> Result<()> {
         let out = OutputDir::create("--out", out)?;
         let dir = out.path();
         write_bytes_atomic(&dir.join("render_bench.csv"), csv(&report).as_bytes())?;
-        write_bytes_atomic(&dir.join("render_bench.md"), markdown(&report).as_bytes())?;
+        write_markdown_report(&dir.join("render_bench.md"), &markdown(&report))?;
         write_json_atomic(&dir.join("render_bench.json"), &report)?;
         out.finish()?;
     }

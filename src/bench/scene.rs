@@ -3,7 +3,8 @@
 //! (colour, depth, instance ids), and the per-frame noise (colour and D435 depth) that every
 //! captured frame adds on the CPU. Medians of `--reps` runs, all rows measured in one run.
 
-use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
+use crate::report::output::{OutputDir, write_json_atomic};
+use crate::report::provenance::write_markdown_report;
 use crate::report::summary::median;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -130,7 +131,7 @@ pub fn run(args: &SceneBenchArgs) -> Result<()> {
     if let Some(out) = &args.out {
         let out = OutputDir::create("--out", out)?;
         let dir = out.path();
-        write_bytes_atomic(&dir.join("scene_bench.md"), markdown(&report).as_bytes())?;
+        write_markdown_report(&dir.join("scene_bench.md"), &markdown(&report))?;
         write_json_atomic(&dir.join("scene_bench.json"), &report)?;
         out.finish()?;
     }

@@ -18,8 +18,9 @@
 
 use crate::app::explainer_choice::{ExplainerChoice, explainer};
 use crate::eval::scenarios::others;
-use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
+use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::plot::{self, BarSeries};
+use crate::report::provenance::write_markdown_report;
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -651,7 +652,7 @@ pub fn run(args: &ExplanationEvalArgs) -> Result<()> {
         let dir = out.path();
         write_json_atomic(&dir.join("results.json"), &report)?;
         write_json_atomic(&dir.join("cases.json"), &scores)?;
-        write_bytes_atomic(&dir.join("table.md"), table.as_bytes())?;
+        write_markdown_report(&dir.join("table.md"), &table)?;
         let names: Vec<String> = report
             .categories
             .iter()

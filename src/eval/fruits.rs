@@ -18,6 +18,7 @@ use crate::app::{Twin, TwinAnswer};
 use crate::eval::scenarios::match_reports;
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::report::plot::{self, BarSeries, ScatterSeries};
+use crate::report::provenance::write_markdown_report;
 use anyhow::{Context, Result, bail, ensure};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -682,7 +683,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
             write_bytes_atomic(&file, t.scene.to_toml().as_bytes())?;
         }
         write_json_atomic(&dir.join("results.json"), &report)?;
-        write_bytes_atomic(&dir.join("table.md"), markdown(&report).as_bytes())?;
+        write_markdown_report(&dir.join("table.md"), &markdown(&report))?;
         plots(dir, &report, &rows)?;
         out.finish()?;
     }

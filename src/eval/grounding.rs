@@ -8,8 +8,9 @@
 
 use crate::app::detector_choice::{DetectorChoice, GroundTruth};
 use crate::eval::PAPER_FRUIT_KINDS;
-use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
+use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::plot::{self, StageGroup};
+use crate::report::provenance::write_markdown_report;
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::DVec3;
@@ -443,7 +444,7 @@ pub fn run(args: &GroundingEvalArgs) -> Result<()> {
         let out = OutputDir::create("--out", out)?;
         let dir = out.path();
         write_json_atomic(&dir.join("results.json"), &report)?;
-        write_bytes_atomic(&dir.join("table.md"), md.as_bytes())?;
+        write_markdown_report(&dir.join("table.md"), &md)?;
         let groups = |f: fn(&Trial) -> Option<f64>, raw: Option<fn(&Trial) -> Option<f64>>| {
             let mut g = Vec::new();
             for (name, t) in &report.trials {

@@ -19,8 +19,9 @@ use crate::app::detector_choice::DetectorChoice;
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::app::{Twin, TwinAnswer};
 use crate::eval::PAPER_FRUIT_KINDS;
-use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
+use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::plot::{self, BarSeries};
+use crate::report::provenance::write_markdown_report;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -648,7 +649,7 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
         let dir = out.path();
         write_json_atomic(&dir.join("runs.json"), &scores)?;
         write_json_atomic(&dir.join("results.json"), &report)?;
-        write_bytes_atomic(&dir.join("table.md"), markdown(&report).as_bytes())?;
+        write_markdown_report(&dir.join("table.md"), &markdown(&report))?;
         plots(dir, &report)?;
         out.finish()?;
     }

@@ -5,5 +5,6 @@ pub mod npz;
 pub mod output;
 pub mod palette;
 pub mod plot;
+pub mod provenance;
 pub mod side_by_side;
 pub mod summary;
