@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 mod cli;
 
 use cli::{json, one_line_error, tactex};
-use tactex_core::perception::markers::grid_pitch_px;
-use tactex_core::perception::ssim::ssim_rgb;
+use tactex_core::tactile::markers::grid_pitch_px;
+use tactex_core::tactile::ssim::ssim_rgb;
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fots")
@@ -408,8 +408,8 @@ fn calibrating_the_twins_own_mini_gives_the_mini_back() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let fitted = tactex_core::sensor_profile::SensorProfile::load(&profile).unwrap();
-    let stock = tactex_core::sensor_profile::SensorProfile::gelsight_mini();
+    let fitted = tactex_core::tactile::sensor_profile::SensorProfile::load(&profile).unwrap();
+    let stock = tactex_core::tactile::sensor_profile::SensorProfile::gelsight_mini();
     let (m, s) = (fitted.spec.markers, stock.spec.markers);
     assert_eq!((m.cols, m.rows), (s.cols, s.rows));
     assert!(

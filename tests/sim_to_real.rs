@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 mod cli;
 
 use cli::{json, tactex};
-use tactex_core::ball_calibration::read_annotations;
-use tactex_core::perception::centroid::median;
-use tactex_core::perception::contact::{ContactRule, contact_evidence};
-use tactex_core::perception::contact_circle::estimate_contact_circle;
+use tactex_core::ground::centroid::median;
+use tactex_core::tactile::ball_calibration::read_annotations;
+use tactex_core::tactile::contact::{ContactRule, contact_evidence};
+use tactex_core::tactile::contact_circle::estimate_contact_circle;
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fots")

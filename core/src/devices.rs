@@ -5,7 +5,7 @@
 
 use crate::frames::{RgbdFrame, TactileFrame};
 use crate::geometry::{CameraIntrinsics, Pose};
-use crate::tactile_spec::TactileSpec;
+use crate::tactile::spec::TactileSpec;
 
 #[derive(Debug, thiserror::Error)]
 pub enum DeviceError {

@@ -1,44 +1,37 @@
 //! tactex-core: everything TactEx needs that does not depend on a backend.
 //!
-//! Types (poses, intrinsics, frames), the device traits that the simulated (`tactex-sim`),
-//! real (`tactex-hw`) and replay backends implement, the fruit catalog and scene format,
-//! Hertz contact theory, perception (detection, mask refinement, centroids, tactile
-//! helpers), hardness estimation, explanation (template, groundedness check, LLM prompt) and
-//! the question pipeline that is generic over the device traits. Nothing in here knows which
-//! backend it runs against,
-//! and nothing here runs a neural network: learned models live in `tactex-learned`.
+//! One folder per pipeline stage: `query` (prompt -> Query), `ground` (RGB-D frames -> the
+//! fruit on the table), `press` (where to press, and the press protocol every backend runs),
+//! `tactile` (the sensor, its profile, and reading its frames), `hardness` (scales and
+//! estimators with measured intervals), `explain` (template, groundedness check, LLM
+//! prompt) and `pipeline` (the stages in order, generic over the device traits); `stats`
+//! holds the tests and intervals the evaluations use. At the root: the device traits
+//! (`devices`) that the simulated (`tactex-sim`), real (`tactex-hw`) and replay backends
+//! implement, frames and geometry, the fruit catalog and scene format, Hertz theory, and the
+//! input and output helpers every crate shares. Nothing in here knows which backend it runs
+//! against, and nothing here runs a neural network: learned models live in `tactex-learned`.
 
 #![forbid(unsafe_code)]
 
-pub mod ball_calibration;
 pub mod catalog;
 pub mod devices;
 pub mod dir_claim;
-pub mod estimate;
 pub mod explain;
 pub mod file_failure;
 pub mod frames;
-pub mod gel_glow;
-pub mod gel_share_fit;
 pub mod geometry;
+pub mod ground;
 pub mod hardness;
 pub mod hertz;
 pub mod image_file;
-pub mod indentation_estimator;
-pub mod interval_calibration;
-pub mod layer_compliance;
-pub mod perception;
-pub mod photometric;
 pub mod pipeline;
 pub mod press;
 pub mod printable;
 pub mod query;
 pub mod scene;
-pub mod sensor_profile;
-pub mod shading_table;
 pub mod spectral;
 pub mod stats;
-pub mod tactile_spec;
+pub mod tactile;
 
 pub use glam;
 pub use image;

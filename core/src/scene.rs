@@ -17,7 +17,7 @@
 
 use crate::catalog::{FruitCatalog, FruitShape};
 use crate::geometry::{CameraIntrinsics, Pose};
-use crate::hardness::Hardness;
+use crate::hardness::scale::Hardness;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

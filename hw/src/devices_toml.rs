@@ -150,7 +150,7 @@ impl DevicesConfig {
     /// The GelSight, its frames read through `profile` (the sensor's calibrated spec).
     pub fn open_tactile(
         &self,
-        profile: tactex_core::tactile_spec::TactileSpec,
+        profile: tactex_core::tactile::spec::TactileSpec,
     ) -> Result<crate::gelsight_mini::GelSightMini, DevicesError> {
         Ok(crate::gelsight_mini::GelSightMini::open(
             &self.tactile.device,

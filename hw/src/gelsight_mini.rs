@@ -92,7 +92,7 @@ pub fn resize_bilinear_like_opencv(src: &RgbImage, width: u32, height: u32) -> R
 #[cfg(all(target_os = "linux", feature = "v4l2"))]
 pub struct GelSightMini {
     capture: crate::v4l2_capture::V4l2Capture,
-    spec: tactex_core::tactile_spec::TactileSpec,
+    spec: tactex_core::tactile::spec::TactileSpec,
     name: String,
     opened: std::time::Instant,
 }
@@ -103,7 +103,7 @@ impl GelSightMini {
     /// frames are read through `profile` (its calibrated table and gel).
     pub fn open(
         spec: &str,
-        profile: tactex_core::tactile_spec::TactileSpec,
+        profile: tactex_core::tactile::spec::TactileSpec,
     ) -> Result<GelSightMini, tactex_core::devices::DeviceError> {
         let capture = crate::v4l2_capture::V4l2Capture::open(
             "gelsight mini",
@@ -128,7 +128,7 @@ impl tactex_core::devices::TactileSensor for GelSightMini {
     fn name(&self) -> &str {
         &self.name
     }
-    fn spec(&self) -> &tactex_core::tactile_spec::TactileSpec {
+    fn spec(&self) -> &tactex_core::tactile::spec::TactileSpec {
         &self.spec
     }
     fn capture(

@@ -7,7 +7,7 @@ use tactex_core::frames::{DepthImage, RgbdFrame, TactileFrame};
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::glam::DVec3;
 use tactex_core::image::{Luma, Rgb, RgbImage};
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::spec::TactileSpec;
 use tactex_hw::session::record::{depth_from_u16, depth_to_u16};
 use tactex_hw::session::{SessionRecorder, open_session};
 

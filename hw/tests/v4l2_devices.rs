@@ -3,7 +3,7 @@
 #![cfg(all(target_os = "linux", feature = "v4l2"))]
 
 use tactex_core::geometry::{CameraIntrinsics, Pose};
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::spec::TactileSpec;
 use tactex_hw::gelsight_mini::GelSightMini;
 use tactex_hw::realsense::RealSense;
 

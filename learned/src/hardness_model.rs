@@ -14,12 +14,12 @@ use ort::value::Tensor;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
-use tactex_core::estimate::{
+use tactex_core::hardness::estimate::{
     EstimateError, Evidence, HardnessEstimate, HardnessEstimator, LearnedEvidence, ModulusInterval,
     PressSequence,
 };
-use tactex_core::hardness::Hardness;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::hardness::scale::Hardness;
+use tactex_core::tactile::spec::TactileSpec;
 
 pub const MODEL_FORMAT: &str = "tactex-hardness-model/1";
 

@@ -13,7 +13,7 @@ use ort::session::Session;
 use ort::value::Tensor;
 use std::path::Path;
 use std::sync::Mutex;
-use tactex_core::perception::detect::{DetectError, Detection, Detector, RgbdView, mask_footprint};
+use tactex_core::ground::detect::{DetectError, Detection, Detector, RgbdView, mask_footprint};
 
 /// Ultralytics' prediction defaults.
 #[derive(Clone, Copy, Debug)]

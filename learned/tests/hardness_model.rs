@@ -4,9 +4,9 @@
 
 use image::{Rgb, RgbImage};
 use std::path::{Path, PathBuf};
-use tactex_core::estimate::{EstimateError, Evidence, HardnessEstimator, PressSequence};
 use tactex_core::frames::TactileFrame;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::hardness::estimate::{EstimateError, Evidence, HardnessEstimator, PressSequence};
+use tactex_core::tactile::spec::TactileSpec;
 use tactex_learned::hardness_model::OnnxEstimator;
 use tactex_learned::runtime::{OnnxBackend, backend};
 

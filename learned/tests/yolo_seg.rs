@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::frames::DepthImage;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
-use tactex_core::perception::detect::{Detector, RgbdView};
+use tactex_core::ground::detect::{Detector, RgbdView};
 use tactex_core::query;
 use tactex_learned::runtime::OnnxError;
 use tactex_learned::yolo_seg::YoloSegDetector;

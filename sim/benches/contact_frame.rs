@@ -10,7 +10,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec2;
 use std::hint::black_box;
 use tactex_core::hertz::Elastic;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::spec::TactileSpec;
 use tactex_sim::elastic::kernels::GridKernels;
 use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
 use tactex_sim::gel_render::{CpuRenderer, PressFrame, SensorOptics, image_fields, pad_rect};

@@ -6,7 +6,7 @@ use crate::pad_contact::{deepest_touch, pad_of};
 use crate::world::SharedWorld;
 use tactex_core::devices::{Arm, DeviceError};
 use tactex_core::geometry::Pose;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::spec::TactileSpec;
 
 pub struct SimArm {
     world: SharedWorld,

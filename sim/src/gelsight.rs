@@ -12,8 +12,8 @@ use crate::world::SharedWorld;
 use tactex_core::devices::{DeviceError, TactileSensor};
 use tactex_core::frames::TactileFrame;
 use tactex_core::hertz::Elastic;
-use tactex_core::sensor_profile::SensorProfile;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::sensor_profile::SensorProfile;
+use tactex_core::tactile::spec::TactileSpec;
 
 pub struct SimGelSight {
     world: SharedWorld,

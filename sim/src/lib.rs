@@ -23,7 +23,7 @@ pub mod world;
 
 use elastic::Fidelity;
 use tactex_core::scene::Scene;
-use tactex_core::sensor_profile::SensorProfile;
+use tactex_core::tactile::sensor_profile::SensorProfile;
 
 /// The three sim devices over one shared world.
 pub struct SimDevices {

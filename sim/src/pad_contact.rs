@@ -10,7 +10,7 @@ use crate::mesh::TriMesh;
 use crate::world::SimWorld;
 use glam::{DQuat, DVec2, DVec3};
 use tactex_core::geometry::Pose;
-use tactex_core::tactile_spec::{GelSpec, TactileSpec};
+use tactex_core::tactile::spec::{GelSpec, TactileSpec};
 
 /// A press's frames share one solver grid, planned at its first contact for this much more
 /// approach: the paper's search rarely runs past 2 mm beyond first touch and its 8 frames

@@ -11,8 +11,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use std::sync::Mutex;
-use tactex_core::perception::detect::{DetectError, Detection, Detector, RgbdView};
-use tactex_core::perception::mask::mask_box;
+use tactex_core::ground::detect::{DetectError, Detection, Detector, RgbdView};
+use tactex_core::ground::mask::mask_box;
 
 /// How one detector errs.
 #[derive(Clone, Debug, PartialEq)]

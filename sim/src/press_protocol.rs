@@ -1,4 +1,4 @@
-//! The paper's press protocol (`tactex_core::press`) on the contact solver alone (no world,
+//! The paper's press protocol (`tactex_core::press::protocol`) on the contact solver alone (no world,
 //! no arm): each step of the descent is a contact solve at the step's approach, through the
 //! same per-press grid as the sim GelSight's (`pad_contact::PressGrid`). Data generation and
 //! the hardness evaluations run it directly; the pipeline runs the same protocol through the
@@ -16,12 +16,12 @@ use crate::gel_render::{
 };
 use crate::pad_contact::{PressGrid, Spot};
 use image::RgbImage;
-use tactex_core::estimate::PressSequence;
 use tactex_core::frames::TactileFrame;
+use tactex_core::hardness::estimate::PressSequence;
 use tactex_core::hertz::Elastic;
-use tactex_core::perception::contact::ContactEvidence;
-use tactex_core::press::{Look, PressOutcome, PressProbe, PressProtocol, run_press};
-use tactex_core::tactile_spec::GelSpec;
+use tactex_core::press::protocol::{Look, PressOutcome, PressProbe, PressProtocol, run_press};
+use tactex_core::tactile::contact::ContactEvidence;
+use tactex_core::tactile::spec::GelSpec;
 
 /// One object under the pad, and the sensor that presses it.
 #[derive(Clone, Copy, Debug)]
@@ -197,8 +197,8 @@ pub fn plan_press(
         step_mm: step,
     };
     let pressed = match run_press(protocol, &mut probe).map_err(|e| match e {
-        tactex_core::press::PressError::Probe(e) => e,
-        tactex_core::press::PressError::Invalid(m) => PressError::Invalid(m),
+        tactex_core::press::protocol::PressError::Probe(e) => e,
+        tactex_core::press::protocol::PressError::Invalid(m) => PressError::Invalid(m),
     })? {
         PressOutcome::Pressed(p) => p,
         PressOutcome::NoContact { travel_mm, .. } => {
@@ -264,7 +264,7 @@ impl PlannedPress {
 mod tests {
     use super::*;
     use glam::DVec2;
-    use tactex_core::tactile_spec::TactileSpec;
+    use tactex_core::tactile::spec::TactileSpec;
 
     fn press(modulus_mpa: Option<f64>, phase_mm: f64) -> PlannedPress {
         let spec = TactileSpec::gelsight_mini();
@@ -331,7 +331,7 @@ mod tests {
                 seed: frame_seed(7, NOISE_FLOOR_FRAME),
             },
         );
-        let test = tactex_core::perception::contact::ContactTest::with_noise_floor(
+        let test = tactex_core::tactile::contact::ContactTest::with_noise_floor(
             &images[0],
             &second,
             &PressProtocol::default().rule,

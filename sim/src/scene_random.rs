@@ -192,7 +192,7 @@ fn draw(
         };
         object.position_m = position_m;
         object.yaw_deg = yaw_deg;
-        object.hardness = tactex_core::hardness::Hardness::ModulusMpa(stage.modulus_mpa);
+        object.hardness = tactex_core::hardness::scale::Hardness::ModulusMpa(stage.modulus_mpa);
         object.ripeness = Some(stage.name.clone());
         object.color = color;
         object.poisson = fruit.poisson;

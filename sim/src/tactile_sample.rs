@@ -16,13 +16,15 @@ use std::fmt;
 use std::str::FromStr;
 use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::hardness::shore_a_to_modulus_mpa;
-use tactex_core::hardness::{modulus_to_shore_00, modulus_to_shore_a, shore_00_to_modulus_mpa};
+use tactex_core::hardness::scale::shore_a_to_modulus_mpa;
+use tactex_core::hardness::scale::{
+    modulus_to_shore_00, modulus_to_shore_a, shore_00_to_modulus_mpa,
+};
 use tactex_core::hertz::Elastic;
-use tactex_core::photometric::PhotometricModel;
-use tactex_core::press::PressProtocol;
-use tactex_core::sensor_profile::SensorProfile;
-use tactex_core::tactile_spec::{GelSpec, TactileSpec};
+use tactex_core::press::protocol::PressProtocol;
+use tactex_core::tactile::photometric::PhotometricModel;
+use tactex_core::tactile::sensor_profile::SensorProfile;
+use tactex_core::tactile::spec::{GelSpec, TactileSpec};
 
 /// The kinds of object a data set draws from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]

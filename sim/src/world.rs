@@ -6,7 +6,7 @@ use glam::{DQuat, DVec3};
 use rapier3d::prelude::*;
 use std::sync::{Arc, Mutex};
 use tactex_core::geometry::{CameraIntrinsics, Pose};
-use tactex_core::hardness::Hardness;
+use tactex_core::hardness::scale::Hardness;
 use tactex_core::scene::{ObjectKind, Scene, Table};
 
 /// One object as the twin simulates it.

@@ -6,7 +6,7 @@
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 use tactex_core::hertz::Elastic;
-use tactex_core::tactile_spec::GelSpec;
+use tactex_core::tactile::spec::GelSpec;
 use tactex_sim::elastic::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, ObjectSurface, Rect,
 };

@@ -3,10 +3,10 @@
 
 use glam::DVec2;
 use image::RgbImage;
-use tactex_core::gel_glow::{ColourGlow, GelGlow, MagnitudeGlow};
 use tactex_core::hertz::Elastic;
-use tactex_core::shading_table::{ShadingSample, ShadingTable};
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::gel_glow::{ColourGlow, GelGlow, MagnitudeGlow};
+use tactex_core::tactile::shading_table::{ShadingSample, ShadingTable};
+use tactex_core::tactile::spec::TactileSpec;
 use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
 use tactex_sim::gel_render::{
     CpuRenderer, DeviceChoice, GelImageFields, GelRenderer, PressFrame, RenderError, SensorOptics,

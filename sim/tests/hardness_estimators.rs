@@ -2,11 +2,11 @@
 //! the full chain (solver, shading, markers, noise).
 
 use glam::DVec2;
-use tactex_core::estimate::{HardnessEstimator, HertzSlopeEstimator};
+use tactex_core::hardness::estimate::{HardnessEstimator, HertzSlopeEstimator};
+use tactex_core::hardness::indentation_estimator::IndentationEstimator;
 use tactex_core::hertz::Elastic;
-use tactex_core::indentation_estimator::IndentationEstimator;
-use tactex_core::press::PressProtocol;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::press::protocol::PressProtocol;
+use tactex_core::tactile::spec::TactileSpec;
 use tactex_sim::elastic::{ContactSolver, Fidelity, ObjectSurface};
 use tactex_sim::gel_render::{CpuRenderer, SensorOptics};
 use tactex_sim::press_protocol::{PressSetup, plan_press};

@@ -4,7 +4,7 @@
 
 use anyhow::{Result, bail};
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::perception::detect::{ClassicalDetector, Detector};
+use tactex_core::ground::detect::{ClassicalDetector, Detector};
 use tactex_learned::yolo_seg::YoloSegDetector;
 use tactex_sim::camera::InstanceImage;
 use tactex_sim::perception_error::{ErrorProfile, PerceptionErrorDetector};

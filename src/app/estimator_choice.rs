@@ -5,9 +5,9 @@
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
-use tactex_core::estimate::{HardnessEstimator, HertzSlopeEstimator};
-use tactex_core::indentation_estimator::IndentationEstimator;
-use tactex_core::interval_calibration::{Calibrated, IntervalCalibration};
+use tactex_core::hardness::estimate::{HardnessEstimator, HertzSlopeEstimator};
+use tactex_core::hardness::indentation_estimator::IndentationEstimator;
+use tactex_core::hardness::interval_calibration::{Calibrated, IntervalCalibration};
 
 /// A hardness estimator by name, or a trained model file.
 #[derive(Clone, Debug, PartialEq)]

@@ -255,7 +255,7 @@ mod tests {
     use std::net::TcpListener;
     use std::sync::{Arc, Mutex};
     use tactex_core::explain::{Measured, location_words, select};
-    use tactex_core::hardness::Hardness;
+    use tactex_core::hardness::scale::Hardness;
 
     /// How the fake endpoint behaves.
     #[derive(Clone)]

@@ -6,7 +6,7 @@ use crate::app::twin_options::TwinOptions;
 use anyhow::{Result, bail};
 use std::path::Path;
 use tactex_core::pipeline::{Answer, PipelineConfig};
-use tactex_core::sensor_profile::SensorProfile;
+use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_hw::devices_toml::DevicesConfig;
 #[cfg(all(target_os = "linux", feature = "v4l2"))]
 use {

@@ -4,9 +4,9 @@ use anyhow::{Context, Result};
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::{Arm, RgbdCamera, TactileSensor};
-use tactex_core::estimate::HardnessEstimator;
 use tactex_core::explain::Explainer;
-use tactex_core::perception::detect::Detector;
+use tactex_core::ground::detect::Detector;
+use tactex_core::hardness::estimate::HardnessEstimator;
 use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
 use tactex_hw::session::{SessionRecorder, TwinRecord};
 use tactex_sim::elastic::Fidelity;
@@ -30,7 +30,7 @@ pub struct Question<'q> {
     /// The sim GelSight's contact physics, when the devices are the twin's.
     pub fidelity: Option<Fidelity>,
     /// The tactile sensor's profile, when one is known.
-    pub sensor: Option<tactex_core::sensor_profile::ProfileId>,
+    pub sensor: Option<tactex_core::tactile::sensor_profile::ProfileId>,
 }
 
 impl Question<'_> {

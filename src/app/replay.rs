@@ -6,7 +6,7 @@ use crate::app::twin_options::OpenedTwin;
 use anyhow::{Context, Result, bail};
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::perception::detect::Detector;
+use tactex_core::ground::detect::Detector;
 use tactex_core::pipeline::{Answer, Devices, PipelineConfig};
 use tactex_hw::session::open_session;
 

@@ -2,7 +2,7 @@
 
 use anyhow::{Result, bail};
 use std::path::Path;
-use tactex_core::sensor_profile::SensorProfile;
+use tactex_core::tactile::sensor_profile::SensorProfile;
 
 /// The profile at `path` (`--sensor`), or the built-in GelSight Mini.
 pub fn load_sensor(path: Option<&Path>) -> Result<SensorProfile> {

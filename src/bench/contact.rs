@@ -16,7 +16,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
 use tactex_core::hertz::{Elastic, Hertz, contact_modulus_mpa, gel_share};
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::spec::TactileSpec;
 use tactex_sim::elastic::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
 };

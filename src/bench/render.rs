@@ -58,7 +58,7 @@ pub struct RenderRow {
 #[derive(Serialize)]
 pub struct RenderBench {
     /// The sensor rendered.
-    pub sensor: tactex_core::sensor_profile::ProfileId,
+    pub sensor: tactex_core::tactile::sensor_profile::ProfileId,
     pub width: u32,
     pub height: u32,
     pub rows: Vec<RenderRow>,

@@ -186,7 +186,7 @@ fn print_answer(a: &Answer) {
         for w in &o.warnings {
             println!("    warning: {w}");
         }
-        if let Some(tactex_core::estimate::Evidence::Learned(l)) = &o.evidence
+        if let Some(tactex_core::hardness::estimate::Evidence::Learned(l)) = &o.evidence
             && let Some(note) = &l.other_sensor
         {
             println!("    note: {note}");

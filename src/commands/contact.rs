@@ -7,8 +7,8 @@ use anyhow::{Result, bail};
 use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
-use tactex_core::perception::contact::{ContactEvidence, ContactRule, contact_evidence};
-use tactex_core::perception::contact_circle::{ContactCircle, estimate_contact_circle};
+use tactex_core::tactile::contact::{ContactEvidence, ContactRule, contact_evidence};
+use tactex_core::tactile::contact_circle::{ContactCircle, estimate_contact_circle};
 
 #[derive(Args, Debug)]
 pub struct ContactArgs {

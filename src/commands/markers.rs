@@ -8,7 +8,7 @@ use anyhow::{Result, bail};
 use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
-use tactex_core::perception::markers::{
+use tactex_core::tactile::markers::{
     detect_markers, grid_pitch_px, mean_moved_displacement, track,
 };
 

@@ -8,7 +8,7 @@ use clap::{Args, ValueEnum};
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 use std::path::PathBuf;
-use tactex_core::hardness::Hardness;
+use tactex_core::hardness::scale::Hardness;
 use tactex_core::hertz::Elastic;
 use tactex_sim::elastic::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
@@ -126,7 +126,7 @@ impl From<&Grid> for GridReport {
 struct PressReport {
     fidelity: String,
     /// The sensor profile (after the gel and marker flags) the press used.
-    sensor: tactex_core::sensor_profile::ProfileId,
+    sensor: tactex_core::tactile::sensor_profile::ProfileId,
     shape: String,
     depth_mm: f64,
     force_n: f64,
@@ -246,7 +246,7 @@ pub fn run(args: &PressArgs) -> Result<()> {
     let mut solver = ContactSolver::new();
     solver.settings.tolerance = args.tolerance;
     let solution = solver.solve(&problem, fidelity)?;
-    let shown = tactex_core::hardness::HardnessReport::from(hardness);
+    let shown = tactex_core::hardness::scale::HardnessReport::from(hardness);
     let report = PressReport {
         fidelity: fidelity.to_string(),
         sensor: profile.id(),

@@ -18,7 +18,7 @@ pub fn check(file: &Path) -> Result<()> {
         scene.table.size_m[1]
     );
     for (o, s) in scene.objects.iter().zip(&world.objects) {
-        let h = tactex_core::hardness::HardnessReport::from(o.hardness);
+        let h = tactex_core::hardness::scale::HardnessReport::from(o.hardness);
         let e = h
             .modulus_mpa
             .map_or("rigid".to_string(), |e| format!("{e:.3} MPa"));

@@ -5,8 +5,8 @@ use anyhow::Result;
 use clap::{Args, Subcommand};
 use serde::Serialize;
 use std::path::PathBuf;
-use tactex_core::perception::ssim::{gray, ssim};
-use tactex_core::sensor_profile::{ProfileId, SensorProfile};
+use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
+use tactex_core::tactile::ssim::{gray, ssim};
 use tactex_sim::gel_render::{CpuRenderer, GelImageFields, PressFrame, SensorOptics};
 
 #[derive(Subcommand)]

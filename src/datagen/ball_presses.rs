@@ -20,7 +20,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::PathBuf;
-use tactex_core::ball_calibration::BallPress;
+use tactex_core::tactile::ball_calibration::BallPress;
 use tactex_sim::elastic::{ContactSolver, Fidelity};
 use tactex_sim::gel_render::{
     DeviceChoice, GelImageFields, PressFrame, SensorOptics, open_renderer,
@@ -91,7 +91,7 @@ struct PressTruth {
 struct Manifest {
     format: &'static str,
     seed: u64,
-    sensor: tactex_core::sensor_profile::ProfileId,
+    sensor: tactex_core::tactile::sensor_profile::ProfileId,
     ball_radius_mm: f64,
     mm_per_px: f64,
     fidelity: String,

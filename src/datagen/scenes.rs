@@ -37,7 +37,7 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
 use tactex_core::dir_claim::LockDir;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
-use tactex_core::perception::mask::mask_box;
+use tactex_core::ground::mask::mask_box;
 use tactex_sim::SimDevices;
 use tactex_sim::camera::{InstanceImage, instance_mask};
 use tactex_sim::render_device::DeviceChoice;

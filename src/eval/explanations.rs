@@ -32,8 +32,8 @@ use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::explain::grounded::{self, numbers_with_units};
 use tactex_core::explain::{Explainer, Explanation, Facts, Measured, location_words, select};
-use tactex_core::hardness::Hardness;
-use tactex_core::perception::colour_name::colour_name;
+use tactex_core::ground::colour_name::colour_name;
+use tactex_core::hardness::scale::Hardness;
 use tactex_core::query;
 use tactex_sim::scene_random::{Variation, random_scene};
 

@@ -29,10 +29,12 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::{FruitCatalog, FruitSpec};
-use tactex_core::estimate::Evidence;
 use tactex_core::explain::TemplateExplainer;
-use tactex_core::hardness::Hardness;
-use tactex_core::interval_calibration::{HeldOutPress, IntervalCalibration, is_elongated};
+use tactex_core::hardness::estimate::Evidence;
+use tactex_core::hardness::interval_calibration::{
+    HeldOutPress, IntervalCalibration, is_elongated,
+};
+use tactex_core::hardness::scale::Hardness;
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
 use tactex_sim::elastic::Fidelity;
@@ -161,7 +163,7 @@ pub struct FruitReport {
     pub estimator: String,
     pub fidelity: String,
     /// The sim GelSight's profile.
-    pub sensor: tactex_core::sensor_profile::ProfileId,
+    pub sensor: tactex_core::tactile::sensor_profile::ProfileId,
     pub intervals: String,
     pub seed: u64,
     pub kinds: Vec<KindResult>,

@@ -12,9 +12,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::estimate::{Evidence, HardnessEstimator, HertzSlopeEstimator};
-use tactex_core::hardness::shore_a_to_modulus_mpa;
-use tactex_core::indentation_estimator::IndentationEstimator;
+use tactex_core::hardness::estimate::{Evidence, HardnessEstimator, HertzSlopeEstimator};
+use tactex_core::hardness::indentation_estimator::IndentationEstimator;
+use tactex_core::hardness::scale::shore_a_to_modulus_mpa;
 use tactex_core::stats::{r_squared, rmse, spearman};
 use tactex_sim::elastic::ContactSolver;
 use tactex_sim::gel_render::CpuRenderer;
@@ -76,7 +76,7 @@ struct HardnessEval {
     shapes: Vec<String>,
     fidelity: String,
     /// The sensor the presses were rendered with and read through.
-    sensor: tactex_core::sensor_profile::ProfileId,
+    sensor: tactex_core::tactile::sensor_profile::ProfileId,
     estimators: Vec<EstimatorScore>,
 }
 
@@ -84,7 +84,7 @@ struct HardnessEval {
 struct Prediction {
     estimator: String,
     shore_a: Option<f64>,
-    interval: Option<tactex_core::estimate::ModulusInterval>,
+    interval: Option<tactex_core::hardness::estimate::ModulusInterval>,
     evidence: Option<Evidence>,
     error: Option<String>,
 }

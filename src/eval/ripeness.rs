@@ -21,8 +21,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::hardness::{modulus_to_shore_00, modulus_to_shore_a};
-use tactex_core::press::PressProtocol;
+use tactex_core::hardness::scale::{modulus_to_shore_00, modulus_to_shore_a};
+use tactex_core::press::protocol::PressProtocol;
 use tactex_core::stats::{
     Alternative, MannWhitneyMethod, holm_bonferroni, mann_whitney_u, quantile,
 };
@@ -102,7 +102,7 @@ struct RipenessEval {
     spot_spread: f64,
     fidelity: String,
     /// The sensor the presses were rendered with and read through.
-    sensor: tactex_core::sensor_profile::ProfileId,
+    sensor: tactex_core::tactile::sensor_profile::ProfileId,
     fruits: Vec<FruitResult>,
 }
 

@@ -666,7 +666,7 @@ mod tests {
     use super::*;
     use tactex_core::devices::RgbdCamera;
     use tactex_core::explain::location_words;
-    use tactex_core::hardness::Hardness;
+    use tactex_core::hardness::scale::Hardness;
     use tactex_core::pipeline::ObjectReport;
     use tactex_sim::SimDevices;
 

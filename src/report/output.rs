@@ -67,9 +67,9 @@ pub fn write_png_atomic(path: &Path, image: &image::RgbImage) -> Result<()> {
 /// file on disk always has its background.
 pub fn write_profile_atomic(
     path: &Path,
-    profile: &tactex_core::sensor_profile::SensorProfile,
+    profile: &tactex_core::tactile::sensor_profile::SensorProfile,
 ) -> Result<()> {
-    use tactex_core::sensor_profile::SensorProfile;
+    use tactex_core::tactile::sensor_profile::SensorProfile;
     let bg = SensorProfile::background_path(path);
     let bg_name = bg
         .file_name()

@@ -5,7 +5,7 @@
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
-use tactex_core::estimate::PressSequence;
+use tactex_core::hardness::estimate::PressSequence;
 use tactex_core::pipeline::{Answer, Progress};
 use tokio::sync::watch;
 

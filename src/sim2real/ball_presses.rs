@@ -9,9 +9,9 @@ use clap::ValueEnum;
 use glam::DVec2;
 use image::RgbImage;
 use std::path::{Path, PathBuf};
-use tactex_core::ball_calibration::{BallPress, read_annotations};
 use tactex_core::hertz::Elastic;
-use tactex_core::tactile_spec::GelSpec;
+use tactex_core::tactile::ball_calibration::{BallPress, read_annotations};
+use tactex_core::tactile::spec::GelSpec;
 use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
 use tactex_sim::gel_render::{
     GelImageFields, SensorOptics, image_fields, pad_rect, pixel_centre_mm,

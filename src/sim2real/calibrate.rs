@@ -9,14 +9,14 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbImage;
 use std::path::PathBuf;
-use tactex_core::ball_calibration::{
+use tactex_core::ground::centroid::median;
+use tactex_core::tactile::ball_calibration::{
     BallPress, SampleRule, camera_noise_sigma, samples_from_ball_press,
 };
-use tactex_core::gel_glow::{GelGlow, GlowPress};
-use tactex_core::perception::centroid::median;
-use tactex_core::sensor_profile::{CalibrationFit, SensorProfile};
-use tactex_core::shading_table::{ShadingTable, frame_position};
-use tactex_core::tactile_spec::{GelSpec, TactileSpec};
+use tactex_core::tactile::gel_glow::{GelGlow, GlowPress};
+use tactex_core::tactile::sensor_profile::{CalibrationFit, SensorProfile};
+use tactex_core::tactile::shading_table::{ShadingTable, frame_position};
+use tactex_core::tactile::spec::{GelSpec, TactileSpec};
 use tactex_sim::elastic::{ContactSolver, Fidelity};
 use tactex_sim::gel_render::{CpuRenderer, SensorOptics};
 
@@ -152,7 +152,7 @@ fn read_markers(
     path: &std::path::Path,
     (w, h): (u32, u32),
     mm_per_px: f64,
-) -> Result<(tactex_core::tactile_spec::MarkerGrid, f64)> {
+) -> Result<(tactex_core::tactile::spec::MarkerGrid, f64)> {
     let frame = crate::app::load_rgb(path)?;
     let turned = match frame.dimensions() {
         d if d == (w, h) => false,
@@ -162,7 +162,7 @@ fn read_markers(
             path.display()
         ),
     };
-    let layout = tactex_core::perception::marker_grid::read_marker_grid(&frame)
+    let layout = tactex_core::tactile::marker_grid::read_marker_grid(&frame)
         .map_err(|e| anyhow::anyhow!("--markers {}: {e}", path.display()))?;
     let (cols, rows) = if turned {
         (layout.rows, layout.cols)
@@ -170,7 +170,7 @@ fn read_markers(
         (layout.cols, layout.rows)
     };
     Ok((
-        tactex_core::tactile_spec::MarkerGrid {
+        tactex_core::tactile::spec::MarkerGrid {
             cols,
             rows,
             pitch_mm: layout.pitch_px * mm_per_px,
@@ -276,7 +276,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         }
         // The ball presses carry no markers: a profile without a marker grid.
         None => (
-            tactex_core::tactile_spec::MarkerGrid {
+            tactex_core::tactile::spec::MarkerGrid {
                 cols: 0,
                 rows: 0,
                 ..stock.spec.markers

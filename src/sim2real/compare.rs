@@ -18,8 +18,8 @@ use clap::Args;
 use image::RgbImage;
 use serde::Serialize;
 use std::path::PathBuf;
-use tactex_core::ball_calibration::BallPress;
-use tactex_core::perception::ssim::{gray, ssim};
+use tactex_core::tactile::ball_calibration::BallPress;
+use tactex_core::tactile::ssim::{gray, ssim};
 use tactex_sim::elastic::{ContactSolver, Fidelity};
 use tactex_sim::gel_render::{
     DeviceChoice, GelImageFields, PressFrame, SensorOptics, open_renderer,
@@ -104,7 +104,7 @@ pub struct PressComparison {
 #[derive(Serialize, Debug)]
 pub struct CompareReport {
     /// The calibrated profile the presses were rendered through.
-    pub sensor: tactex_core::sensor_profile::ProfileId,
+    pub sensor: tactex_core::tactile::sensor_profile::ProfileId,
     pub split: String,
     pub fidelity: String,
     /// Whether the presses were rendered with the profile's glow.

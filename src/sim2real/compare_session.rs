@@ -19,15 +19,17 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::TactileSensor;
-use tactex_core::estimate::{HardnessEstimator, PressSequence};
 use tactex_core::frames::TactileFrame;
-use tactex_core::hardness::HardnessReport;
-use tactex_core::perception::contact::ContactEvidence;
-use tactex_core::perception::markers::{detect_markers, track};
-use tactex_core::perception::ssim::ssim_rgb;
-use tactex_core::press::{Look, PressError, PressOutcome, PressProbe, PressProtocol, run_press};
+use tactex_core::hardness::estimate::{HardnessEstimator, PressSequence};
+use tactex_core::hardness::scale::HardnessReport;
+use tactex_core::press::protocol::{
+    Look, PressError, PressOutcome, PressProbe, PressProtocol, run_press,
+};
 use tactex_core::scene::Scene;
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::contact::ContactEvidence;
+use tactex_core::tactile::markers::{detect_markers, track};
+use tactex_core::tactile::spec::TactileSpec;
+use tactex_core::tactile::ssim::ssim_rgb;
 use tactex_hw::session::presses::press_runs;
 use tactex_hw::session::{Manifest, open_session};
 use tactex_sim::SimDevices;

@@ -3,9 +3,9 @@
 
 use image::RgbImage;
 use serde::Serialize;
-use tactex_core::ball_calibration::BallPress;
-use tactex_core::perception::centroid::median;
-use tactex_core::perception::contact_circle::estimate_contact_circle;
+use tactex_core::ground::centroid::median;
+use tactex_core::tactile::ball_calibration::BallPress;
+use tactex_core::tactile::contact_circle::estimate_contact_circle;
 
 #[derive(Serialize, Debug, Clone, Copy)]
 pub struct CircleScore {

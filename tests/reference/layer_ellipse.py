@@ -1,4 +1,4 @@
-"""Reference values for core/src/layer_compliance.rs: the centre displacement of a bonded layer
+"""Reference values for core/src/hardness/layer_compliance.rs: the centre displacement of a bonded layer
 under an elliptical Hertz pressure relative to the half-space, integrated numerically over the
 wavevector plane (polar k, phi) with scipy, without the circular reduction the Rust code uses.
 

@@ -260,7 +260,7 @@ pub fn check_dropped(reply: &str, facts: &Facts, catalog: &FruitCatalog) -> Resu
 mod tests {
     use super::*;
     use crate::explain::{Explainer, TemplateExplainer, location_words, select};
-    use crate::hardness::Hardness;
+    use crate::hardness::scale::Hardness;
 
     fn facts(prompt: &str) -> (Facts, FruitCatalog) {
         let catalog = FruitCatalog::builtin();

@@ -61,7 +61,7 @@ pub fn messages(facts: &Facts) -> Value {
 mod tests {
     use super::*;
     use crate::catalog::FruitCatalog;
-    use crate::hardness::Hardness;
+    use crate::hardness::scale::Hardness;
 
     #[test]
     fn the_model_sees_every_value_the_check_accepts() {

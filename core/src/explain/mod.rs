@@ -12,7 +12,7 @@ pub use location::{LOCATION_BAND_M, location_words};
 pub use template::TemplateExplainer;
 
 use crate::catalog::FruitCatalog;
-use crate::hardness::HardnessReport;
+use crate::hardness::scale::HardnessReport;
 use crate::query::{Extreme, Intent, Property, Query};
 use serde::Serialize;
 

@@ -2,7 +2,7 @@
 //! hardness given with its likely range (the calibrated 68% interval).
 
 use super::{Explainer, Explanation, Facts, Measured, stiffness};
-use crate::hardness::HardnessReport;
+use crate::hardness::scale::HardnessReport;
 use crate::query::{Extreme, Intent, Property, Query};
 
 /// The default explainer: the same facts always give the same words.
@@ -237,7 +237,7 @@ mod tests {
     use super::*;
     use crate::catalog::FruitCatalog;
     use crate::explain::{location_words, select};
-    use crate::hardness::Hardness;
+    use crate::hardness::scale::Hardness;
 
     fn m(label: &str, e: f64, x: f64, y: f64) -> Measured {
         Measured {

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use tactex_core::geometry::{CameraIntrinsics, Pose};
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::spec::TactileSpec;
 
 pub const FORMAT: &str = "tactex-session/1";
 pub const MANIFEST: &str = "manifest.json";
@@ -73,7 +73,7 @@ pub struct TwinRecord {
     pub fidelity: Option<String>,
     /// The sim GelSight's sensor profile.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sensor: Option<tactex_core::sensor_profile::ProfileId>,
+    pub sensor: Option<tactex_core::tactile::sensor_profile::ProfileId>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

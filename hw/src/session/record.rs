@@ -11,7 +11,7 @@ use tactex_core::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
 use tactex_core::frames::{DepthImage, RgbdFrame, TactileFrame};
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::image::{ImageBuffer, Luma};
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::spec::TactileSpec;
 
 struct Log {
     partial: PathBuf,

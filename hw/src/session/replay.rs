@@ -12,7 +12,7 @@ use std::sync::{Arc, Mutex};
 use tactex_core::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
 use tactex_core::frames::{RgbdFrame, TactileFrame};
 use tactex_core::geometry::{CameraIntrinsics, Pose};
-use tactex_core::tactile_spec::TactileSpec;
+use tactex_core::tactile::spec::TactileSpec;
 
 /// How far a replayed move's target may lie from the recorded one: the depth stored in
 /// 0.1 mm steps moves touch points by less than this.

@@ -17,7 +17,7 @@
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::{Arc, Mutex};
-use tactex_core::layer_compliance::{lateral_ratio, normal_compliance_ratio};
+use tactex_core::hardness::layer_compliance::{lateral_ratio, normal_compliance_ratio};
 
 /// The half-space radial-to-normal displacement ratio T_inf (negative: inward).
 pub fn half_space_lateral_ratio(nu: f64) -> f64 {

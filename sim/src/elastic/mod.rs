@@ -33,7 +33,7 @@ use std::collections::HashMap;
 use std::fmt;
 use std::str::FromStr;
 use tactex_core::hertz::{Elastic, Hertz};
-use tactex_core::tactile_spec::GelSpec;
+use tactex_core::tactile::spec::GelSpec;
 
 /// How much physics a contact solve models.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

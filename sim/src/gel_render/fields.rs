@@ -6,7 +6,7 @@
 use super::{GelImageFields, SensorOptics};
 use crate::elastic::{ContactSolution, ContactSolver, Rect};
 use glam::DVec2;
-use tactex_core::tactile_spec::GelSpec;
+use tactex_core::tactile::spec::GelSpec;
 
 /// Pad coordinates (mm) of pixel centre (i, j): the pad is centred on the frame, x along
 /// columns and y along rows.

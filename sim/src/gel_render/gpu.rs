@@ -9,7 +9,7 @@ use super::{
 };
 use crate::render_device::GpuDevice;
 use image::RgbImage;
-use tactex_core::gel_glow::gaussian_kernel;
+use tactex_core::tactile::gel_glow::gaussian_kernel;
 use wgpu::util::DeviceExt;
 
 const COMMON: &str = include_str!("../../../shaders/common.wgsl");

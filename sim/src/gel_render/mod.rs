@@ -22,10 +22,10 @@ pub use gpu::{GpuRenderer, SHADER_SOURCES, shader_source};
 pub use noise::gaussian3;
 
 use image::RgbImage;
-pub use tactex_core::gel_glow::GelGlow;
-use tactex_core::sensor_profile::SensorProfile;
-pub use tactex_core::sensor_profile::Shading;
-use tactex_core::tactile_spec::TactileSpec;
+pub use tactex_core::tactile::gel_glow::GelGlow;
+use tactex_core::tactile::sensor_profile::SensorProfile;
+pub use tactex_core::tactile::sensor_profile::Shading;
+use tactex_core::tactile::spec::TactileSpec;
 
 /// Everything about the sensor's optics that stays fixed from frame to frame.
 #[derive(Clone, Debug, PartialEq)]

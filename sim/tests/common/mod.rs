@@ -3,7 +3,7 @@
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
-use tactex_core::perception::detect::{ClassicalDetector, Detection, Detector, RgbdView};
+use tactex_core::ground::detect::{ClassicalDetector, Detection, Detector, RgbdView};
 use tactex_sim::SimDevices;
 
 /// One frame of the twin's noisy camera through the classical detector, with the camera's

@@ -3,9 +3,9 @@
 //! sensor's profile read backwards). Marker dots and saturated pixels carry no shading and
 //! are left out.
 
-use crate::photometric::PhotometricModel;
-use crate::shading_table::frame_position;
-use crate::tactile_spec::TactileSpec;
+use crate::tactile::photometric::PhotometricModel;
+use crate::tactile::shading_table::frame_position;
+use crate::tactile::spec::TactileSpec;
 use image::RgbImage;
 
 /// Slopes dw/dx and dw/dy (mm per mm) per pixel, in image axes (x along columns, y down).

@@ -7,9 +7,9 @@
 //! captures from a tactile sensor (twin or real), data generation solves the contact and
 //! renders it, and `compare --session` reads a recorded descent back. Each implements
 //! [`PressProbe`]; [`run_press`] is the one protocol they all run, with the one contact
-//! criterion of `perception::contact`.
+//! criterion of `tactile::contact`.
 
-use crate::perception::contact::{ContactEvidence, ContactRule, ContactTest};
+use crate::tactile::contact::{ContactEvidence, ContactRule, ContactTest};
 use image::RgbImage;
 
 /// How a press is run: the paper's 0.25 mm steps and 8 frames by default.

@@ -269,7 +269,8 @@ impl GelGlow {
         for i in 0..n {
             normal[i * n + i] += 1e-6 * trace.max(1e-12);
         }
-        let x = crate::shading_table::solve_spd(&mut normal, n, &rhs).ok_or(GlowError::Singular)?;
+        let x = crate::tactile::shading_table::solve_spd(&mut normal, n, &rhs)
+            .ok_or(GlowError::Singular)?;
         let glow = GelGlow {
             colour: colour_sigmas
                 .iter()

@@ -4,8 +4,8 @@
 
 use crate::frames::DepthImage;
 use crate::geometry::{CameraIntrinsics, Pose};
-use crate::perception::centroid::{back_project_mask, median_point};
-use crate::perception::mask::refine_mask;
+use crate::ground::centroid::{back_project_mask, median_point};
+use crate::ground::mask::refine_mask;
 use glam::DVec3;
 use image::GrayImage;
 

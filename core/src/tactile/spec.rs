@@ -1,7 +1,7 @@
 //! What a vision-based tactile sensor is: image geometry, gel, optics and marker grid.
 
-use crate::photometric::PhotometricModel;
-use crate::shading_table::ShadingTable;
+use crate::tactile::photometric::PhotometricModel;
+use crate::tactile::shading_table::ShadingTable;
 use serde::{Deserialize, Serialize};
 
 /// The elastomer layer bonded to the sensor's rigid acrylic window.

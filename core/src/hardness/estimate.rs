@@ -13,10 +13,10 @@
 //! follows from s and the gel's modulus.
 
 use crate::frames::TactileFrame;
-use crate::hardness::Hardness;
+use crate::hardness::scale::Hardness;
 use crate::hertz::{Elastic, Hertz, object_modulus_from_share};
-use crate::perception::slopes::{SlopeField, recover_slopes};
-use crate::tactile_spec::TactileSpec;
+use crate::tactile::slopes::{SlopeField, recover_slopes};
+use crate::tactile::spec::TactileSpec;
 use serde::Serialize;
 
 /// What the press routine records for one object.

@@ -3,21 +3,21 @@
 
 use crate::catalog::FruitCatalog;
 use crate::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
-use crate::estimate::{
-    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval, PressSequence,
-};
 use crate::explain::{self, Explainer, Facts, Measured, location_words};
 use crate::frames::TactileFrame;
 use crate::geometry::Pose;
-use crate::hardness::HardnessReport;
-use crate::perception::centroid::median_depth;
-use crate::perception::colour_name::{colour_name, mean_colour};
-use crate::perception::contact::ContactEvidence;
-use crate::perception::detect::{DetectError, Detector, RgbdView};
-use crate::perception::grounding::locate;
-use crate::perception::press_site::{HeightMap, PadClearance, PressSite, press_site};
-use crate::press::{Look, PressOutcome, PressProbe, PressProtocol, run_press};
+use crate::ground::centroid::median_depth;
+use crate::ground::colour_name::{colour_name, mean_colour};
+use crate::ground::detect::{DetectError, Detector, RgbdView};
+use crate::ground::grounding::locate;
+use crate::hardness::estimate::{
+    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval, PressSequence,
+};
+use crate::hardness::scale::HardnessReport;
+use crate::press::protocol::{Look, PressOutcome, PressProbe, PressProtocol, run_press};
+use crate::press::site::{HeightMap, PadClearance, PressSite, press_site};
 use crate::query::{self, Query, QueryError};
+use crate::tactile::contact::ContactEvidence;
 use glam::DVec3;
 use serde::Serialize;
 use std::time::Instant;
@@ -187,14 +187,14 @@ pub struct Answer {
     pub answer: String,
     pub not_found: Vec<String>,
     pub estimator: String,
-    /// The contact criterion every press ran (see `perception::contact`).
+    /// The contact criterion every press ran (see `tactile::contact`).
     pub contact_criterion: String,
     /// The twin's contact physics (rigid, hertz, halfspace, layer); None on real or replayed
     /// devices.
     pub fidelity: Option<String>,
     /// The tactile sensor's profile (name and content hash) the presses were rendered or
     /// read through, when one is known.
-    pub sensor: Option<crate::sensor_profile::ProfileId>,
+    pub sensor: Option<crate::tactile::sensor_profile::ProfileId>,
     /// "template", or "llm:<model>" when a model's grounded reply is the answer.
     pub explainer: String,
     /// Why a model's reply was not used, when the template stood in for it.
@@ -562,7 +562,7 @@ fn ground<C: RgbdCamera>(
 fn clear_touch(
     crest: DVec3,
     index: usize,
-    detections: &[crate::perception::detect::Detection],
+    detections: &[crate::ground::detect::Detection],
     cloud: &[Option<DVec3>],
     pad: &PadClearance,
 ) -> Option<PressSite> {
@@ -821,8 +821,10 @@ fn press_at<T: TactileSensor, A: Arm>(
         Ok(PressOutcome::NoContact { travel_mm, .. }) => {
             return Ok(Attempt::NotMeasured(NotMeasured::no_contact(travel_mm)));
         }
-        Err(crate::press::PressError::Probe(e)) => return Ok(Attempt::NotMeasured(refused(e)?)),
-        Err(crate::press::PressError::Invalid(m)) => {
+        Err(crate::press::protocol::PressError::Probe(e)) => {
+            return Ok(Attempt::NotMeasured(refused(e)?));
+        }
+        Err(crate::press::protocol::PressError::Invalid(m)) => {
             return Err(PipelineError::Camera(format!("tactile sensor: {m}")));
         }
     };
@@ -866,12 +868,12 @@ mod tests {
     //! disc once the pad is below the apple's top, and an arm that may refuse to go low.
 
     use super::*;
-    use crate::estimate::{EstimateError, HardnessEstimate, PhysicsEvidence};
     use crate::frames::{DepthImage, RgbdFrame};
     use crate::geometry::CameraIntrinsics;
-    use crate::hardness::Hardness;
-    use crate::perception::detect::Detection;
-    use crate::tactile_spec::TactileSpec;
+    use crate::ground::detect::Detection;
+    use crate::hardness::estimate::{EstimateError, HardnessEstimate, PhysicsEvidence};
+    use crate::hardness::scale::Hardness;
+    use crate::tactile::spec::TactileSpec;
     use image::{GrayImage, Luma, Rgb, RgbImage};
     use std::cell::Cell;
     use std::rc::Rc;

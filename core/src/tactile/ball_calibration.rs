@@ -3,7 +3,7 @@
 //! so every pixel there has a known slope; far from the contact the gel is flat. Each such
 //! pixel is a `ShadingSample` of its colour change over the no-contact frame.
 
-use crate::shading_table::{ShadingSample, frame_position};
+use crate::tactile::shading_table::{ShadingSample, frame_position};
 use image::RgbImage;
 use std::path::Path;
 
@@ -231,9 +231,9 @@ pub fn camera_noise_sigma(
     }
     // Whole grey levels make the median absolute deviation jump in steps: it only sets the
     // cut for the odd outlier; the spread is the standard deviation of what stays.
-    let mid = crate::perception::centroid::median(&mut steps.clone())?;
+    let mid = crate::ground::centroid::median(&mut steps.clone())?;
     let mut dev: Vec<f64> = steps.iter().map(|e| (e - mid).abs()).collect();
-    let cut = 5.0 * (1.4826 * crate::perception::centroid::median(&mut dev)?).max(1.0);
+    let cut = 5.0 * (1.4826 * crate::ground::centroid::median(&mut dev)?).max(1.0);
     let kept: Vec<f64> = steps
         .into_iter()
         .filter(|e| (e - mid).abs() <= cut)

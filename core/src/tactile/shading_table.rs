@@ -421,7 +421,7 @@ mod tests {
     /// A table fitted to the analytic lights over a flat grey background: its changes are
     /// the lights' gains times the background, less the background.
     fn lights_table() -> ShadingTable {
-        let lights = crate::photometric::PhotometricModel::default();
+        let lights = crate::tactile::photometric::PhotometricModel::default();
         let bg = 140.0f32;
         let mut samples = Vec::new();
         for i in 0..=40 {

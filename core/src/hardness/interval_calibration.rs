@@ -15,13 +15,13 @@
 //! the frame) are read with another bias than round ones: when the held-out set has enough of
 //! them they get bins of their own, chosen by the contact's aspect in the estimate's evidence.
 
-use crate::estimate::{
+use crate::hardness::estimate::{
     EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval, PhysicsEvidence,
     PressSequence,
 };
-use crate::hardness::Hardness;
+use crate::hardness::scale::Hardness;
 use crate::stats::quantile;
-use crate::tactile_spec::TactileSpec;
+use crate::tactile::spec::TactileSpec;
 use serde::{Deserialize, Serialize};
 
 pub const FORMAT: &str = "tactex-interval-calibration/1";

@@ -8,10 +8,10 @@
 //! contents (the canonical TOML, without the background's file name, then the background's
 //! pixels), so two profiles that render alike hash alike wherever their files live.
 
-use crate::gel_glow::GelGlow;
-use crate::photometric::PhotometricModel;
-use crate::shading_table::ShadingTable;
-use crate::tactile_spec::{GelSpec, MarkerGrid, TactileSpec};
+use crate::tactile::gel_glow::GelGlow;
+use crate::tactile::photometric::PhotometricModel;
+use crate::tactile::shading_table::ShadingTable;
+use crate::tactile::spec::{GelSpec, MarkerGrid, TactileSpec};
 use image::RgbImage;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -604,11 +604,11 @@ mod tests {
             image::Rgb([(x % 251) as u8, (y % 241) as u8, 90])
         }));
         p.glow = Some(GelGlow {
-            colour: vec![crate::gel_glow::ColourGlow {
+            colour: vec![crate::tactile::gel_glow::ColourGlow {
                 sigma_px: 3.0,
                 mix: [[0.7, 0.1, 0.0], [0.0, 0.6, -0.05], [0.2, 0.0, 0.9]],
             }],
-            magnitude: vec![crate::gel_glow::MagnitudeGlow {
+            magnitude: vec![crate::tactile::gel_glow::MagnitudeGlow {
                 sigma_px: 27.0,
                 colour: [0.11, -0.02, 0.3],
             }],

@@ -6,9 +6,9 @@
 use crate::catalog::FruitCatalog;
 use crate::frames::DepthImage;
 use crate::geometry::{CameraIntrinsics, Pose};
-use crate::perception::colour_name::mean_surface_colour;
-use crate::perception::height_split::{HeightPixel, split_by_height};
-use crate::perception::neck_split::cut_at_neck;
+use crate::ground::colour_name::mean_surface_colour;
+use crate::ground::height_split::{HeightPixel, split_by_height};
+use crate::ground::neck_split::cut_at_neck;
 use crate::query::Query;
 use glam::DVec3;
 use image::{GrayImage, Luma, RgbImage};

@@ -8,17 +8,17 @@
 //! as a softer object. The object's modulus follows from the compliance ratio and the gel's
 //! modulus.
 
-use crate::estimate::{
+use crate::hardness::estimate::{
     EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval,
     OWN_FIT_INTERVAL, PhysicsEvidence, PressSequence, Z95,
 };
-use crate::gel_share_fit::{fit_gel_share, gel_share};
-use crate::hardness::Hardness;
+use crate::hardness::gel_share_fit::{fit_gel_share, gel_share};
+use crate::hardness::layer_compliance::hertz_ellipse_centre_compliance_ratio;
+use crate::hardness::scale::Hardness;
 use crate::hertz::Elastic;
-use crate::layer_compliance::hertz_ellipse_centre_compliance_ratio;
-use crate::perception::depth::integrate_slopes;
-use crate::perception::slopes::recover_slopes;
-use crate::tactile_spec::TactileSpec;
+use crate::tactile::depth::integrate_slopes;
+use crate::tactile::slopes::recover_slopes;
+use crate::tactile::spec::TactileSpec;
 use std::f64::consts::PI;
 
 #[derive(Clone, Debug)]

@@ -1,0 +1,13 @@
+//! The hardness stage: the scales (`scale`: Shore A, Shore 00, modulus and the conversions)
+//! and reading hardness from a press sequence: the `HardnessEstimator` trait and the Hertz
+//! slope fit (`estimate`), the integrated-indentation estimator (`indentation_estimator`)
+//! with the bonded layer's compliance (`layer_compliance`, `gel_share_fit`), and intervals
+//! whose coverage is measured (`interval_calibration`). The learned estimator is in
+//! tactex-learned.
+
+pub mod estimate;
+pub mod gel_share_fit;
+pub mod indentation_estimator;
+pub mod interval_calibration;
+pub mod layer_compliance;
+pub mod scale;

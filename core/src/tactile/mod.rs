@@ -1,0 +1,20 @@
+//! The tactile sensor and its frames: what a GelSight is (`spec`, `sensor_profile`, the
+//! shading models `photometric` and `shading_table`, the `gel_glow`), how a profile is fitted
+//! from ball presses (`ball_calibration`), and reading its frames: SSIM, markers and their
+//! grid, the contact criterion, the contact circle, surface slopes and the indentation map.
+
+pub mod ball_calibration;
+pub mod circle_fit;
+mod closing;
+pub mod contact;
+pub mod contact_circle;
+pub mod depth;
+pub mod gel_glow;
+pub mod marker_grid;
+pub mod markers;
+pub mod photometric;
+pub mod sensor_profile;
+pub mod shading_table;
+pub mod slopes;
+pub mod spec;
+pub mod ssim;
