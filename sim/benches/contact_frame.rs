@@ -11,9 +11,9 @@ use glam::DVec2;
 use std::hint::black_box;
 use tactex_core::hertz::Elastic;
 use tactex_core::tactile::spec::TactileSpec;
-use tactex_sim::elastic::kernels::GridKernels;
-use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
-use tactex_sim::gel_render::{CpuRenderer, PressFrame, SensorOptics, image_fields, pad_rect};
+use tactex_sim::contact::kernels::GridKernels;
+use tactex_sim::contact::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
+use tactex_sim::render::gel::{CpuRenderer, PressFrame, SensorOptics, image_fields, pad_rect};
 
 /// The render bench's press: a 10 mm ball of 1 MPa, 1 mm past first touch.
 fn bench_frame(c: &mut Criterion) {

@@ -4,33 +4,31 @@
 //! clock) is shared by the sim devices: `SimCamera` renders RGB-D frames of it, `SimArm`
 //! moves the GelSight pad through it, and `SimGelSight` renders what the gel sees when the
 //! pad presses into an object (elastic contact -> gel fields -> shading and markers).
+//!
+//! By stage: `devices/` (the sim camera, arm and GelSight, the RealSense depth noise),
+//! `contact/` (the elastic contact, one file per fidelity level, and the pad's grid),
+//! `render/{gel,scene}/` (GelSight and RGB-D image synthesis, CPU and wgpu paths, and the
+//! render device choice), `datagen/` (randomised presses and scenes, and the press protocol
+//! on the solver alone). `world` and `mesh` are the table and its bodies.
 
-pub mod arm;
-pub mod camera;
-pub mod depth_noise;
-pub mod elastic;
-pub mod gel_render;
-pub mod gelsight;
+pub mod contact;
+pub mod datagen;
+pub mod devices;
 pub mod mesh;
-pub mod pad_contact;
 pub mod perception_error;
-pub mod press_protocol;
-pub mod render_device;
-pub mod scene_random;
-pub mod scene_render;
-pub mod tactile_sample;
+pub mod render;
 pub mod world;
 
-use elastic::Fidelity;
+use contact::Fidelity;
 use tactex_core::scene::Scene;
 use tactex_core::tactile::sensor_profile::SensorProfile;
 
 /// The three sim devices over one shared world.
 pub struct SimDevices {
     pub world: world::SharedWorld,
-    pub camera: camera::SimCamera,
-    pub tactile: gelsight::SimGelSight,
-    pub arm: arm::SimArm,
+    pub camera: devices::camera::SimCamera,
+    pub tactile: devices::gelsight::SimGelSight,
+    pub arm: devices::arm::SimArm,
 }
 
 impl SimDevices {
@@ -51,9 +49,9 @@ impl SimDevices {
         let shared = world::SimWorld::from_scene(scene)?.shared();
         let spec = sensor.spec.clone();
         Ok(Self {
-            camera: camera::SimCamera::new(shared.clone(), seed),
-            tactile: gelsight::SimGelSight::new(shared.clone(), &sensor, fidelity, seed),
-            arm: arm::SimArm::new(shared.clone(), spec),
+            camera: devices::camera::SimCamera::new(shared.clone(), seed),
+            tactile: devices::gelsight::SimGelSight::new(shared.clone(), &sensor, fidelity, seed),
+            arm: devices::arm::SimArm::new(shared.clone(), spec),
             world: shared,
         })
     }

@@ -4,7 +4,7 @@
 //! set after the TactEx paper's YOLOv8 and Grounded-SAM (GSAM) comparison, for ablations of
 //! the rest of the pipeline against detector quality.
 
-use crate::camera::{InstanceImage, instance_mask};
+use crate::devices::camera::{InstanceImage, instance_mask};
 use image::{GrayImage, Luma};
 use imageproc::distance_transform::Norm;
 use rand::{Rng, SeedableRng};

@@ -370,7 +370,7 @@ mod tests {
         assert_eq!(world.interpenetrating(), Some((0, 1)));
         // Crowded tables as the evaluations draw them: half the fruits put against another,
         // settled touching. None is deep in another.
-        let variation = crate::scene_random::Variation {
+        let variation = crate::datagen::scene_random::Variation {
             touching_share: 0.6,
             ..Default::default()
         };
@@ -379,7 +379,8 @@ mod tests {
         ];
         for seed in 0..6 {
             let scene =
-                crate::scene_random::random_scene(&kinds, &catalog, seed, &variation).unwrap();
+                crate::datagen::scene_random::random_scene(&kinds, &catalog, seed, &variation)
+                    .unwrap();
             let world = SimWorld::from_scene(&scene).unwrap();
             assert_eq!(world.interpenetrating(), None, "seed {seed}");
         }

@@ -7,7 +7,7 @@ use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 use tactex_core::hertz::Elastic;
 use tactex_core::tactile::spec::GelSpec;
-use tactex_sim::elastic::{
+use tactex_sim::contact::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, ObjectSurface, Rect,
 };
 

@@ -4,7 +4,7 @@
 use glam::DVec2;
 use tactex_core::hertz::{Elastic, Hertz, contact_modulus_mpa};
 use tactex_core::tactile::spec::GelSpec;
-use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface, Rect};
+use tactex_sim::contact::{ContactProblem, ContactSolver, Fidelity, ObjectSurface, Rect};
 
 fn gel(thickness_mm: f64) -> GelSpec {
     GelSpec {

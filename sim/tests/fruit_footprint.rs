@@ -7,7 +7,7 @@ mod common;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::scene::ObjectKind;
 use tactex_sim::SimDevices;
-use tactex_sim::scene_random::{Variation, random_scene};
+use tactex_sim::datagen::scene_random::{Variation, random_scene};
 
 #[test]
 fn every_catalog_fruit_is_seen_at_its_true_size_anywhere_on_the_table() {

@@ -7,8 +7,8 @@ use tactex_core::hertz::Elastic;
 use tactex_core::tactile::gel_glow::{ColourGlow, GelGlow, MagnitudeGlow};
 use tactex_core::tactile::shading_table::{ShadingSample, ShadingTable};
 use tactex_core::tactile::spec::TactileSpec;
-use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
-use tactex_sim::gel_render::{
+use tactex_sim::contact::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
+use tactex_sim::render::gel::{
     CpuRenderer, DeviceChoice, GelImageFields, GelRenderer, PressFrame, RenderError, SensorOptics,
     Shading, image_fields, open_renderer, pad_rect,
 };

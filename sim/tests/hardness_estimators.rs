@@ -7,9 +7,9 @@ use tactex_core::hardness::indentation_estimator::IndentationEstimator;
 use tactex_core::hertz::Elastic;
 use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::spec::TactileSpec;
-use tactex_sim::elastic::{ContactSolver, Fidelity, ObjectSurface};
-use tactex_sim::gel_render::{CpuRenderer, SensorOptics};
-use tactex_sim::press_protocol::{PressSetup, plan_press};
+use tactex_sim::contact::{ContactSolver, Fidelity, ObjectSurface};
+use tactex_sim::datagen::press_protocol::{PressSetup, plan_press};
+use tactex_sim::render::gel::{CpuRenderer, SensorOptics};
 
 /// Presses a 25 mm sphere of soft to firm fruit flesh (0.1, 0.4, 1.5 MPa; the 4 mm gel is
 /// 0.3 MPa) at `fidelity` and asserts the estimator reads each modulus back within

@@ -5,8 +5,8 @@ use glam::DVec3;
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::scene::Scene;
-use tactex_sim::render_device::{DeviceChoice, RenderError};
-use tactex_sim::scene_render::{
+use tactex_sim::render::device::{DeviceChoice, RenderError};
+use tactex_sim::render::scene::{
     CleanRender, CpuSceneRenderer, SceneGeometry, SceneRenderer, open_scene_renderer,
 };
 use tactex_sim::world::SimWorld;

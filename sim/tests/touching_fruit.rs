@@ -7,7 +7,7 @@ use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::scene::Scene;
 use tactex_sim::SimDevices;
-use tactex_sim::scene_random::{Variation, random_scene};
+use tactex_sim::datagen::scene_random::{Variation, random_scene};
 use tactex_sim::world::SimWorld;
 
 #[test]

@@ -6,7 +6,7 @@ use anyhow::{Result, bail};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::ground::detect::{ClassicalDetector, Detector};
 use tactex_learned::yolo_seg::YoloSegDetector;
-use tactex_sim::camera::InstanceImage;
+use tactex_sim::devices::camera::InstanceImage;
 use tactex_sim::perception_error::{ErrorProfile, PerceptionErrorDetector};
 
 pub const KNOWN: &str = "classical, yolo:FILE.onnx, error-gsam, error-yolo";

@@ -16,7 +16,7 @@ use {
     crate::app::replay::detector_without_truth,
     tactex_core::catalog::FruitCatalog,
     tactex_core::pipeline::Devices,
-    tactex_sim::elastic::Fidelity,
+    tactex_sim::contact::Fidelity,
 };
 
 /// Answers `prompt` on the real devices `devices.toml` names: an xArm, a RealSense and a

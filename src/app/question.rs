@@ -9,7 +9,7 @@ use tactex_core::ground::detect::Detector;
 use tactex_core::hardness::estimate::HardnessEstimator;
 use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
 use tactex_hw::session::{SessionRecorder, TwinRecord};
-use tactex_sim::elastic::Fidelity;
+use tactex_sim::contact::Fidelity;
 
 /// Where `Question::ask` records a session: a new directory, the backend's name, and the sim
 /// world when the backend is the twin.

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::scene::Scene;
-use tactex_sim::render_device::DeviceChoice;
-use tactex_sim::scene_render::{SceneRenderer, open_scene_renderer};
+use tactex_sim::render::device::DeviceChoice;
+use tactex_sim::render::scene::{SceneRenderer, open_scene_renderer};
 
 /// The built-in demo scene: `scenes/demo.toml` here, or the one beside the sources.
 pub fn default_scene() -> PathBuf {

@@ -17,9 +17,9 @@ use tactex_core::scene::Scene;
 use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_hw::session::TwinRecord;
 use tactex_sim::SimDevices;
-use tactex_sim::camera::InstanceImage;
-use tactex_sim::elastic::Fidelity;
-use tactex_sim::scene_render::SceneRenderer;
+use tactex_sim::contact::Fidelity;
+use tactex_sim::devices::camera::InstanceImage;
+use tactex_sim::render::scene::SceneRenderer;
 use tactex_sim::world::SharedWorld;
 
 /// An answer from the twin, with the ground truth an evaluation scores it against.

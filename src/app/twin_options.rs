@@ -14,9 +14,9 @@ use std::sync::Arc;
 use tactex_core::explain::Explainer;
 use tactex_core::hardness::estimate::HardnessEstimator;
 use tactex_core::tactile::sensor_profile::SensorProfile;
-use tactex_sim::elastic::Fidelity;
-use tactex_sim::render_device::DeviceChoice;
-use tactex_sim::scene_render::SceneRenderer;
+use tactex_sim::contact::Fidelity;
+use tactex_sim::render::device::DeviceChoice;
+use tactex_sim::render::scene::SceneRenderer;
 
 /// How the twin answers: the detector, the camera's render device and the explainer (shared
 /// by `ask` and `serve`).

@@ -19,8 +19,8 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::explain::TemplateExplainer;
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
-use tactex_sim::elastic::Fidelity;
-use tactex_sim::scene_render::{CpuSceneRenderer, SceneRenderer};
+use tactex_sim::contact::Fidelity;
+use tactex_sim::render::scene::{CpuSceneRenderer, SceneRenderer};
 
 use crate::app::detector_choice::DetectorChoice;
 

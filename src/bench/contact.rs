@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use tactex_core::hertz::{Elastic, Hertz, contact_modulus_mpa, gel_share};
 use tactex_core::tactile::spec::TactileSpec;
-use tactex_sim::elastic::{
+use tactex_sim::contact::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
 };
 

@@ -10,7 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
-use tactex_sim::gel_render::DeviceChoice;
+use tactex_sim::render::gel::DeviceChoice;
 
 #[derive(Args, Debug)]
 pub struct DatagenBenchArgs {

@@ -15,8 +15,8 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
 use tactex_core::hertz::Elastic;
-use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
-use tactex_sim::gel_render::{
+use tactex_sim::contact::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
+use tactex_sim::render::gel::{
     CpuRenderer, GelImageFields, GelRenderer, GpuRenderer, PressFrame, SensorOptics, adapters,
     image_fields, pad_rect,
 };

@@ -17,8 +17,8 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
 use tactex_core::scene::Scene;
 use tactex_sim::SimDevices;
-use tactex_sim::render_device::adapters;
-use tactex_sim::scene_render::{CpuSceneRenderer, GpuSceneRenderer, SceneGeometry, SceneRenderer};
+use tactex_sim::render::device::adapters;
+use tactex_sim::render::scene::{CpuSceneRenderer, GpuSceneRenderer, SceneGeometry, SceneRenderer};
 
 #[derive(Args, Debug)]
 pub struct SceneBenchArgs {

@@ -10,10 +10,10 @@ use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::hardness::scale::Hardness;
 use tactex_core::hertz::Elastic;
-use tactex_sim::elastic::{
+use tactex_sim::contact::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
 };
-use tactex_sim::gel_render::{
+use tactex_sim::render::gel::{
     DeviceChoice, GelImageFields, PressFrame, SensorOptics, image_fields, open_renderer,
 };
 

@@ -7,7 +7,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_core::tactile::ssim::{gray, ssim};
-use tactex_sim::gel_render::{CpuRenderer, GelImageFields, PressFrame, SensorOptics};
+use tactex_sim::render::gel::{CpuRenderer, GelImageFields, PressFrame, SensorOptics};
 
 #[derive(Subcommand)]
 pub enum SensorCommand {

@@ -39,10 +39,10 @@ use tactex_core::dir_claim::LockDir;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::ground::mask::mask_box;
 use tactex_sim::SimDevices;
-use tactex_sim::camera::{InstanceImage, instance_mask};
-use tactex_sim::render_device::DeviceChoice;
-use tactex_sim::scene_random::{Variation, random_scene};
-use tactex_sim::scene_render::SceneRenderer;
+use tactex_sim::datagen::scene_random::{Variation, random_scene};
+use tactex_sim::devices::camera::{InstanceImage, instance_mask};
+use tactex_sim::render::device::DeviceChoice;
+use tactex_sim::render::scene::SceneRenderer;
 
 const FORMAT: &str = "tactex-scene-dataset/1";
 /// Douglas-Peucker tolerance of the label polygons (px): keeps them within a pixel of the

@@ -28,10 +28,10 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::contact::ContactEvidence;
 use tactex_core::tactile::sensor_profile::ProfileId;
-use tactex_sim::elastic::{ContactSolver, Fidelity};
-use tactex_sim::gel_render::{CpuRenderer, DeviceChoice, GelRenderer, open_renderer};
-use tactex_sim::press_protocol::PlannedPress;
-use tactex_sim::tactile_sample::{SampleDraw, SampleSpace, ShapeFamily};
+use tactex_sim::contact::{ContactSolver, Fidelity};
+use tactex_sim::datagen::press_protocol::PlannedPress;
+use tactex_sim::datagen::tactile_sample::{SampleDraw, SampleSpace, ShapeFamily};
+use tactex_sim::render::gel::{CpuRenderer, DeviceChoice, GelRenderer, open_renderer};
 
 const FORMAT: &str = "tactex-tactile-dataset/1";
 /// Redraws of a sample whose press found no contact before the run gives up on it.
@@ -357,7 +357,7 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
     let sensor = space.sensor.id();
     let catalog = FruitCatalog::builtin();
     let protocol = PressProtocol::default();
-    let optics = tactex_sim::gel_render::SensorOptics::for_profile(&space.sensor);
+    let optics = tactex_sim::render::gel::SensorOptics::for_profile(&space.sensor);
     let info = DatasetInfo {
         format: FORMAT.into(),
         count: args.count,

@@ -35,7 +35,7 @@ use tactex_core::explain::{Explainer, Explanation, Facts, Measured, location_wor
 use tactex_core::ground::colour_name::colour_name;
 use tactex_core::hardness::scale::Hardness;
 use tactex_core::query;
-use tactex_sim::scene_random::{Variation, random_scene};
+use tactex_sim::datagen::scene_random::{Variation, random_scene};
 
 /// The standard error every fact carries, relative to its modulus.
 pub const FACT_SE: f64 = 0.05;

@@ -37,9 +37,9 @@ use tactex_core::hardness::interval_calibration::{
 use tactex_core::hardness::scale::Hardness;
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
-use tactex_sim::elastic::Fidelity;
-use tactex_sim::render_device::DeviceChoice;
-use tactex_sim::scene_random::{RandomSceneError, Variation, random_scene};
+use tactex_sim::contact::Fidelity;
+use tactex_sim::datagen::scene_random::{RandomSceneError, Variation, random_scene};
+use tactex_sim::render::device::DeviceChoice;
 
 /// The question every scene is asked.
 pub const PROMPT: &str = "Describe the hardness of all the fruits.";

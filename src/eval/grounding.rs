@@ -32,10 +32,10 @@ use tactex_core::ground::grounding::locate;
 use tactex_core::query;
 use tactex_core::stats::{self, Alternative};
 use tactex_sim::SimDevices;
-use tactex_sim::camera::instance_mask;
-use tactex_sim::render_device::DeviceChoice;
-use tactex_sim::scene_random::{Variation, random_scene};
-use tactex_sim::scene_render::SceneRenderer;
+use tactex_sim::datagen::scene_random::{Variation, random_scene};
+use tactex_sim::devices::camera::instance_mask;
+use tactex_sim::render::device::DeviceChoice;
+use tactex_sim::render::scene::SceneRenderer;
 
 #[derive(Args)]
 #[command(allow_negative_numbers = true)]

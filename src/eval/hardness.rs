@@ -16,9 +16,9 @@ use tactex_core::hardness::estimate::{Evidence, HardnessEstimator, HertzSlopeEst
 use tactex_core::hardness::indentation_estimator::IndentationEstimator;
 use tactex_core::hardness::scale::shore_a_to_modulus_mpa;
 use tactex_core::stats::{r_squared, rmse, spearman};
-use tactex_sim::elastic::ContactSolver;
-use tactex_sim::gel_render::CpuRenderer;
-use tactex_sim::tactile_sample::ShapeFamily;
+use tactex_sim::contact::ContactSolver;
+use tactex_sim::datagen::tactile_sample::ShapeFamily;
+use tactex_sim::render::gel::CpuRenderer;
 
 #[derive(Args, Debug)]
 pub struct HardnessEvalArgs {

@@ -26,11 +26,11 @@ use tactex_core::press::protocol::PressProtocol;
 use tactex_core::stats::{
     Alternative, MannWhitneyMethod, holm_bonferroni, mann_whitney_u, quantile,
 };
-use tactex_sim::elastic::{ContactSolver, Fidelity};
-use tactex_sim::gel_render::CpuRenderer;
-use tactex_sim::tactile_sample::{
+use tactex_sim::contact::{ContactSolver, Fidelity};
+use tactex_sim::datagen::tactile_sample::{
     SampleDraw, SensorDraw, ShapeDraw, ShapeFamily, press_with_redraws,
 };
+use tactex_sim::render::gel::CpuRenderer;
 
 /// The paper's Table III fruits.
 const TABLE_III: [&str; 5] = ["mango", "lime", "tomato", "banana", "avocado"];

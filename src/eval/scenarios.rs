@@ -35,9 +35,9 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::explain::TemplateExplainer;
 use tactex_core::pipeline::{Answer, PipelineConfig};
 use tactex_core::scene::Scene;
-use tactex_sim::elastic::Fidelity;
-use tactex_sim::render_device::DeviceChoice;
-use tactex_sim::scene_random::{Variation, random_scene};
+use tactex_sim::contact::Fidelity;
+use tactex_sim::datagen::scene_random::{Variation, random_scene};
+use tactex_sim::render::device::DeviceChoice;
 
 /// Pairs whose true moduli differ by less than this factor are not judged for order: the
 /// twin's hardness estimates scatter by about 10%, as the paper's did.

@@ -31,9 +31,9 @@ use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
 use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_sim::SimDevices;
-use tactex_sim::camera::SimCamera;
-use tactex_sim::elastic::Fidelity;
-use tactex_sim::scene_render::SceneRenderer;
+use tactex_sim::contact::Fidelity;
+use tactex_sim::devices::camera::SimCamera;
+use tactex_sim::render::scene::SceneRenderer;
 use tokio::sync::Semaphore;
 
 const PAGE: &str = include_str!("page.html");

@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 use tactex_core::hertz::Elastic;
 use tactex_core::tactile::ball_calibration::{BallPress, read_annotations};
 use tactex_core::tactile::spec::GelSpec;
-use tactex_sim::elastic::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
-use tactex_sim::gel_render::{
+use tactex_sim::contact::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
+use tactex_sim::render::gel::{
     GelImageFields, SensorOptics, image_fields, pad_rect, pixel_centre_mm,
 };
 

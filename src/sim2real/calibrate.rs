@@ -17,8 +17,8 @@ use tactex_core::tactile::gel_glow::{GelGlow, GlowPress};
 use tactex_core::tactile::sensor_profile::{CalibrationFit, SensorProfile};
 use tactex_core::tactile::shading_table::{ShadingTable, frame_position};
 use tactex_core::tactile::spec::{GelSpec, TactileSpec};
-use tactex_sim::elastic::{ContactSolver, Fidelity};
-use tactex_sim::gel_render::{CpuRenderer, SensorOptics};
+use tactex_sim::contact::{ContactSolver, Fidelity};
+use tactex_sim::render::gel::{CpuRenderer, SensorOptics};
 
 #[derive(Args, Debug)]
 #[command(allow_negative_numbers = true)]

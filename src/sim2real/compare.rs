@@ -20,8 +20,8 @@ use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::tactile::ball_calibration::BallPress;
 use tactex_core::tactile::ssim::{gray, ssim};
-use tactex_sim::elastic::{ContactSolver, Fidelity};
-use tactex_sim::gel_render::{
+use tactex_sim::contact::{ContactSolver, Fidelity};
+use tactex_sim::render::gel::{
     DeviceChoice, GelImageFields, PressFrame, SensorOptics, open_renderer,
 };
 

@@ -33,8 +33,8 @@ use tactex_core::tactile::ssim::ssim_rgb;
 use tactex_hw::session::presses::press_runs;
 use tactex_hw::session::{Manifest, open_session};
 use tactex_sim::SimDevices;
-use tactex_sim::elastic::Fidelity;
-use tactex_sim::pad_contact::{deepest_touch, pad_of};
+use tactex_sim::contact::Fidelity;
+use tactex_sim::contact::pad::{deepest_touch, pad_of};
 
 /// What `compare --session` needs beside the session directory.
 pub struct SessionCompare<'a> {

@@ -14,7 +14,7 @@ use tactex_core::geometry::Pose;
 use tactex_hw::session::SessionRecorder;
 use tactex_hw::session::format::MoveRecord;
 use tactex_hw::xarm::frame::{f32_params, f32_values, status};
-use tactex_sim::arm::SimArm;
+use tactex_sim::devices::arm::SimArm;
 use tactex_sim::world::SharedWorld;
 
 /// The controller's registers the twin answers (`XCONF.UxbusReg` in the SDK).

@@ -21,9 +21,9 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::{RgbdCamera, TactileSensor};
 use tactex_hw::session::{SessionRecorder, TwinRecord};
 use tactex_sim::SimDevices;
-use tactex_sim::camera::SimCamera;
-use tactex_sim::elastic::Fidelity;
-use tactex_sim::gelsight::SimGelSight;
+use tactex_sim::contact::Fidelity;
+use tactex_sim::devices::camera::SimCamera;
+use tactex_sim::devices::gelsight::SimGelSight;
 
 #[derive(Args)]
 pub struct TwinArgs {

@@ -16,7 +16,7 @@ pub use device::{SceneRendererChoice, open_scene_renderer};
 pub use geometry::{SceneGeometry, SceneTriangle};
 pub use gpu::{GpuSceneRenderer, SCENE_SHADER};
 
-use crate::render_device::RenderError;
+use crate::render::device::RenderError;
 use glam::DVec3;
 use image::{ImageBuffer, Luma};
 

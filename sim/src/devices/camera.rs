@@ -1,10 +1,10 @@
-//! The simulated RGB-D camera: a clean render of the world (`scene_render`, CPU or GPU) at the
+//! The simulated RGB-D camera: a clean render of the world (`render::scene`, CPU or GPU) at the
 //! scene's intrinsics and pose, then per frame seeded colour noise and the RealSense D435
 //! depth noise model (`depth_noise`).
 
-use crate::depth_noise::{CleanDepth, RealSenseNoise};
-use crate::render_device::RenderError;
-use crate::scene_render::{CleanRender, CpuSceneRenderer, SceneGeometry, SceneRenderer};
+use crate::devices::depth_noise::{CleanDepth, RealSenseNoise};
+use crate::render::device::RenderError;
+use crate::render::scene::{CleanRender, CpuSceneRenderer, SceneGeometry, SceneRenderer};
 use crate::world::SharedWorld;
 use image::{Luma, Rgb, RgbImage};
 use rand::SeedableRng;
@@ -15,7 +15,7 @@ use tactex_core::devices::{DeviceError, RgbdCamera};
 use tactex_core::frames::{DepthImage, RgbdFrame};
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 
-pub use crate::scene_render::InstanceImage;
+pub use crate::render::scene::InstanceImage;
 
 /// The mask (255 inside) of one instance id.
 pub fn instance_mask(instances: &InstanceImage, id: u16) -> image::GrayImage {

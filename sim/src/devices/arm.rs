@@ -2,7 +2,7 @@
 //! acceleration limits (trapezoidal profile), advancing the simulated clock, inside a
 //! workspace box and refusing moves that would crush an object.
 
-use crate::pad_contact::{deepest_touch, pad_of};
+use crate::contact::pad::{deepest_touch, pad_of};
 use crate::world::SharedWorld;
 use tactex_core::devices::{Arm, DeviceError};
 use tactex_core::geometry::Pose;

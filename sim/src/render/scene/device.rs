@@ -1,7 +1,7 @@
 //! The scene renderer a device choice (`render_device`) opens.
 
 use super::{CpuSceneRenderer, GpuSceneRenderer, SceneRenderer};
-use crate::render_device::{DeviceChoice, RenderError, pick_adapter};
+use crate::render::device::{DeviceChoice, RenderError, pick_adapter};
 use std::sync::Arc;
 
 /// The renderer picked, and why when that is worth telling the user.

@@ -6,10 +6,10 @@
 
 use super::geometry::NEAR_M;
 use super::{CleanRender, InstanceImage, SceneGeometry, SceneRenderer};
-use crate::render_device::{GpuDevice, RenderError};
+use crate::render::device::{GpuDevice, RenderError};
 use wgpu::util::DeviceExt;
 
-pub const SCENE_SHADER: &str = include_str!("../../../shaders/scene_raster.wgsl");
+pub const SCENE_SHADER: &str = include_str!("../../../../shaders/scene_raster.wgsl");
 
 const FAR_M: f32 = 1000.0;
 const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -361,7 +361,7 @@ fn unpack(bytes: &[u8], w: u32, h: u32, rows: &[u32; 3]) -> CleanRender {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render_device::shader_checks::{struct_size, validated};
+    use crate::render::device::shader_checks::{struct_size, validated};
 
     #[test]
     fn scene_shader_parses_and_validates_with_naga() {

@@ -2,7 +2,7 @@
 //! (the sim GelSight renders it, the sim arm's crush limit reads it), and the elastic solve
 //! of a press at a chosen fidelity, one solver grid (with warm starts) per press.
 
-use crate::elastic::{
+use crate::contact::{
     ContactError, ContactProblem, ContactSolution, ContactSolver, Fidelity, Grid, ObjectSurface,
     Rect,
 };

@@ -1,7 +1,7 @@
 //! The GelSight renderer a device choice (`render_device`) opens.
 
 use super::{CpuRenderer, GelRenderer, GpuRenderer, RenderError};
-use crate::render_device::{DeviceChoice, pick_adapter};
+use crate::render::device::{DeviceChoice, pick_adapter};
 
 /// The renderer picked, and why when that is worth telling the user.
 pub struct RendererChoice {

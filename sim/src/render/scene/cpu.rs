@@ -2,7 +2,7 @@
 //! pixel centres with perspective-correct interpolation of normal, colour and position.
 
 use super::{CleanRender, InstanceImage, SceneGeometry, SceneRenderer};
-use crate::render_device::RenderError;
+use crate::render::device::RenderError;
 use glam::{DVec2, DVec3};
 
 #[derive(Clone, Copy, Debug, Default)]

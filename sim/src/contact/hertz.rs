@@ -3,9 +3,14 @@
 //! gives the pressure, and each body takes its compliance share of the approach. The gel's
 //! lateral field is Johnson's half-space solution (eq. 3.41a) under that pressure.
 
+use super::fidelity::Fidelity;
 use super::grid::Grid;
+use super::influence::half_space_lateral_ratio;
+use super::problem::ContactProblem;
+use super::solution::{ContactSolution, FieldModel, GelFields};
 use glam::DVec2;
-use tactex_core::hertz::Hertz;
+use tactex_core::hertz::{Elastic, Hertz};
+use tactex_core::tactile::spec::GelSpec;
 
 /// The equivalent sphere of a contact.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -121,11 +126,94 @@ pub fn gel_radial_mm(hertz: &Hertz, r: f64, gel_compliance: f64, t_inf: f64) -> 
     2.0 / 3.0 * t_inf * gel_compliance * p0 * a * a / r * shape
 }
 
+pub(super) fn solve(
+    problem: &ContactProblem,
+    grid: Grid,
+    separation: &[f64],
+    warnings: &mut Vec<String>,
+) -> ContactSolution {
+    let heights: Vec<f64> = separation.iter().map(|s| s + problem.approach_mm).collect();
+    let sphere = equivalent_sphere(&grid, &heights, problem.approach_mm);
+    let mut sphere = sphere.unwrap_or(EquivalentSphere {
+        centre_mm: grid.centre(grid.nx / 2, grid.ny / 2),
+        radius_mm: f64::INFINITY,
+    });
+    if sphere.radius_mm.is_nan() || sphere.radius_mm >= 1e3 {
+        warnings.push(
+            "hertz assumes a locally spherical contact, but this surface is flat there: radius capped at 1 m"
+                .into(),
+        );
+        sphere.radius_mm = 1e3;
+    }
+    let gel = Elastic {
+        modulus_mpa: Some(problem.gel.modulus_mpa),
+        poisson: problem.gel.poisson,
+    };
+    let hertz = Hertz {
+        radius_mm: sphere.radius_mm,
+        approach_mm: problem.approach_mm,
+        contact_modulus_mpa: tactex_core::hertz::contact_modulus_mpa(gel, problem.object),
+    };
+    let gel_share = tactex_core::hertz::gel_share(gel, problem.object);
+    let model = FieldModel::Hertz {
+        hertz,
+        centre_mm: sphere.centre_mm,
+        gel_share,
+    };
+    let fields = hertz_fields(&grid, &hertz, sphere.centre_mm, gel_share, &problem.gel);
+    let pressure = (0..grid.len())
+        .map(|k| {
+            let r = (grid.centre(k % grid.nx, k / grid.nx) - sphere.centre_mm).length();
+            hertz.pressure_mpa(r)
+        })
+        .collect();
+    let mut s = ContactSolution::assemble(problem, Fidelity::Hertz, grid, pressure, fields, model);
+    // The level's answer is the analytic one, not the grid sums.
+    let a = hertz.contact_radius_mm();
+    s.force_n = hertz.force_n();
+    s.contact_radius_mm = a;
+    s.contact_area_mm2 = std::f64::consts::PI * a * a;
+    s.max_pressure_mpa = hertz.max_pressure_mpa();
+    s.gel_max_indentation_mm = gel_share * problem.approach_mm;
+    s.object_max_indentation_mm = (1.0 - gel_share) * problem.approach_mm;
+    s
+}
+
+/// The gel's fields under a Hertz contact centred at `centre`.
+pub(super) fn hertz_fields(
+    grid: &Grid,
+    hertz: &Hertz,
+    centre: DVec2,
+    gel_share: f64,
+    gel: &GelSpec,
+) -> GelFields {
+    let gel_c = (1.0 - gel.poisson * gel.poisson) / gel.modulus_mpa;
+    let t_inf = half_space_lateral_ratio(gel.poisson);
+    let n = grid.len();
+    let (mut normal, mut lx, mut ly) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    for q in 0..n {
+        let d = grid.centre(q % grid.nx, q / grid.nx) - centre;
+        let r = d.length();
+        normal[q] = gel_share * hertz.total_displacement_mm(r);
+        if r > 0.0 {
+            let ur = gel_radial_mm(hertz, r, gel_c, t_inf);
+            lx[q] = ur * d.x / r;
+            ly[q] = ur * d.y / r;
+        }
+    }
+    GelFields {
+        grid: *grid,
+        normal_mm: normal,
+        lateral_x_mm: lx,
+        lateral_y_mm: ly,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::elastic::grid::Rect;
-    use crate::elastic::surface::ObjectSurface;
+    use crate::contact::grid::Rect;
+    use crate::contact::surface::ObjectSurface;
 
     #[test]
     fn recovers_an_ellipsoids_gaussian_curvature_radius() {

@@ -306,8 +306,8 @@ pub fn solve(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::elastic::convolution::wrapped_kernel;
-    use crate::elastic::influence::love_normal;
+    use crate::contact::convolution::wrapped_kernel;
+    use crate::contact::influence::love_normal;
 
     /// A rigid sphere of radius 5 mm pressed 0.2 mm into a half-space of unit compliance on
     /// a 24x24 grid of 0.25 mm cells: the contact set grows, clips and settles, so the

@@ -4,10 +4,10 @@
 //! markers and noise are randomised. Each sample is drawn from (seed, index, attempt) alone, so
 //! any shard of a data set can be generated anywhere, in any order.
 
-use crate::elastic::{ContactSolver, Fidelity, ObjectSurface};
-use crate::gel_render::SensorOptics;
+use crate::contact::{ContactSolver, Fidelity, ObjectSurface};
+use crate::datagen::press_protocol::{PlannedPress, PressError, PressSetup, plan_press};
 use crate::mesh::{self, Lobe};
-use crate::press_protocol::{PlannedPress, PressError, PressSetup, plan_press};
+use crate::render::gel::SensorOptics;
 use glam::{DQuat, DVec2, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -618,7 +618,7 @@ mod tests {
             };
             let d = space.draw(&catalog, 5, 0, 0);
             let surface = d.surface(&catalog);
-            let pad = crate::elastic::Rect::centred(DVec2::new(10.1, 7.6));
+            let pad = crate::contact::Rect::centred(DVec2::new(10.1, 7.6));
             let lowest = surface.lowest_over(&pad).expect("object over the pad");
             assert!(lowest.abs() < 1e-6, "{family}: lowest {lowest}");
             // The apex sits at the drawn offset.

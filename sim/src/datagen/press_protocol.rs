@@ -1,6 +1,6 @@
 //! The paper's press protocol (`tactex_core::press::protocol`) on the contact solver alone (no world,
 //! no arm): each step of the descent is a contact solve at the step's approach, through the
-//! same per-press grid as the sim GelSight's (`pad_contact::PressGrid`). Data generation and
+//! same per-press grid as the sim GelSight's (`contact::pad::PressGrid`). Data generation and
 //! the hardness evaluations run it directly; the pipeline runs the same protocol through the
 //! device traits.
 //!
@@ -9,12 +9,12 @@
 //! renderer to draw in batches. Frame k of the descent has noise seed `frame_seed(seed, k)`,
 //! so the recorded first frame is the very frame the criterion fired on.
 
-use crate::elastic::{ContactError, ContactProblem, ContactSolver, Fidelity, ObjectSurface};
-use crate::gel_render::{
+use crate::contact::pad::{PressGrid, Spot};
+use crate::contact::{ContactError, ContactProblem, ContactSolver, Fidelity, ObjectSurface};
+use crate::render::gel::{
     CpuRenderer, GelImageFields, GelRenderer, PressFrame, RenderError, SensorOptics, image_fields,
     pad_rect,
 };
-use crate::pad_contact::{PressGrid, Spot};
 use image::RgbImage;
 use tactex_core::frames::TactileFrame;
 use tactex_core::hardness::estimate::PressSequence;

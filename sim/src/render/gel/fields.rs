@@ -4,7 +4,7 @@
 //! beyond that the gel is taken as undisturbed.
 
 use super::{GelImageFields, SensorOptics};
-use crate::elastic::{ContactSolution, ContactSolver, Rect};
+use crate::contact::{ContactSolution, ContactSolver, Rect};
 use glam::DVec2;
 use tactex_core::tactile::spec::GelSpec;
 

@@ -13,7 +13,7 @@ mod fields;
 mod gpu;
 mod noise;
 
-pub use crate::render_device::{DeviceChoice, RenderError, adapters};
+pub use crate::render::device::{DeviceChoice, RenderError, adapters};
 pub use cpu::CpuRenderer;
 pub use device::{RendererChoice, open_renderer};
 pub use fields::image_fields;

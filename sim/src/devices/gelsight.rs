@@ -1,13 +1,13 @@
 //! The simulated GelSight Mini: the pad's contact with the object it presses, solved by the
-//! elastic solver at the chosen fidelity on the world's meshes (`pad_contact`) -> the
-//! GelSight renderer (`gel_render`, CPU reference path: one frame at a time gains nothing
+//! elastic solver at the chosen fidelity on the world's meshes (`contact::pad`) -> the
+//! GelSight renderer (`render::gel`, CPU reference path: one frame at a time gains nothing
 //! from a dispatch) -> a seeded tactile frame.
 
-use crate::elastic::{ContactProblem, ContactSolver, Fidelity};
-use crate::gel_render::{
+use crate::contact::pad::{PressGrid, Spot, deepest_touch};
+use crate::contact::{ContactProblem, ContactSolver, Fidelity};
+use crate::render::gel::{
     CpuRenderer, GelImageFields, PressFrame, SensorOptics, image_fields, pad_rect,
 };
-use crate::pad_contact::{PressGrid, Spot, deepest_touch};
 use crate::world::SharedWorld;
 use tactex_core::devices::{DeviceError, TactileSensor};
 use tactex_core::frames::TactileFrame;

@@ -93,7 +93,8 @@ fn draw(
     // The D435 sees no depth in a band on the left (f B / Z pixels): keep fruit out of it.
     let k = scene.intrinsics;
     let z_cam = scene.camera_pose.position.z;
-    let band_px = k.fx * crate::depth_noise::RealSenseNoise::default().baseline_m / z_cam + 4.0;
+    let band_px =
+        k.fx * crate::devices::depth_noise::RealSenseNoise::default().baseline_m / z_cam + 4.0;
     let x_min_view = (band_px - k.cx) * z_cam / k.fx;
     // Footprints: rotated rectangles (centre, half extents, yaw) tested by separating axes.
     let mut placed: Vec<Footprint> = Vec::new();

@@ -7,42 +7,42 @@ use super::{
     GelGlow, GelImageFields, GelRenderer, PressFrame, RenderError, RenderParams, SensorOptics,
     Shading,
 };
-use crate::render_device::GpuDevice;
+use crate::render::device::GpuDevice;
 use image::RgbImage;
 use tactex_core::tactile::gel_glow::gaussian_kernel;
 use wgpu::util::DeviceExt;
 
-const COMMON: &str = include_str!("../../../shaders/common.wgsl");
+const COMMON: &str = include_str!("../../../../shaders/common.wgsl");
 
 /// Each stage's own source; the shared prelude (`common.wgsl`) goes in front of it.
 pub const SHADER_SOURCES: [(&str, &str); 7] = [
     (
         "gel_slopes",
-        include_str!("../../../shaders/gel_slopes.wgsl"),
+        include_str!("../../../../shaders/gel_slopes.wgsl"),
     ),
     (
         "gel_shading",
-        include_str!("../../../shaders/gel_shading.wgsl"),
+        include_str!("../../../../shaders/gel_shading.wgsl"),
     ),
     (
         "marker_displacement",
-        include_str!("../../../shaders/marker_displacement.wgsl"),
+        include_str!("../../../../shaders/marker_displacement.wgsl"),
     ),
     (
         "sensor_exposure",
-        include_str!("../../../shaders/sensor_exposure.wgsl"),
+        include_str!("../../../../shaders/sensor_exposure.wgsl"),
     ),
     (
         "gel_glow_rows",
-        include_str!("../../../shaders/gel_glow_rows.wgsl"),
+        include_str!("../../../../shaders/gel_glow_rows.wgsl"),
     ),
     (
         "gel_glow_columns",
-        include_str!("../../../shaders/gel_glow_columns.wgsl"),
+        include_str!("../../../../shaders/gel_glow_columns.wgsl"),
     ),
     (
         "gel_glow_apply",
-        include_str!("../../../shaders/gel_glow_apply.wgsl"),
+        include_str!("../../../../shaders/gel_glow_apply.wgsl"),
     ),
 ];
 
@@ -407,7 +407,7 @@ impl GelRenderer for GpuRenderer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render_device::shader_checks::{struct_size, validated};
+    use crate::render::device::shader_checks::{struct_size, validated};
 
     #[test]
     fn every_shader_parses_and_validates_with_naga() {
