@@ -1,5 +1,7 @@
 //! Records the commit the binary was built from, for the provenance line of generated
-//! reports (src/report/provenance.rs). Outside a git checkout it says "unknown".
+//! reports (src/report/provenance.rs); outside a git checkout it says "unknown". Under CI
+//! (CI=true) it sets `cfg(ci)`, which turns on the tests that need what `.ci/run`
+//! installs (elsewhere they are `#[ignore]`d with the reason, and `--include-ignored` runs them).
 
 use std::process::Command;
 
@@ -21,4 +23,9 @@ fn main() {
         }
     }
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rustc-check-cfg=cfg(ci)");
+    println!("cargo:rerun-if-env-changed=CI");
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        println!("cargo:rustc-cfg=ci");
+    }
 }

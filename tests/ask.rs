@@ -118,6 +118,10 @@ fn demo_scene_answers_the_softest_fruit_with_positions_hardness_and_latency() {
 }
 
 #[test]
+#[cfg_attr(
+    not(ci),
+    ignore = "needs a Vulkan adapter (lavapipe: mesa-vulkan-drivers, as .ci/run installs)"
+)]
 fn the_gpu_rendered_camera_finds_the_same_fruit_at_the_same_place() {
     let run = |device| {
         tactex(&[
@@ -133,11 +137,6 @@ fn the_gpu_rendered_camera_finds_the_same_fruit_at_the_same_place() {
     };
     let gpu = run("gpu");
     let err = String::from_utf8_lossy(&gpu.stderr).to_string();
-    // In CI (CI=true) the GPU path must really run (lavapipe); elsewhere it may be missing.
-    if !gpu.status.success() && err.contains("no Vulkan adapter") && std::env::var("CI").is_err() {
-        eprintln!("skipping the GPU path: {err}");
-        return;
-    }
     assert!(gpu.status.success(), "{err}");
     let cpu = run("cpu");
     let (gpu, cpu): (Value, Value) = (

@@ -4,21 +4,20 @@
 //! clears the safety-boundary and collision errors, with the SDK's own calls only.
 //!
 //! `.ci/run` installs the SDK, pytest, numpy and Pillow into a directory and names it in
-//! TACTEX_TEST_PYTHONPATH. Without it the test is skipped on a workstation and fails in CI
-//! (CI=true). The twin it starts listens on the controller's report ports 30001-30003 (the
+//! TACTEX_TEST_PYTHONPATH. Outside CI the test is ignored (`--include-ignored` runs it); in CI
+//! (CI=true) it fails without the SDK. The twin it starts listens on the controller's report ports 30001-30003 (the
 //! SDK's report parser knows no others): the only test here that takes them.
 
 use std::process::Command;
 
 #[test]
+#[cfg_attr(
+    not(ci),
+    ignore = "needs the xArm SDK and pytest in TACTEX_TEST_PYTHONPATH, as .ci/run installs"
+)]
 fn the_vendor_sdk_connects_presses_and_clears_faults_on_the_twin() {
     let Ok(pythonpath) = std::env::var("TACTEX_TEST_PYTHONPATH") else {
-        assert!(
-            std::env::var("CI").is_err(),
-            "TACTEX_TEST_PYTHONPATH is not set: .ci/run installs the xArm SDK there"
-        );
-        eprintln!("skipped: TACTEX_TEST_PYTHONPATH (the xArm SDK and pytest) is not set");
-        return;
+        panic!("TACTEX_TEST_PYTHONPATH is not set: .ci/run installs the xArm SDK there");
     };
     let root = env!("CARGO_MANIFEST_DIR");
     let out = Command::new("python3")

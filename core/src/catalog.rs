@@ -61,7 +61,7 @@ impl FruitSpec {
         self.stages.len() > 1
     }
 
-    pub fn answers_to(&self, word: &str) -> bool {
+    fn answers_to(&self, word: &str) -> bool {
         let w = word.to_ascii_lowercase();
         w == self.name || w == self.plural || self.synonyms.contains(&w)
     }

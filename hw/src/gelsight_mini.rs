@@ -54,7 +54,7 @@ pub fn crop_to_gel(frame: &RgbImage) -> Result<RgbImage, FrameError> {
 /// ((x + 0.5) * scale - 0.5) between its four neighbours, with no averaging over the
 /// footprint when shrinking. The image crate's filters average, which changes the pixels
 /// a vendor-trained model expects.
-pub fn resize_bilinear_like_opencv(src: &RgbImage, width: u32, height: u32) -> RgbImage {
+fn resize_bilinear_like_opencv(src: &RgbImage, width: u32, height: u32) -> RgbImage {
     let taps = |dst: u32, src_len: u32| -> Vec<(u32, u32, f32)> {
         let scale = src_len as f64 / dst as f64;
         (0..dst)

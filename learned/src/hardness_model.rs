@@ -90,7 +90,7 @@ pub struct OnnxEstimator {
 }
 
 /// The card of `model.onnx` is `model.json` beside it.
-pub fn card_path(model: &Path) -> PathBuf {
+fn card_path(model: &Path) -> PathBuf {
     model.with_extension("json")
 }
 

@@ -145,7 +145,7 @@ pub fn decode(
         .collect()
 }
 
-pub fn box_iou(a: &[f64; 4], b: &[f64; 4]) -> f64 {
+fn box_iou(a: &[f64; 4], b: &[f64; 4]) -> f64 {
     let iw = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
     let ih = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
     let inter = iw * ih;
@@ -155,7 +155,7 @@ pub fn box_iou(a: &[f64; 4], b: &[f64; 4]) -> f64 {
 }
 
 /// Greedy per-class non-maximum suppression, best score first, at most `max` kept.
-pub fn non_max_suppression(mut candidates: Vec<Candidate>, iou: f64, max: usize) -> Vec<Candidate> {
+fn non_max_suppression(mut candidates: Vec<Candidate>, iou: f64, max: usize) -> Vec<Candidate> {
     candidates.sort_by(|a, b| b.score.total_cmp(&a.score));
     let mut kept: Vec<Candidate> = Vec::new();
     for c in candidates {

@@ -55,7 +55,7 @@ impl TriMesh {
     }
 
     /// Scales each axis so the bounding box is `size` and centres it at the origin.
-    pub fn fit_box(mut self, size: DVec3) -> Self {
+    fn fit_box(mut self, size: DVec3) -> Self {
         let (lo, hi) = self.bounds();
         let scale = size / (hi - lo).max(DVec3::splat(1e-12));
         let centre = (lo + hi) / 2.0;

@@ -130,7 +130,7 @@ struct ObjectMeta {
 /// bananas); beyond that no draw fits.
 pub const MAX_FRUITS: usize = 12;
 
-pub fn parse_range(text: &str) -> Result<[usize; 2]> {
+fn parse_range(text: &str) -> Result<[usize; 2]> {
     let parsed = match text.split_once('-') {
         Some((a, b)) => a.trim().parse().ok().zip(b.trim().parse().ok()),
         None => text.trim().parse().ok().map(|n| (n, n)),
@@ -156,7 +156,7 @@ fn scene_seed(seed: u64, index: usize) -> u64 {
 
 /// The outer contour of a mask's largest region, simplified, as polygon vertices (pixel
 /// coordinates, the convention of OpenCV's contours that Ultralytics' converters use).
-pub fn mask_polygon(mask: &GrayImage) -> Option<Vec<Point<i32>>> {
+fn mask_polygon(mask: &GrayImage) -> Option<Vec<Point<i32>>> {
     let contours = find_contours::<i32>(mask);
     let outer = contours
         .iter()

@@ -117,7 +117,7 @@ struct ManifestLine<'a> {
     warnings: &'a [String],
 }
 
-pub fn parse_shard(text: &str) -> Result<(u64, u64)> {
+fn parse_shard(text: &str) -> Result<(u64, u64)> {
     let parsed = text
         .split_once('/')
         .and_then(|(i, n)| Some((i.trim().parse::<u64>().ok()?, n.trim().parse::<u64>().ok()?)));

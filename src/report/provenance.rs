@@ -18,7 +18,7 @@ pub fn write_markdown_report(path: &Path, body: &str) -> Result<()> {
 }
 
 /// "_Made on 2026-11-25 from commit 1084872 by `tactex bench ask --out docs/results/bench`._"
-pub fn provenance_line() -> String {
+fn provenance_line() -> String {
     let command = command_line(std::env::args().skip(1));
     format!(
         "_Made on {} from commit {BUILD_COMMIT} by `{command}`._",

@@ -537,7 +537,7 @@ impl Controller {
 
 /// The world pose of the pad at SDK pose `p`: the base's axes are the table's, the
 /// orientation is the SDK's roll-pitch-yaw (fixed axes x, y, z).
-pub fn world_pose(mount: &ArmMount, p: &TcpPoseMm) -> Pose {
+fn world_pose(mount: &ArmMount, p: &TcpPoseMm) -> Pose {
     Pose::new(
         mount.base_m + DVec3::new(p[0], p[1], p[2]) * 1e-3,
         DQuat::from_euler(EulerRot::ZYX, p[5], p[4], p[3]),

@@ -20,7 +20,7 @@ pub enum ReportKind {
 
 impl ReportKind {
     /// Bytes in one report of this kind, its length prefix included.
-    pub fn byte_len(self) -> usize {
+    fn byte_len(self) -> usize {
         match self {
             ReportKind::Real => 135,
             ReportKind::Normal => 145,

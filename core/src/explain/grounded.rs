@@ -220,7 +220,7 @@ pub fn check_invented(
 
 /// The second half of `check`: every answering object with its hardness and ripeness, and
 /// every kind not found, is in `reply`.
-pub fn check_dropped(reply: &str, facts: &Facts, catalog: &FruitCatalog) -> Result<(), Ungrounded> {
+fn check_dropped(reply: &str, facts: &Facts, catalog: &FruitCatalog) -> Result<(), Ungrounded> {
     let said = words(reply);
     let says = |w: &str| said.iter().any(|s| s == w);
     let mentions_fruit = |name: &str| {

@@ -39,7 +39,7 @@ fn object(i: usize, m: &Measured, facts: &Facts) -> Value {
 }
 
 /// The facts as the model sees them.
-pub fn facts_json(facts: &Facts) -> Value {
+fn facts_json(facts: &Facts) -> Value {
     json!({
         "question": facts.prompt,
         "asked_property": facts.query.property,

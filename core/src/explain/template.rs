@@ -48,7 +48,7 @@ pub fn range_percent(e: f64, [lo, hi]: [f64; 2]) -> [f64; 2] {
 
 /// "36 Shore A (1.46 MPa, likely -9% to +7%)", "55 Shore 00 (0.29 MPa)", "rigid". The range
 /// is the 68% interval, whose coverage is measured (`eval fruits`), relative to the estimate.
-pub fn describe_hardness(h: &HardnessReport, likely: Option<[f64; 2]>) -> String {
+fn describe_hardness(h: &HardnessReport, likely: Option<[f64; 2]>) -> String {
     let Some(e) = h.modulus_mpa else {
         return "rigid".into();
     };

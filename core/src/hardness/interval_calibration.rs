@@ -97,7 +97,7 @@ pub fn is_elongated(first_contact_aspect: f64) -> bool {
 
 /// Whether an estimate's first contact was elongated, as its evidence says (None: its
 /// evidence does not say).
-pub fn elongated_contact(evidence: &Evidence) -> Option<bool> {
+fn elongated_contact(evidence: &Evidence) -> Option<bool> {
     match evidence {
         Evidence::Physics(PhysicsEvidence {
             first_contact_aspect: Some(aspect),
@@ -188,7 +188,7 @@ impl IntervalCalibration {
     }
 
     /// The recentred estimate of a raw `modulus_mpa`.
-    pub fn recentred(&self, modulus_mpa: f64, elongated: bool) -> f64 {
+    fn recentred(&self, modulus_mpa: f64, elongated: bool) -> f64 {
         let (bins, _, _) = self.group(elongated);
         modulus_mpa * shift_at(&centres(bins), modulus_mpa.ln()).exp()
     }

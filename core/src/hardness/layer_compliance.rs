@@ -49,7 +49,7 @@ pub fn normal_compliance_ratio(kh: f64, nu: f64) -> f64 {
 /// The Hankel transform of p0 sqrt(1 - r^2/a^2) is p0 a^2 j1(ka) / (ka), whose integral over
 /// k is p0 a pi / 4, so the ratio is 1 - (4 / pi) int_0^inf j1(x)/x (1 - K(x h/a)) dx; 1 - K
 /// decays like e^(-2kh), so the integral stops at kh = 40.
-pub fn hertz_centre_compliance_ratio(contact_over_thickness: f64, nu: f64) -> f64 {
+fn hertz_centre_compliance_ratio(contact_over_thickness: f64, nu: f64) -> f64 {
     let aoh = contact_over_thickness;
     if aoh.is_nan() || aoh <= 0.0 {
         return 1.0;

@@ -97,11 +97,6 @@ impl PressProtocol {
         }
         Ok(())
     }
-
-    /// The deepest recorded frame lies this far below the first contact frame (mm).
-    pub fn recorded_span_mm(&self) -> f64 {
-        (self.frames.saturating_sub(1)) as f64 * self.step_mm
-    }
 }
 
 /// Runs the protocol on `probe` (see the module docs).

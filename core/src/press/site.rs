@@ -79,7 +79,7 @@ impl HeightMap {
     }
 
     /// The highest point in the cells `pad` overlaps; -inf if none.
-    pub fn highest_in(&self, pad: &Footprint) -> f64 {
+    fn highest_in(&self, pad: &Footprint) -> f64 {
         self.under(pad)
             .map(|(_, t)| t)
             .fold(f64::NEG_INFINITY, f64::max)

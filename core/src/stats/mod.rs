@@ -1,28 +1,23 @@
 //! Statistics of the paper's validation tables, each checked against scipy's or numpy's
-//! values in its tests: rank tests (Mann-Whitney U), t-tests (Welch, one-sample), Levene's
-//! test (median-centred), Shapiro-Wilk (Royston), Holm-Bonferroni, Spearman's rank
-//! correlation, sample quantiles, t and Wilson confidence intervals, and the regression
-//! metrics RMSE and R^2. Distribution
-//! functions come from statrs.
+//! values in its tests: rank tests (Mann-Whitney U), t-tests (Welch, one-sample),
+//! Holm-Bonferroni, Spearman's rank correlation, sample quantiles, t and Wilson confidence
+//! intervals, and the regression metrics RMSE and R^2. Distribution functions come from
+//! statrs.
 
 mod correlation;
 mod intervals;
-mod levene;
 mod mann_whitney;
 mod multiple;
 mod quantile;
 mod ranks;
-mod shapiro_wilk;
 mod t_tests;
 
 pub use correlation::{r_squared, rmse, spearman};
 pub use intervals::{mean_interval, proportion_interval};
-pub use levene::levene_median;
 pub use mann_whitney::{MannWhitneyMethod, mann_whitney_u};
 pub use multiple::holm_bonferroni;
 pub use quantile::quantile;
 pub use ranks::average_ranks;
-pub use shapiro_wilk::shapiro_wilk;
 pub use t_tests::{one_sample_t, welch_t};
 
 /// Which way the alternative hypothesis points (the first sample larger: `Greater`).

@@ -145,7 +145,7 @@ impl Default for SampleRule {
 
 /// Slope of the gel's indentation (dw/dx, dw/dy) at offset (dx, dy) mm from the centre of a
 /// ball of radius `r`: the gel takes the sphere's shape, deepest at the centre.
-pub fn ball_slope(dx: f64, dy: f64, r: f64) -> Option<(f64, f64)> {
+fn ball_slope(dx: f64, dy: f64, r: f64) -> Option<(f64, f64)> {
     let rho2 = dx * dx + dy * dy;
     (rho2 < r * r).then(|| {
         let s = (r * r - rho2).sqrt();

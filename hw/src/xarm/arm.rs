@@ -8,7 +8,7 @@ use tactex_core::glam::{DQuat, DVec3, EulerRot};
 
 /// A world pose as the controller's TCP pose, for an arm whose base frame is the world frame
 /// shifted to `base_in_world_m` (axes aligned).
-pub fn tcp_pose_of(pose: &Pose, base_in_world_m: DVec3) -> TcpPose {
+fn tcp_pose_of(pose: &Pose, base_in_world_m: DVec3) -> TcpPose {
     let p = (pose.position - base_in_world_m) * 1e3;
     // R = Rz(yaw) Ry(pitch) Rx(roll): intrinsic Z-Y-X, which glam calls EulerRot::ZYX.
     let (yaw, pitch, roll) = pose.rotation.to_euler(EulerRot::ZYX);
@@ -22,7 +22,7 @@ pub fn tcp_pose_of(pose: &Pose, base_in_world_m: DVec3) -> TcpPose {
     }
 }
 
-pub fn pose_of(tcp: &TcpPose, base_in_world_m: DVec3) -> Pose {
+fn pose_of(tcp: &TcpPose, base_in_world_m: DVec3) -> Pose {
     Pose::new(
         DVec3::new(tcp.x_mm, tcp.y_mm, tcp.z_mm) * 1e-3 + base_in_world_m,
         DQuat::from_euler(EulerRot::ZYX, tcp.yaw_rad, tcp.pitch_rad, tcp.roll_rad),

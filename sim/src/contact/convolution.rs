@@ -77,7 +77,7 @@ impl Convolver {
         out
     }
 
-    pub fn spectrum_into(&mut self, field: &[f64], out: &mut Spectrum) {
+    fn spectrum_into(&mut self, field: &[f64], out: &mut Spectrum) {
         self.forward_field(field);
         out.0.clone_from(&self.work);
     }

@@ -53,7 +53,7 @@ fn fit_quadric(points: &[(DVec2, f64)]) -> Option<[f64; 6]> {
 
 /// Fits the sphere to the cells of `heights` (relative to first touch) below `level`. On a
 /// saddle or a near-cylinder the smaller curvature is capped at 1/20 of the larger.
-pub fn equivalent_sphere(grid: &Grid, heights: &[f64], level: f64) -> Option<EquivalentSphere> {
+fn equivalent_sphere(grid: &Grid, heights: &[f64], level: f64) -> Option<EquivalentSphere> {
     let lowest = (0..heights.len()).min_by(|&a, &b| heights[a].total_cmp(&heights[b]))?;
     if !heights[lowest].is_finite() {
         return None;
@@ -112,7 +112,7 @@ pub fn equivalent_sphere(grid: &Grid, heights: &[f64], level: f64) -> Option<Equ
 
 /// The gel's radial displacement at r under the Hertz pressure (Johnson eq. 3.41a), for a
 /// gel of compliance `gel_compliance` and half-space lateral ratio `t_inf`.
-pub fn gel_radial_mm(hertz: &Hertz, r: f64, gel_compliance: f64, t_inf: f64) -> f64 {
+fn gel_radial_mm(hertz: &Hertz, r: f64, gel_compliance: f64, t_inf: f64) -> f64 {
     let a = hertz.contact_radius_mm();
     if a <= 0.0 || r <= 0.0 {
         return 0.0;

@@ -43,7 +43,7 @@ pub fn love_normal(x: f64, y: f64, a: f64) -> f64 {
 
 /// Displacement along x at offset (x, y) from a cell of half side `a` for a point response
 /// x / (pi r^2) (the half-space lateral kernel without its factor T_inf).
-pub fn love_lateral_x(x: f64, y: f64, a: f64) -> f64 {
+fn love_lateral_x(x: f64, y: f64, a: f64) -> f64 {
     // H(X, Y) = double antiderivative of X / (X^2 + Y^2).
     let h = |u: f64, v: f64| {
         let r2 = u * u + v * v;

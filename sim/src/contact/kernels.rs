@@ -148,7 +148,7 @@ impl GridKernels {
 }
 
 /// sum_i w_i S_i over spectra of one shape.
-pub fn combine(terms: &[(f64, &Spectrum)]) -> Spectrum {
+fn combine(terms: &[(f64, &Spectrum)]) -> Spectrum {
     let len = terms[0].1.0.len();
     let mut out = vec![Complex::default(); len];
     for (w, s) in terms {

@@ -41,7 +41,7 @@ pub struct PadTouch {
 
 /// `mesh` (world, m) in the pad frame of a pad at `tool` (mm), only the triangles that can
 /// meet the gel over `pad`; None when none can.
-pub fn surface_under_pad(mesh: &TriMesh, tool: &Pose, pad: &Rect) -> Option<ObjectSurface> {
+fn surface_under_pad(mesh: &TriMesh, tool: &Pose, pad: &Rect) -> Option<ObjectSurface> {
     let to_pad = tool.inverse();
     let reach = pad.grown(PAD_MARGIN_MM);
     // Cheap rejection on the world bounding box's corners first.

@@ -6,7 +6,6 @@
 use super::grid::{Grid, Rect};
 use crate::mesh::TriMesh;
 use glam::{DVec2, DVec3};
-use tactex_core::geometry::Pose;
 
 /// An object's shape, placed over the pad.
 #[derive(Clone, Debug)]
@@ -48,20 +47,6 @@ fn check_positive(name: &str, v: f64) -> Result<(), String> {
 }
 
 impl ObjectSurface {
-    /// A mesh in world coordinates (m) seen from a pad at `tool` (its z axis pointing from the
-    /// gel into the object).
-    pub fn from_world_mesh(mesh: &TriMesh, tool: &Pose) -> Self {
-        let to_tool = tool.inverse();
-        ObjectSurface::Mesh(TriMesh {
-            vertices: mesh
-                .vertices
-                .iter()
-                .map(|v| to_tool.transform_point(*v) * 1e3)
-                .collect(),
-            triangles: mesh.triangles.clone(),
-        })
-    }
-
     /// A mesh in its own frame (z up, any unit times `scale_to_mm`) pressed from above at the
     /// middle of its top: the pad frame flips z (and y, to stay right-handed).
     pub fn from_mesh_top(mesh: &TriMesh, scale_to_mm: f64) -> Self {

@@ -84,7 +84,7 @@ const NOISE_FLOOR_FRAME: usize = 1 << 20;
 
 /// The noise seed of frame `k` of a descent seeded `seed` (splitmix-style mixing, so that
 /// neighbouring seeds and frames give unrelated noise).
-pub fn frame_seed(seed: u32, k: usize) -> u32 {
+fn frame_seed(seed: u32, k: usize) -> u32 {
     let mut z = (seed as u64) << 32 | k as u64;
     z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);

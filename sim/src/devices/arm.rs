@@ -39,7 +39,7 @@ impl SimArm {
     }
 
     /// Duration of a trapezoidal-profile move of `distance` at cruise `speed`.
-    pub fn move_duration_s(&self, distance: f64, speed: f64) -> f64 {
+    fn move_duration_s(&self, distance: f64, speed: f64) -> f64 {
         let v = speed.min(self.max_speed_m_s);
         let a = self.max_accel_m_s2;
         if distance <= v * v / a {

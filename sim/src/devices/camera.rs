@@ -68,10 +68,6 @@ impl SimCamera {
         self.clean = None;
     }
 
-    pub fn renderer_name(&self) -> String {
-        self.renderer.name()
-    }
-
     /// The scene without noise, with instance ids (the ground truth); rendered once.
     pub fn clean(&mut self) -> Result<&CleanRender, RenderError> {
         if self.clean.is_none() {

@@ -59,17 +59,6 @@ pub struct CleanDepth<'a> {
 }
 
 impl RealSenseNoise {
-    /// 1-sigma depth error at depth z (m): Z^2 s / (f B).
-    pub fn depth_sigma_m(&self, z: f64, fx: f64) -> f64 {
-        z * z * self.subpixel_sigma_px / (fx * self.baseline_m)
-    }
-
-    /// Width in pixels of the invalid band on the left edge for a surface at depth z: the
-    /// disparity f B / Z.
-    pub fn invalid_band_px(&self, z: f64, fx: f64) -> f64 {
-        fx * self.baseline_m / z
-    }
-
     /// One noisy depth frame (m, 0 = no depth).
     pub fn apply<R: Rng>(&self, clean: &CleanDepth, rng: &mut R) -> Vec<f32> {
         let (w, h) = (clean.width, clean.height);
@@ -196,7 +185,8 @@ mod tests {
         let (w, h, fx, z) = (300, 10, 600.0, 0.6);
         let plane = Plane::new(w, h, fx, z);
         let frame = noise.apply(&plane.view(), &mut ChaCha8Rng::seed_from_u64(2));
-        let band = noise.invalid_band_px(z, fx);
+        // The invalid band on the left edge is as wide as the disparity f B / Z.
+        let band = fx * noise.baseline_m / z;
         assert_eq!(band, 50.0);
         for y in 0..h {
             assert!(frame[y * w..y * w + 49].iter().all(|v| *v == 0.0));

@@ -106,7 +106,7 @@ pub trait GelRenderer {
 
 /// The synthetic no-contact frame of a GelSight-like sensor: a bluish-grey pad lit from the
 /// sides (vignetting is applied by the renderer, not baked in).
-pub fn synthetic_background(width: u32, height: u32) -> Vec<[f32; 3]> {
+fn synthetic_background(width: u32, height: u32) -> Vec<[f32; 3]> {
     let (w, h) = (width as f32, height as f32);
     (0..height)
         .flat_map(|j| (0..width).map(move |i| (i, j)))
