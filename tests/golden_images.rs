@@ -16,8 +16,8 @@ use tactex_core::hertz::Elastic;
 use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_sim::contact::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
 use tactex_sim::render::gel::{
-    CpuRenderer, DeviceChoice, GelImageFields, GelRenderer, PressFrame, SensorOptics,
-    image_fields, open_renderer, pad_rect,
+    CpuRenderer, DeviceChoice, GelImageFields, GelRenderer, PressFrame, SensorOptics, image_fields,
+    open_renderer, pad_rect,
 };
 
 const SEED: u32 = 7;
@@ -31,7 +31,10 @@ fn profiles() -> Vec<(&'static str, SensorProfile)> {
     let fots = root().join("tests/fixtures/fots/profile/fots-9.toml");
     vec![
         ("mini", SensorProfile::gelsight_mini()),
-        ("fots-9", SensorProfile::load(&fots).expect("the fixture profile loads")),
+        (
+            "fots-9",
+            SensorProfile::load(&fots).expect("the fixture profile loads"),
+        ),
     ]
 }
 

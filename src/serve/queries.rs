@@ -14,20 +14,20 @@ const KEPT: usize = 32;
 
 /// One server-sent event: its name and JSON data.
 #[derive(Clone, Debug)]
-pub struct LoggedEvent {
+pub(super) struct LoggedEvent {
     pub name: &'static str,
     pub data: String,
 }
 
 #[derive(Default)]
-pub struct QueryLog {
+pub(super) struct QueryLog {
     pub events: Vec<LoggedEvent>,
     pub done: bool,
     /// Each answered object's press, in the answer's object order.
     pub presses: Vec<Option<PressSequence>>,
 }
 
-pub struct QueryRun {
+pub(super) struct QueryRun {
     pub id: u64,
     pub log: watch::Sender<QueryLog>,
 }
@@ -53,12 +53,12 @@ impl QueryRun {
             .send_modify(|log| log.events.push(LoggedEvent { name, data }));
     }
 
-    pub fn progress(&self, progress: &Progress) {
+    pub(super) fn progress(&self, progress: &Progress) {
         let data = serde_json::to_string(progress).unwrap_or_else(|e| format!("\"{e}\""));
         self.push("progress", data);
     }
 
-    pub fn answered(&self, mut answer: Answer) {
+    pub(super) fn answered(&self, mut answer: Answer) {
         let presses = std::mem::take(&mut answer.presses);
         let tactile = presses
             .iter()
@@ -87,7 +87,7 @@ impl QueryRun {
         });
     }
 
-    pub fn failed(&self, message: &str) {
+    pub(super) fn failed(&self, message: &str) {
         self.log.send_modify(|log| {
             log.events.push(failure(message));
             log.done = true;
@@ -103,14 +103,14 @@ fn failure(message: &str) -> LoggedEvent {
 }
 
 #[derive(Default)]
-pub struct QueryStore {
+pub(super) struct QueryStore {
     next_id: u64,
     runs: VecDeque<Arc<QueryRun>>,
 }
 
 impl QueryStore {
     /// A new question's run; the oldest finished ones are forgotten beyond [`KEPT`].
-    pub fn start(&mut self) -> Arc<QueryRun> {
+    pub(super) fn start(&mut self) -> Arc<QueryRun> {
         self.next_id += 1;
         let (log, _) = watch::channel(QueryLog::default());
         let run = Arc::new(QueryRun {
@@ -127,13 +127,13 @@ impl QueryStore {
         run
     }
 
-    pub fn get(&self, id: u64) -> Option<Arc<QueryRun>> {
+    pub(super) fn get(&self, id: u64) -> Option<Arc<QueryRun>> {
         self.runs.iter().find(|r| r.id == id).cloned()
     }
 }
 
 /// Locks the store; a poisoned lock (a panic elsewhere while holding it) is still usable
 /// because every update leaves the store consistent.
-pub fn lock(store: &Mutex<QueryStore>) -> std::sync::MutexGuard<'_, QueryStore> {
+pub(super) fn lock(store: &Mutex<QueryStore>) -> std::sync::MutexGuard<'_, QueryStore> {
     store.lock().unwrap_or_else(|e| e.into_inner())
 }

@@ -19,7 +19,7 @@ const PRIVATE_PROTOCOLS: [u16; 2] = [2, 3];
 /// The SDK reads replies into a 1024-byte buffer; no request is longer.
 const MAX_FRAME_BODY: usize = 1024;
 
-pub fn serve_control(listener: TcpListener, twin: &std::sync::Arc<Twin>) {
+pub(super) fn serve_control(listener: TcpListener, twin: &std::sync::Arc<Twin>) {
     for stream in listener.incoming().flatten() {
         let twin = twin.clone();
         std::thread::spawn(move || {
@@ -74,7 +74,7 @@ fn control_client(mut stream: TcpStream, twin: &Twin) -> Result<(), String> {
     }
 }
 
-pub fn serve_reports(listener: TcpListener, kind: ReportKind, twin: &std::sync::Arc<Twin>) {
+pub(super) fn serve_reports(listener: TcpListener, kind: ReportKind, twin: &std::sync::Arc<Twin>) {
     for stream in listener.incoming().flatten() {
         let twin = twin.clone();
         std::thread::spawn(move || report_client(stream, kind, &twin));

@@ -26,7 +26,7 @@ use tactex_hw::session::record::depth_to_u16;
 
 type Shared = Arc<Twin>;
 
-pub fn serve(listener: TcpListener, twin: Shared) -> Result<()> {
+pub(super) fn serve(listener: TcpListener, twin: Shared) -> Result<()> {
     listener.set_nonblocking(true)?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)

@@ -6,7 +6,7 @@ use std::process::{Command, Output};
 
 /// `tactex ARGS` run from the repository root (with a runtime dir, so that the Vulkan
 /// loader keeps stderr clean where a command looks for a GPU).
-pub fn tactex(args: &[&str]) -> Output {
+pub(crate) fn tactex(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_tactex"))
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -16,7 +16,7 @@ pub fn tactex(args: &[&str]) -> Output {
 }
 
 /// The JSON a successful run printed (its stderr shown if it failed).
-pub fn json(out: &Output) -> serde_json::Value {
+pub(crate) fn json(out: &Output) -> serde_json::Value {
     assert!(
         out.status.success(),
         "{}",
@@ -27,7 +27,7 @@ pub fn json(out: &Output) -> serde_json::Value {
 
 /// The failure's stderr, after checking it is one line, the exit code is 1 and nothing was
 /// printed on stdout.
-pub fn one_line_error(out: &Output) -> String {
+pub(crate) fn one_line_error(out: &Output) -> String {
     assert_eq!(
         out.status.code(),
         Some(1),
@@ -42,7 +42,7 @@ pub fn one_line_error(out: &Output) -> String {
 
 /// The built-in GelSight Mini profile under another name, written to `dir/NAME.toml`: the
 /// same sensor, which outputs must name as given.
-pub fn renamed_stock_profile(dir: &std::path::Path, name: &str) -> std::path::PathBuf {
+pub(crate) fn renamed_stock_profile(dir: &std::path::Path, name: &str) -> std::path::PathBuf {
     let stock = tactex(&["sensor", "show", "--toml"]);
     assert!(stock.status.success());
     let text = String::from_utf8(stock.stdout).unwrap().replacen(

@@ -4,7 +4,7 @@
 use std::io::{BufRead, BufReader};
 use std::process::{Child, ChildStdout, Command, Stdio};
 
-pub struct Server {
+pub(crate) struct Server {
     child: Child,
     /// Kept open so that the server never writes into a closed pipe.
     _stdout: BufReader<ChildStdout>,
@@ -14,7 +14,7 @@ pub struct Server {
 
 impl Server {
     /// Starts `tactex serve --port 0 EXTRA...` and waits for the address it prints.
-    pub fn start(extra: &[&str]) -> Server {
+    pub(crate) fn start(extra: &[&str]) -> Server {
         let mut child = Command::new(env!("CARGO_BIN_EXE_tactex"))
             .args(["serve", "--port", "0"])
             .args(extra)

@@ -80,14 +80,14 @@ fn reduce_rows(
 }
 
 /// Grey-level closing of `img` by a disk of `radius` px.
-pub fn close_with_disk(img: &GrayImage, radius: u8) -> GrayImage {
+pub(super) fn close_with_disk(img: &GrayImage, radius: u8) -> GrayImage {
     let widths = half_widths(radius);
     reduce_rows(&reduce_rows(img, &widths, u8::max), &widths, u8::min)
 }
 
 /// Closing of a binary image (0 or 255) by the (2k + 1)-pixel square: fills gaps narrower
 /// than the square.
-pub fn close_binary_with_square(img: &GrayImage, k: u8) -> GrayImage {
+pub(super) fn close_binary_with_square(img: &GrayImage, k: u8) -> GrayImage {
     let widths = vec![usize::from(k); 2 * usize::from(k) + 1];
     reduce_rows(&reduce_rows(img, &widths, u8::max), &widths, u8::min)
 }

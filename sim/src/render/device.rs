@@ -205,7 +205,7 @@ pub(crate) mod shader_checks {
     use wgpu::naga;
 
     /// Parses and validates WGSL with naga, panicking with the located message.
-    pub fn validated(label: &str, source: &str) -> naga::Module {
+    pub(crate) fn validated(label: &str, source: &str) -> naga::Module {
         let module = naga::front::wgsl::parse_str(source)
             .unwrap_or_else(|e| panic!("{label}: {}", e.emit_to_string(source)));
         naga::valid::Validator::new(
@@ -218,7 +218,7 @@ pub(crate) mod shader_checks {
     }
 
     /// The size in bytes of the WGSL struct `name`, laid out as the shader sees it.
-    pub fn struct_size(source: &str, name: &str) -> usize {
+    pub(crate) fn struct_size(source: &str, name: &str) -> usize {
         let module = naga::front::wgsl::parse_str(source).unwrap();
         let ty = module
             .types

@@ -8,7 +8,7 @@ use tactex_sim::SimDevices;
 
 /// One frame of the twin's noisy camera through the classical detector, with the camera's
 /// intrinsics and pose.
-pub fn detect_classical(
+pub(crate) fn detect_classical(
     sim: &mut SimDevices,
     catalog: &FruitCatalog,
 ) -> (Vec<Detection>, CameraIntrinsics, Pose) {
@@ -27,7 +27,7 @@ pub fn detect_classical(
 /// Where the middle of a detection's mask lies on the table (x, y in metres), taking the
 /// fruit's visible surface 3 cm up.
 #[allow(dead_code)]
-pub fn mask_centre_m(d: &Detection, k: &CameraIntrinsics, pose: &Pose) -> [f64; 2] {
+pub(crate) fn mask_centre_m(d: &Detection, k: &CameraIntrinsics, pose: &Pose) -> [f64; 2] {
     let (mut u, mut v, mut n) = (0.0, 0.0, 0.0);
     for (x, y, m) in d.mask.enumerate_pixels() {
         if m[0] > 0 {

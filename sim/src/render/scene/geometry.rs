@@ -8,7 +8,7 @@ use glam::DVec3;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 
 /// Triangles with a vertex closer to the camera than this are left out (by both renderers).
-pub const NEAR_M: f64 = 0.01;
+pub(super) const NEAR_M: f64 = 0.01;
 const TABLE_HEIGHT_M: f64 = 0.74;
 const FLOOR_COLOR: [f64; 3] = [0.25, 0.24, 0.23];
 const FLOOR_HALF_SIZE_M: f64 = 10.0;

@@ -20,7 +20,7 @@ const Z_BUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The shader's uniform block (see `scene_raster.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct SceneParams {
+pub(super) struct SceneParams {
     world_to_camera: [[f32; 4]; 4],
     focal_centre: [f32; 4],
     viewport: [f32; 4],
