@@ -1,6 +1,6 @@
 """The vendor's xArm Python SDK against `tactex twin`, with the SDK's own calls only.
 
-Run by tests/twin_sdk.rs (which starts nothing itself: this file starts the twin from
+Run by tests/integration/twin_sdk.rs (which starts nothing itself: this file starts the twin from
 TACTEX_BIN). The control port is set through the SDK's configuration (XCONF.SocketConf);
 the SDK's report parser only knows the controller's report ports 30001-30003, so the twin
 serves its reports there.

@@ -320,7 +320,7 @@ fn chromaticity(rgb: [f64; 3]) -> [f64; 2] {
 
 /// The share of a fruit's length and width that the 2nd-98th percentile spread of the points
 /// the camera sees on it covers: the steep flanks show few pixels and the far side none. Read
-/// on the twin's camera for every catalog kind (`sim/tests/fruit_footprint.rs`: 0.905-0.937
+/// on the twin's camera for every catalog kind (`sim/tests/integration/fruit_footprint.rs`: 0.905-0.937
 /// of the true extent before this correction, when it was the 0.96 of uniform points).
 const VISIBLE_SPREAD: f64 = 0.885;
 

@@ -16,7 +16,7 @@
 //! Measured on the 31 FOTS real ball presses against the hand-marked circles: median centre
 //! error 3.9 px (0.20 mm at 19.58 px/mm), radius error +0.4 px median and 1.9 px mean
 //! absolute (about 5% of a 40 px radius), 25 of 31 centres within 5 px
-//! (`tests/sim_to_real.rs`; `tactex compare` reports it per image).
+//! (`tests/integration/sim_to_real.rs`; `tactex compare` reports it per image).
 
 use super::circle_fit::fit_circle;
 use super::slopes::is_dark;

@@ -2,10 +2,9 @@
 //! frames served, the same answer as `tactex ask`, bad requests answered with errors while the
 //! server keeps serving, and the limit on questions at once.
 
-mod serve_process;
 
 use serde_json::Value;
-use serve_process::Server;
+use crate::serve_process::Server;
 use std::io::{BufRead, BufReader, Read};
 use std::process::Command;
 use std::time::Duration;

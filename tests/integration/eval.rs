@@ -2,8 +2,7 @@
 //! and `eval explanations` end to end on small runs: their JSON contracts, plots and raw records, tests
 //! that recompute from the raw predictions, and bad input named.
 
-mod cli;
-use cli::tactex;
+use crate::cli::tactex;
 use std::process::Command;
 
 /// `tactex eval ARGS --json --out DIR` into a fresh DIR: the directory and stdout's JSON.
@@ -139,7 +138,7 @@ fn the_trained_model_answers_alike_on_tract_and_onnx_runtime() {
 fn stages_are_told_apart_and_each_test_recomputes_from_the_predictions() {
     // Through a profile file (the built-in one renamed): the report names the sensor.
     let profiles = tempfile::tempdir().unwrap();
-    let profile = cli::renamed_stock_profile(profiles.path(), "lab mini");
+    let profile = crate::cli::renamed_stock_profile(profiles.path(), "lab mini");
     let (dir, r) = eval_json(&[
         "ripeness",
         "--fruits",

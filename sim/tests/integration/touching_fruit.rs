@@ -1,7 +1,6 @@
 //! Crowded tables: fruits drawn against each other settle touching, and the classical
 //! detector tells touching fruits apart (the watershed on height) on the twin's noisy camera.
 
-mod common;
 
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
@@ -68,7 +67,7 @@ ripeness = "ripe"
         );
         world.objects.iter().map(|o| o.centre.to_array()).collect()
     };
-    let (found, k, pose) = common::detect_classical(&mut sim, &catalog);
+    let (found, k, pose) = crate::common::detect_classical(&mut sim, &catalog);
     assert_eq!(
         found.len(),
         2,
@@ -78,7 +77,7 @@ ripeness = "ripe"
     for d in &found {
         assert_eq!(d.label, "tomato");
         // Each mask's centre lies over one tomato, not on the seam between them.
-        let p = common::mask_centre_m(d, &k, &pose);
+        let p = crate::common::mask_centre_m(d, &k, &pose);
         let nearest = centres
             .iter()
             .map(|c| (p[0] - c[0]).hypot(p[1] - c[1]))
@@ -125,12 +124,12 @@ modulus_mpa = 0.2
             .map(|o| (o.label.clone(), o.centre.to_array()))
             .collect()
     };
-    let (found, k, pose) = common::detect_classical(&mut sim, &catalog);
+    let (found, k, pose) = crate::common::detect_classical(&mut sim, &catalog);
     let mut labels: Vec<&str> = found.iter().map(|d| d.label.as_str()).collect();
     labels.sort();
     assert_eq!(labels, ["apple", "strawberry"]);
     for d in &found {
-        let p = common::mask_centre_m(d, &k, &pose);
+        let p = crate::common::mask_centre_m(d, &k, &pose);
         let (_, c) = centres.iter().find(|(l, _)| *l == d.label).unwrap();
         let off = (p[0] - c[0]).hypot(p[1] - c[1]);
         assert!(off < 0.012, "{}'s mask centred {off} m from it", d.label);

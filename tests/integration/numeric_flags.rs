@@ -3,7 +3,6 @@
 //! table lists the flags that parse as numbers (found by giving each flag of `--help` a word
 //! in place of its value); each subcommand runs with what it needs besides.
 
-mod cli;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 

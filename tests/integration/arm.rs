@@ -1,7 +1,6 @@
 //! `tactex arm` against the fake xArm controller (tactex-hw) running in this test process.
 
-mod cli;
-use cli::one_line_error;
+use crate::cli::one_line_error;
 use serde_json::Value;
 use std::process::{Command, Output};
 use tactex_hw::xarm::fake_controller::FakeController;

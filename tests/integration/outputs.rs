@@ -2,8 +2,7 @@
 //! found it (so the corrected run is accepted), and a directory another tactex writes into
 //! is refused with one line, not shared.
 
-mod cli;
-use cli::tactex;
+use crate::cli::tactex;
 use std::path::Path;
 use std::process::Output;
 

@@ -4,9 +4,8 @@
 
 use image::RgbImage;
 use std::path::{Path, PathBuf};
-mod cli;
 
-use cli::{json, tactex};
+use crate::cli::{json, tactex};
 use tactex_core::ground::centroid::median;
 use tactex_core::tactile::ball_calibration::read_annotations;
 use tactex_core::tactile::contact::{ContactRule, contact_evidence};

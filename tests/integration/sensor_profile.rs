@@ -3,9 +3,8 @@
 //! --sensor` renders with it, and bad profiles fail in one line naming the field.
 
 use std::path::{Path, PathBuf};
-mod cli;
 
-use cli::{json, one_line_error, tactex};
+use crate::cli::{json, one_line_error, tactex};
 use tactex_core::tactile::markers::grid_pitch_px;
 use tactex_core::tactile::ssim::ssim_rgb;
 
@@ -327,7 +326,7 @@ fn calibrate_reads_the_marker_grid_from_a_real_marker_frame_and_press_draws_it()
 #[test]
 fn the_learned_model_says_so_when_it_reads_another_sensor_than_it_was_trained_on() {
     let dir = tempfile::tempdir().unwrap();
-    let profile = cli::renamed_stock_profile(dir.path(), "lab mini");
+    let profile = crate::cli::renamed_stock_profile(dir.path(), "lab mini");
     let ask = |extra: &[&str]| {
         let mut args = vec![
             "ask",

@@ -214,7 +214,7 @@ fn gpu_renders_match_the_golden_images_within_the_gpu_tolerance() {
         let golden = load_golden(&name);
         let (mean, max) = differences(&frame, &golden);
         eprintln!("{name} on {}: mean {mean:.4?}, max {max}", gpu.name());
-        // The tolerance of the GPU path against the CPU path (sim/tests/gel_render.rs).
+        // The tolerance of the GPU path against the CPU path (sim/tests/integration/gel_render.rs).
         if mean.iter().any(|m| *m > 1.0) || max > 4 {
             failures.push(format!(
                 "{name}: mean |difference| {mean:.4?}, max {max}; {}",

@@ -1,9 +1,8 @@
 //! `tactex press` and `tactex bench contact` from the command line: the JSON contract, the
 //! maps on disk, and clear one-line errors for bad input.
 
-mod cli;
 
-use cli::{json, tactex};
+use crate::cli::{json, tactex};
 use std::process::Command;
 
 #[test]

@@ -2,8 +2,7 @@
 //! repeated, non-finite or too many rows, and images larger than any sensor gives, are each
 //! one line naming the file (and line), before any of them is fitted or decoded.
 
-mod cli;
-use cli::{one_line_error, tactex};
+use crate::cli::{one_line_error, tactex};
 use std::path::Path;
 
 const FOTS: &str = "tests/fixtures/fots";

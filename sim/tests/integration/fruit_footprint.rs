@@ -2,7 +2,6 @@
 //! the camera sees on it: that measurement must read every catalog kind's true size, or a
 //! green tomato reads as small as a lime.
 
-mod common;
 
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::scene::ObjectKind;
@@ -26,7 +25,7 @@ fn every_catalog_fruit_is_seen_at_its_true_size_anywhere_on_the_table() {
                 size_m[2],
             ];
             let mut sim = SimDevices::from_scene(&scene, seed).unwrap();
-            let (found, _, _) = common::detect_classical(&mut sim, &catalog);
+            let (found, _, _) = crate::common::detect_classical(&mut sim, &catalog);
             assert_eq!(found.len(), 1, "{} (seed {seed})", f.name);
             ratios.push(std::array::from_fn::<f64, 3, _>(|i| {
                 found[0].size_m[i] / truth[i]

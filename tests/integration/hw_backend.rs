@@ -2,8 +2,7 @@
 //! and field, the real sensor's profile is required, a missing camera is named and the arm is
 //! not enabled, and misused flags are one-line errors.
 
-mod cli;
-use cli::one_line_error;
+use crate::cli::one_line_error;
 use std::process::{Command, Output};
 use tactex_hw::xarm::fake_controller::FakeController;
 

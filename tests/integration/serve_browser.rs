@@ -5,9 +5,8 @@
 //! packages or chromium it fails; outside CI (CI=true) it is ignored unless asked for,
 //! where `.ci/run` installs them.
 
-mod serve_process;
 
-use serve_process::Server;
+use crate::serve_process::Server;
 use std::path::Path;
 use std::process::Command;
 

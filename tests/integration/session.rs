@@ -2,8 +2,7 @@
 //! from the recording gives the same answer, hardness and robot time; a replay that asks
 //! for other moves, and broken sessions, are one-line errors.
 
-mod cli;
-use cli::{one_line_error, tactex};
+use crate::cli::{one_line_error, tactex};
 use serde_json::Value;
 use std::path::Path;
 use std::process::Output;
