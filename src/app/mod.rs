@@ -3,6 +3,7 @@
 //! choosing the detector, estimator and explainer, and answering a question on the twin, on
 //! the real devices or from a recorded session.
 
+pub mod ball_presses;
 pub mod detector_choice;
 pub mod estimator_choice;
 pub mod explainer_choice;
@@ -10,6 +11,7 @@ pub mod hardware;
 pub mod image_input;
 pub mod question;
 pub mod replay;
+pub mod sample_space;
 pub mod scene;
 pub mod sensor;
 pub mod twin;

@@ -10,8 +10,8 @@
 //! of the ball's radius, rendered with the sensor's camera noise and without marker dots (a
 //! calibration gel carries none; neither do FOTS's ball presses).
 
+use crate::app::ball_presses::rebuild;
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic, write_png_atomic};
-use crate::sim2real::ball_presses::rebuild;
 use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};

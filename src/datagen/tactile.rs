@@ -14,6 +14,7 @@
 //! manifest line is appended; a rerun skips every sample with a complete line and redoes the
 //! rest, so an interrupted run resumes and gives the same bytes as an uninterrupted one.
 
+use crate::app::sample_space::sample_space;
 use crate::report::npz::{NpyArray, npz_bytes};
 use crate::report::output::{write_bytes_atomic, write_json_atomic};
 use anyhow::{Context, Result, bail};
@@ -28,9 +29,9 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::contact::ContactEvidence;
 use tactex_core::tactile::sensor_profile::ProfileId;
-use tactex_sim::contact::{ContactSolver, Fidelity};
+use tactex_sim::contact::ContactSolver;
 use tactex_sim::datagen::press_protocol::PlannedPress;
-use tactex_sim::datagen::tactile_sample::{SampleDraw, SampleSpace, ShapeFamily};
+use tactex_sim::datagen::tactile_sample::{SampleDraw, SampleSpace};
 use tactex_sim::render::gel::{CpuRenderer, DeviceChoice, GelRenderer, open_renderer};
 
 const FORMAT: &str = "tactex-tactile-dataset/1";
@@ -265,28 +266,6 @@ fn manifest_line(s: &Sample, files: Vec<String>) -> Result<String> {
     let mut text = serde_json::to_string(&line)?;
     text.push('\n');
     Ok(text)
-}
-
-/// The sample space the arguments describe.
-pub fn sample_space(fidelity: &str, shapes: &[String]) -> Result<SampleSpace> {
-    let fidelity: Fidelity = fidelity
-        .parse()
-        .map_err(|e| anyhow::anyhow!("--fidelity: {e}"))?;
-    let mut families = Vec::new();
-    for s in shapes {
-        let f: ShapeFamily = s.parse().map_err(|e| anyhow::anyhow!("--shapes: {e}"))?;
-        if !families.contains(&f) {
-            families.push(f);
-        }
-    }
-    if families.is_empty() {
-        bail!("--shapes: name at least one shape family");
-    }
-    Ok(SampleSpace {
-        families,
-        fidelity,
-        ..SampleSpace::default()
-    })
 }
 
 /// Prepares DIR: checks or writes dataset.json. Errors name the path or the differing field.

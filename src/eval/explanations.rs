@@ -17,7 +17,7 @@
 //! * clarity: every number carries a unit, at most 40 words per fruit described (plus 20).
 
 use crate::app::explainer_choice::{ExplainerChoice, explainer};
-use crate::eval::scenarios::others;
+use crate::eval::other_paper_kinds;
 use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::plot::{self, BarSeries};
 use crate::report::provenance::write_markdown_report;
@@ -140,7 +140,7 @@ pub fn case(index: usize, seed: u64, catalog: &FruitCatalog) -> Result<Case> {
     let mut rng = ChaCha8Rng::seed_from_u64(base);
     let category = CATEGORIES[index % CATEGORIES.len()];
     let n = 1 + (index / CATEGORIES.len()) % 6;
-    let kinds = others(&mut rng, &[], n);
+    let kinds = other_paper_kinds(&mut rng, &[], n);
     let scene = random_scene(&kinds, catalog, base, &Variation::default())
         .with_context(|| format!("case {index}: scene"))?;
     let truth: Vec<TrueFruit> = scene
@@ -170,7 +170,8 @@ pub fn case(index: usize, seed: u64, catalog: &FruitCatalog) -> Result<Case> {
             .filter(|&j| e(i).max(e(j)) / e(i).min(e(j)) < TIE_RATIO)
             .collect()
     };
-    let absent_kind = || others(&mut ChaCha8Rng::seed_from_u64(base ^ 0xab5e), &kinds, 1)[0];
+    let absent_kind =
+        || other_paper_kinds(&mut ChaCha8Rng::seed_from_u64(base ^ 0xab5e), &kinds, 1)[0];
     let (prompt, absent, expected) = match category {
         Category::LocateMeasure => {
             if index.is_multiple_of(5) {

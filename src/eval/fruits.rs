@@ -15,7 +15,7 @@
 use crate::app::detector_choice::DetectorChoice;
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::app::{Twin, TwinAnswer};
-use crate::eval::scenarios::match_reports;
+use crate::eval::report_matching::match_reports;
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::report::plot::{self, BarSeries, ScatterSeries};
 use crate::report::provenance::write_markdown_report;

@@ -101,7 +101,7 @@ struct PressRecord {
 }
 
 pub fn run(args: &HardnessEvalArgs) -> Result<()> {
-    let mut space = crate::datagen::tactile::sample_space(&args.fidelity, &args.shapes)?;
+    let mut space = crate::app::sample_space::sample_space(&args.fidelity, &args.shapes)?;
     if args.sensor.is_some() {
         space = space.around(crate::app::load_sensor(args.sensor.as_deref())?);
     }

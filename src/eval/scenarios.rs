@@ -18,7 +18,8 @@
 use crate::app::detector_choice::DetectorChoice;
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::app::{Twin, TwinAnswer};
-use crate::eval::PAPER_FRUIT_KINDS;
+use crate::eval::report_matching::match_reports;
+use crate::eval::{PAPER_FRUIT_KINDS, other_paper_kinds};
 use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::plot::{self, BarSeries};
 use crate::report::provenance::write_markdown_report;
@@ -33,7 +34,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::explain::TemplateExplainer;
-use tactex_core::pipeline::{Answer, PipelineConfig};
+use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
 use tactex_sim::contact::Fidelity;
 use tactex_sim::datagen::scene_random::{Variation, random_scene};
@@ -178,18 +179,6 @@ fn true_modulus(scene: &Scene, i: usize) -> f64 {
         .unwrap_or(f64::INFINITY)
 }
 
-/// Distinct kinds other than `not`, shuffled.
-pub(crate) fn others(rng: &mut ChaCha8Rng, not: &[&str], n: usize) -> Vec<&'static str> {
-    let mut pool: Vec<&'static str> = PAPER_FRUIT_KINDS
-        .iter()
-        .copied()
-        .filter(|k| !not.contains(k))
-        .collect();
-    pool.shuffle(rng);
-    pool.truncate(n);
-    pool
-}
-
 /// The scenario of `run` in `tier`: its scene, question and what the question asks about.
 pub fn scenario(tier: u8, run: usize, seed: u64, catalog: &FruitCatalog) -> Result<Scenario> {
     let base = seed
@@ -207,7 +196,7 @@ pub fn scenario(tier: u8, run: usize, seed: u64, catalog: &FruitCatalog) -> Resu
     let (prompt, kinds, scene, asked, extreme) = match tier {
         1 => {
             let mut kinds = vec![target];
-            kinds.extend(others(&mut rng, &[target], run % 4));
+            kinds.extend(other_paper_kinds(&mut rng, &[target], run % 4));
             kinds.shuffle(&mut rng);
             let (names, scene) = build(kinds, base)?;
             let asked = vec![names.iter().position(|k| k == target).expect("placed")];
@@ -219,7 +208,7 @@ pub fn scenario(tier: u8, run: usize, seed: u64, catalog: &FruitCatalog) -> Resu
             let target = staged[run % staged.len()];
             let softest = run.is_multiple_of(2);
             let mut kinds = vec![target; 2 + run % 2];
-            kinds.extend(others(&mut rng, &[target], run % 3));
+            kinds.extend(other_paper_kinds(&mut rng, &[target], run % 3));
             kinds.shuffle(&mut rng);
             // Fruits of one kind at one stage have one modulus and no softest: draw again
             // until the true extreme stands apart.
@@ -254,9 +243,9 @@ pub fn scenario(tier: u8, run: usize, seed: u64, catalog: &FruitCatalog) -> Resu
             (prompt, names, scene, same, Some(best))
         }
         3 => {
-            let second = others(&mut rng, &[target], 1)[0];
+            let second = other_paper_kinds(&mut rng, &[target], 1)[0];
             let mut kinds = vec![target, second];
-            kinds.extend(others(&mut rng, &[target, second], run % 3));
+            kinds.extend(other_paper_kinds(&mut rng, &[target, second], run % 3));
             kinds.shuffle(&mut rng);
             let (names, scene) = build(kinds, base)?;
             let asked = [target, second]
@@ -269,7 +258,7 @@ pub fn scenario(tier: u8, run: usize, seed: u64, catalog: &FruitCatalog) -> Resu
         4 => {
             let n = 3 + run % 3;
             let mut kinds = vec![target];
-            kinds.extend(others(&mut rng, &[target], n - 1));
+            kinds.extend(other_paper_kinds(&mut rng, &[target], n - 1));
             kinds.shuffle(&mut rng);
             let (names, scene) = build(kinds, base)?;
             let asked = (0..names.len()).collect();
@@ -288,38 +277,6 @@ pub fn scenario(tier: u8, run: usize, seed: u64, catalog: &FruitCatalog) -> Resu
         extreme,
         scene,
     })
-}
-
-/// Which report identifies which scene object: a report of the object's kind whose surface
-/// centroid (where the arm will touch) lies on the object in the clean render, as in
-/// `eval grounding`; the highest-scoring such report when there are several.
-pub(crate) fn match_reports(
-    answer: &Answer,
-    kinds: &[String],
-    twin: &TwinAnswer,
-) -> Vec<Option<usize>> {
-    let (k, to_camera) = (twin.intrinsics, twin.camera_pose.inverse());
-    let id_under = |p: [f64; 3]| -> Option<usize> {
-        let (u, v) = k.project(to_camera.transform_point(glam::DVec3::from_array(p)))?;
-        let inside = u >= 0.0 && v >= 0.0 && (u as u32) < k.width && (v as u32) < k.height;
-        let id = inside.then(|| twin.instances.get_pixel(u as u32, v as u32)[0])?;
-        (id > 0).then(|| id as usize - 1)
-    };
-    let mut of_object: Vec<Option<usize>> = vec![None; kinds.len()];
-    for (r, report) in answer.objects.iter().enumerate() {
-        let Some(o) = id_under(report.surface_centroid_m) else {
-            continue;
-        };
-        if kinds[o] != report.label {
-            continue;
-        }
-        let better =
-            of_object[o].is_none_or(|q| report.detection_score > answer.objects[q].detection_score);
-        if better {
-            of_object[o] = Some(r);
-        }
-    }
-    of_object
 }
 
 /// Scores one answer against the scenario's ground truth.
@@ -667,7 +624,7 @@ mod tests {
     use tactex_core::devices::RgbdCamera;
     use tactex_core::explain::location_words;
     use tactex_core::hardness::scale::Hardness;
-    use tactex_core::pipeline::ObjectReport;
+    use tactex_core::pipeline::{Answer, ObjectReport};
     use tactex_sim::SimDevices;
 
     /// The twin's ground truth for a scenario, and a perfect answer: one report per asked

@@ -2,9 +2,9 @@
 //! glow round a contact from the same presses rebuilt in the twin, measures the camera's
 //! noise, and writes a sensor profile (TOML + its background PNG beside it).
 
+use crate::app::ball_presses::{self, Split, contact_box, rebuild};
 use crate::cli::flag_range::{above, within};
 use crate::report::output::write_profile_atomic;
-use crate::sim2real::ball_presses::{self, Split, contact_box, rebuild};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbImage;

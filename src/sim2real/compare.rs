@@ -8,9 +8,9 @@
 //! contact circle is estimated on the real frame and on the rendered one and scored against
 //! the marked circle.
 
+use crate::app::ball_presses::{self, Split, contact_box, rebuild};
 use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic};
 use crate::report::side_by_side::side_by_side;
-use crate::sim2real::ball_presses::{self, Split, contact_box, rebuild};
 use crate::sim2real::compare_session::SessionCompare;
 use crate::sim2real::contact_circle_score::{CircleScore, CircleSummary, score_circle, summarise};
 use anyhow::{Result, bail};

@@ -1,7 +1,6 @@
 //! Sim-to-real: fitting a sensor profile from ball presses, and scoring the twin's renders
 //! and recorded sessions against real frames.
 
-pub mod ball_presses;
 pub mod calibrate;
 pub mod compare;
 pub mod compare_session;

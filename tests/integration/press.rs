@@ -1,7 +1,6 @@
 //! `tactex press` and `tactex bench contact` from the command line: the JSON contract, the
 //! maps on disk, and clear one-line errors for bad input.
 
-
 use crate::cli::{json, tactex};
 use std::process::Command;
 

@@ -2,9 +2,8 @@
 //! frames served, the same answer as `tactex ask`, bad requests answered with errors while the
 //! server keeps serving, and the limit on questions at once.
 
-
-use serde_json::Value;
 use crate::serve_process::Server;
+use serde_json::Value;
 use std::io::{BufRead, BufReader, Read};
 use std::process::Command;
 use std::time::Duration;

@@ -5,7 +5,6 @@
 //! packages or chromium it fails; outside CI (CI=true) it is ignored unless asked for,
 //! where `.ci/run` installs them.
 
-
 use crate::serve_process::Server;
 use std::path::Path;
 use std::process::Command;

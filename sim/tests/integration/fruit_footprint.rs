@@ -2,7 +2,6 @@
 //! the camera sees on it: that measurement must read every catalog kind's true size, or a
 //! green tomato reads as small as a lime.
 
-
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::scene::ObjectKind;
 use tactex_sim::SimDevices;

@@ -1,7 +1,6 @@
 //! Crowded tables: fruits drawn against each other settle touching, and the classical
 //! detector tells touching fruits apart (the watershed on height) on the twin's noisy camera.
 
-
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::scene::Scene;
