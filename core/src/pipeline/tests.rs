@@ -1,0 +1,128 @@
+//! The pipeline on the fake devices (fake_devices.rs).
+
+use super::fake_devices::*;
+use super::*;
+use crate::tactile::spec::TactileSpec;
+use std::cell::Cell;
+use std::rc::Rc;
+
+fn ask(centre: (f64, f64), shows: bool, refuse_below_m: f64) -> Answer {
+    ask_on(centre, None, shows, refuse_below_m)
+}
+
+fn ask_on(
+    centre: (f64, f64),
+    object_m: Option<(f64, f64)>,
+    shows: bool,
+    refuse_below_m: f64,
+) -> Answer {
+    let z = Rc::new(Cell::new(0.3));
+    let xy = Rc::new(Cell::new((0.0, 0.0)));
+    let mut gel = Gel {
+        z: z.clone(),
+        xy: xy.clone(),
+        first_xy: Cell::new(None),
+        centre,
+        object_m,
+        shows,
+        spec: TactileSpec::gelsight_mini(),
+    };
+    let mut arm = FakeArm {
+        z,
+        xy,
+        refuse_below_m,
+    };
+    answer(
+        "How hard is the apple?",
+        &FruitCatalog::builtin(),
+        Devices {
+            camera: &mut Camera,
+            tactile: &mut gel,
+            arm: &mut arm,
+        },
+        &OneApple,
+        &TwoMpa,
+        &explain::TemplateExplainer,
+        &PipelineConfig::default(),
+    )
+    .expect("the question is answered")
+}
+
+#[test]
+fn a_press_records_eight_frames_from_the_first_contact_frame() {
+    let a = ask((48.0, 40.0), true, 0.0);
+    let o = &a.objects[0];
+    assert!(o.not_measured.is_none(), "{:?}", o.not_measured);
+    assert_eq!(o.hardness.unwrap().modulus_mpa, Some(2.0));
+    let evidence = o.contact.as_ref().unwrap();
+    assert!(evidence.contact && !evidence.fired_by.is_empty());
+    // The search starts 4 mm above the top the camera saw and fires once the disc shows.
+    let search = o.contact_search_mm.unwrap();
+    assert!((4.0..=5.0).contains(&search), "{search}");
+    let press = a.presses[0].as_ref().unwrap();
+    assert_eq!(press.travel_mm.len(), 8);
+    for (j, t) in press.travel_mm.iter().enumerate() {
+        assert!((t - 0.25 * j as f64).abs() < 1e-9, "{t}");
+    }
+    assert!(
+        a.answer.contains("2.00 MPa") || a.answer.contains("Shore"),
+        "{}",
+        a.answer
+    );
+}
+
+#[test]
+fn a_gel_that_never_changes_is_no_contact_not_a_failed_question() {
+    let a = ask((48.0, 40.0), false, 0.0);
+    let o = &a.objects[0];
+    let why = o.not_measured.as_ref().unwrap();
+    assert_eq!(why.reason, NotMeasuredReason::NoContact);
+    assert!(o.hardness.is_none());
+    assert!(
+        a.answer
+            .contains("could not measure (no contact within 20 mm"),
+        "{}",
+        a.answer
+    );
+}
+
+#[test]
+fn a_refused_move_is_reported_with_the_arms_reason() {
+    // The arm will not go below 1 mm above the apple's top: the search is cut short.
+    let a = ask((48.0, 40.0), true, TOP_M + 0.001);
+    let why = a.objects[0].not_measured.as_ref().unwrap();
+    assert_eq!(why.reason, NotMeasuredReason::ArmRefused);
+    assert!(why.detail.contains("crush limit"), "{}", why.detail);
+    assert!(
+        a.answer.contains("the arm refused the press"),
+        "{}",
+        a.answer
+    );
+}
+
+#[test]
+fn an_imprint_at_the_frames_edge_wherever_the_pad_goes_is_reported_as_cut() {
+    let a = ask((4.0, 40.0), true, 0.0);
+    let why = a.objects[0].not_measured.as_ref().unwrap();
+    assert_eq!(why.reason, NotMeasuredReason::ImprintCut);
+    assert!(
+        why.detail.contains("again with the pad moved"),
+        "{}",
+        why.detail
+    );
+    assert!(a.objects[0].hardness.is_none());
+}
+
+#[test]
+fn an_imprint_at_the_frames_edge_is_pressed_again_with_the_pad_over_it() {
+    // The pad's first contact lies 44 px (of 96) left of the frame's middle: the object
+    // is 9.3 mm off along the world's -x. The second press, moved there, is centred.
+    let mm_per_px = 320.0 * 0.0634 / 96.0;
+    let object = (-44.0 * mm_per_px * 1e-3, 0.0);
+    let a = ask_on((0.0, 0.0), Some(object), true, 0.0);
+    let o = &a.objects[0];
+    assert!(o.not_measured.is_none(), "{:?}", o.not_measured);
+    assert_eq!(o.hardness.unwrap().modulus_mpa, Some(2.0));
+    assert_eq!(o.warnings.len(), 1, "{:?}", o.warnings);
+    assert!(o.warnings[0].contains("moved 9."), "{}", o.warnings[0]);
+}
