@@ -7,6 +7,7 @@ pub mod ball_presses;
 pub mod detector_choice;
 pub mod estimator_choice;
 pub mod explainer_choice;
+pub mod flag_range;
 pub mod hardware;
 pub mod image_input;
 pub mod question;

@@ -43,7 +43,7 @@ pub struct AskBenchArgs {
     #[arg(long)]
     sensor: Option<PathBuf>,
     /// Timed questions at each fidelity (the median is reported); one more, untimed, warms up; 1 to 1000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(1, 1000), default_value_t = 5)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(1, 1000), default_value_t = 5)]
     reps: usize,
     /// Seed of the sim devices.
     #[arg(long, default_value_t = 0)]

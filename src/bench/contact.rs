@@ -30,18 +30,18 @@ pub struct ContactBenchArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Timed repetitions of each 8-frame press (the median is reported); 1 to 1000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(1, 1000), default_value_t = 5)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(1, 1000), default_value_t = 5)]
     reps: usize,
     /// Solver cells to time (mm, 0.02 to 5, or "auto" for the default grid).
     #[arg(long, value_delimiter = ',', default_value = "auto,0.4,0.2,0.1")]
     cells: Vec<String>,
     /// Finest cell (mm, 0.01 to 1): the reference `layer` solution.
-    #[arg(long, default_value_t = 0.05, value_parser = crate::cli::flag_range::within(0.01, 1.0))]
+    #[arg(long, default_value_t = 0.05, value_parser = crate::app::flag_range::within(0.01, 1.0))]
     reference_cell_mm: f64,
     /// Stopping tolerances to time besides the default (1e-12 to 0.5), for `layer` on the
     /// first cell.
     #[arg(long, value_delimiter = ',', default_value = "1e-3,1e-4,1e-5,1e-8",
-          value_parser = crate::cli::flag_range::within(1e-12, 0.5))]
+          value_parser = crate::app::flag_range::within(1e-12, 0.5))]
     tolerances: Vec<f64>,
 }
 

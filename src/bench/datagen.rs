@@ -15,7 +15,7 @@ use tactex_sim::render::gel::DeviceChoice;
 #[derive(Args, Debug)]
 pub struct DatagenBenchArgs {
     /// Sequences generated per fidelity level; 1 to 100000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<u64>(1, 100_000), default_value_t = 48)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<u64>(1, 100_000), default_value_t = 48)]
     count: u64,
     /// Fidelity levels to time (comma-separated).
     #[arg(

@@ -30,10 +30,10 @@ pub struct RenderBenchArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Timed repetitions of each 8-frame press (the median is reported); 1 to 1000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(1, 1000), default_value_t = 5)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(1, 1000), default_value_t = 5)]
     reps: usize,
     /// Frames per GPU dispatch for the batch row (data generation renders many at once); 1 to 4096.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(1, 4096), default_value_t = 64)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(1, 4096), default_value_t = 64)]
     batch: usize,
     /// Sensor profile to render with (default: the built-in GelSight Mini).
     #[arg(long)]

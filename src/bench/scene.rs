@@ -26,7 +26,7 @@ pub struct SceneBenchArgs {
     #[arg(long)]
     scene: Option<PathBuf>,
     /// Timed repetitions of each measurement (the median is reported); 1 to 1000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(1, 1000), default_value_t = 9)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(1, 1000), default_value_t = 9)]
     reps: usize,
     /// Print the report as JSON.
     #[arg(long)]

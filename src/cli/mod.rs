@@ -1,7 +1,6 @@
 //! The command line: what `tactex` accepts (clap) and which library function each command
 //! runs. `main.rs` only parses, calls [`run`] and prints the error line.
 
-pub mod flag_range;
 pub mod process;
 
 use crate::{bench, commands, datagen, eval, serve, sim2real, xarm_twin};

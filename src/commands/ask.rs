@@ -45,7 +45,7 @@ pub struct AskArgs {
     pub record: Option<PathBuf>,
     /// The sim GelSight's gel modulus (MPa) instead of the stock 0.3: what a softer or
     /// harder gel would see (--backend sim); 0.01 to 50 MPa.
-    #[arg(long, value_parser = crate::cli::flag_range::within(0.01, 50.0))]
+    #[arg(long, value_parser = crate::app::flag_range::within(0.01, 50.0))]
     pub gel_modulus_mpa: Option<f64>,
     /// The question.
     pub prompt: String,

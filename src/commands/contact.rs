@@ -1,8 +1,8 @@
 //! `tactex contact`: has a tactile frame (real or rendered) touched something, and where? The
 //! paper's contact criterion against a no-contact frame, and the contact circle and region.
 
+use crate::app::flag_range::above;
 use crate::app::load_rgb;
-use crate::cli::flag_range::above;
 use anyhow::{Result, bail};
 use clap::Args;
 use serde::Serialize;

@@ -22,7 +22,7 @@ pub struct DetectArgs {
     #[arg(long, default_value_t = 0.25)]
     pub confidence: f64,
     /// NMS IoU threshold, 0 to 1 (Ultralytics' default 0.7).
-    #[arg(long, default_value_t = 0.7, value_parser = crate::cli::flag_range::within(0.0, 1.0))]
+    #[arg(long, default_value_t = 0.7, value_parser = crate::app::flag_range::within(0.0, 1.0))]
     pub iou: f64,
     /// Print one JSON object on stdout.
     #[arg(long)]

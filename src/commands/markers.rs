@@ -94,8 +94,8 @@ fn read_marker_annotations(path: &std::path::Path) -> Result<Vec<(f64, f64)>> {
                 "{}: line {}: marker at ({}, {}) px is not in an image (0 to {side} px)",
                 path.display(),
                 i + 1,
-                crate::cli::flag_range::show(x),
-                crate::cli::flag_range::show(y)
+                crate::app::flag_range::show(x),
+                crate::app::flag_range::show(y)
             );
         }
         if out.len() == MAX_MARKERS {

@@ -1,7 +1,7 @@
 //! `tactex press`: one press of the GelSight gel into a primitive or a mesh at a chosen
 //! fidelity, reported as JSON or text, with the gel maps written as 16-bit PNGs.
 
-use crate::cli::flag_range::{above, within};
+use crate::app::flag_range::{above, within};
 use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic, write_png16_atomic};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};

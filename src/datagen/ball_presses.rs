@@ -29,7 +29,7 @@ use tactex_sim::render::gel::{
 #[derive(Args, Debug)]
 pub struct BallPressDatagenArgs {
     /// Presses; 1 to 1000 (the most `calibrate` reads).
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(1, 1000))]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(1, 1000))]
     pub count: usize,
     /// Output directory.
     #[arg(long)]
@@ -40,7 +40,7 @@ pub struct BallPressDatagenArgs {
     #[arg(long)]
     pub sensor: Option<PathBuf>,
     /// The ball's radius (mm, above 0 up to 100).
-    #[arg(long, default_value_t = 2.35, value_parser = crate::cli::flag_range::above(0.0, 100.0))]
+    #[arg(long, default_value_t = 2.35, value_parser = crate::app::flag_range::above(0.0, 100.0))]
     pub ball_radius_mm: f64,
     /// Contact radii are drawn uniformly between these shares of the ball's radius, MIN,MAX
     /// (above 0, below 0.95).

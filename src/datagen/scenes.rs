@@ -55,7 +55,7 @@ const PREVIEW_SCENES: usize = 4;
 #[derive(Args, Debug)]
 pub struct SceneDatagenArgs {
     /// Scenes in the data set; 1 to 10000000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(1, 10_000_000))]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(1, 10_000_000))]
     pub count: usize,
     /// Output directory.
     #[arg(long)]

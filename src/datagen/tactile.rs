@@ -47,7 +47,7 @@ pub enum SampleFormat {
 #[derive(Args, Debug)]
 pub struct TactileDatagenArgs {
     /// Samples in the whole data set (all shards); 1 to 100000000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<u64>(1, 100_000_000))]
+    #[arg(long, value_parser = crate::app::flag_range::count::<u64>(1, 100_000_000))]
     pub(crate) count: u64,
     /// Output directory.
     #[arg(long)]

@@ -45,7 +45,7 @@ const TIE_RATIO: f64 = 1.01;
 #[derive(Args)]
 pub struct ExplanationEvalArgs {
     /// Prompts to ask (the issue: 100); 1 to 100000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(1, 100_000), default_value_t = 100)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(1, 100_000), default_value_t = 100)]
     pub prompts: usize,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,

@@ -55,7 +55,7 @@ const SINGLE_STAGE_SPAN: f64 = 1.5;
 pub struct FruitEvalArgs {
     /// Placements of each kind alone on the table (its stages in turn, every other one at a
     /// modulus between them); 0 to 1000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(0, 1000), default_value_t = 8)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(0, 1000), default_value_t = 8)]
     pub placements: usize,
     /// Crowded tables of 10-12 fruits, some touching.
     #[arg(long, default_value_t = 6)]

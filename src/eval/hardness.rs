@@ -23,7 +23,7 @@ use tactex_sim::render::gel::CpuRenderer;
 #[derive(Args, Debug)]
 pub struct HardnessEvalArgs {
     /// Held-out presses; 3 to 100000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<u64>(3, 100_000), default_value_t = 60)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<u64>(3, 100_000), default_value_t = 60)]
     count: u64,
     #[arg(long, default_value_t = 1)]
     seed: u64,

@@ -43,13 +43,13 @@ pub struct RipenessEvalArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Presses per ripeness stage; 3 to 10000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<u32>(3, 10_000), default_value_t = 20)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<u32>(3, 10_000), default_value_t = 20)]
     presses: u32,
     /// Fruits to press (catalog names; default the paper's Table III).
     #[arg(long, value_delimiter = ',')]
     fruits: Vec<String>,
     /// Log-sd of the flesh modulus from spot to spot within a fruit; 0 to 1.
-    #[arg(long, value_parser = crate::cli::flag_range::within(0.0, 1.0), default_value_t = 0.1, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::app::flag_range::within(0.0, 1.0), default_value_t = 0.1, allow_negative_numbers = true)]
     spot_spread: f64,
     /// Fidelity level of the presses.
     #[arg(long, default_value = "layer")]

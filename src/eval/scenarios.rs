@@ -49,7 +49,7 @@ const TIER2_DRAWS: u64 = 64;
 #[derive(Args)]
 pub struct ScenarioEvalArgs {
     /// Runs per tier (the paper: 10); 1 to 1000.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<usize>(1, 1000), default_value_t = 10)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<usize>(1, 1000), default_value_t = 10)]
     pub runs: usize,
     /// Detectors to compare: classical, yolo:FILE.onnx, error-gsam, error-yolo.
     #[arg(

@@ -3,7 +3,7 @@
 //! noise, and writes a sensor profile (TOML + its background PNG beside it).
 
 use crate::app::ball_presses::{self, Split, contact_box, rebuild};
-use crate::cli::flag_range::{above, within};
+use crate::app::flag_range::{above, within};
 use crate::report::output::write_profile_atomic;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -61,10 +61,10 @@ pub struct CalibrateArgs {
     #[arg(long, value_enum, default_value_t = Split::Calib)]
     pub split: Split,
     /// Table nodes over slope magnitude; 2 to 100.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<u32>(2, 100), default_value_t = 12)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<u32>(2, 100), default_value_t = 12)]
     pub mag_bins: u32,
     /// Table nodes over slope direction; 4 to 360.
-    #[arg(long, value_parser = crate::cli::flag_range::count::<u32>(4, 360), default_value_t = 24)]
+    #[arg(long, value_parser = crate::app::flag_range::count::<u32>(4, 360), default_value_t = 24)]
     pub dir_bins: u32,
     /// Largest slope (dw/dr) the table covers (above 0 up to 100).
     #[arg(long, default_value_t = 2.5, value_parser = above(0.0, 100.0))]
