@@ -15,6 +15,7 @@ pub mod replay;
 pub mod sample_space;
 pub mod scene;
 pub mod sensor;
+pub mod single_press;
 pub mod twin;
 pub mod twin_options;
 

@@ -2,20 +2,17 @@
 //! fidelity, reported as JSON or text, with the gel maps written as 16-bit PNGs.
 
 use crate::app::flag_range::{above, within};
+use crate::app::single_press::{
+    GridReport, PressReport, PressRequest, PressShape, SolvedPress, parse_marker_grid,
+};
 use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic, write_png16_atomic};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use glam::{DVec2, DVec3};
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::hardness::scale::Hardness;
-use tactex_core::hertz::Elastic;
-use tactex_sim::contact::{
-    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
-};
-use tactex_sim::render::gel::{
-    DeviceChoice, GelImageFields, PressFrame, SensorOptics, image_fields, open_renderer,
-};
+use tactex_sim::contact::{Fidelity, GelFields, Grid};
+use tactex_sim::render::gel::{DeviceChoice, open_renderer};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum Shape {
@@ -103,87 +100,37 @@ pub struct PressArgs {
     json: bool,
 }
 
-#[derive(Serialize)]
-struct GridReport {
-    cell_mm: f64,
-    nx: usize,
-    ny: usize,
-    origin_mm: [f64; 2],
-}
-
-impl From<&Grid> for GridReport {
-    fn from(g: &Grid) -> Self {
-        Self {
-            cell_mm: g.cell_mm,
-            nx: g.nx,
-            ny: g.ny,
-            origin_mm: [g.origin_mm.x, g.origin_mm.y],
-        }
-    }
-}
-
-#[derive(Serialize)]
-struct PressReport {
-    fidelity: String,
-    /// The sensor profile (after the gel and marker flags) the press used.
-    sensor: tactex_core::tactile::sensor_profile::ProfileId,
-    shape: String,
-    depth_mm: f64,
-    force_n: f64,
-    contact_radius_mm: f64,
-    contact_area_mm2: f64,
-    max_pressure_mpa: f64,
-    gel_max_indentation_mm: f64,
-    object_max_indentation_mm: f64,
-    gel_modulus_mpa: f64,
-    gel_poisson: f64,
-    gel_thickness_mm: f64,
-    object_modulus_mpa: Option<f64>,
-    object_poisson: f64,
-    object_shore_a: f64,
-    object_shore_00: f64,
-    grid: GridReport,
-    iterations: usize,
-    residual: f64,
-    warnings: Vec<String>,
-}
-
-fn surface(args: &PressArgs) -> Result<ObjectSurface> {
-    let size = |default: f64| -> Result<DVec3> {
+fn shape(args: &PressArgs) -> Result<PressShape> {
+    let size = |default: f64| -> Result<[f64; 3]> {
         match &args.size_mm {
             Some(v) => {
                 if v.len() != 3 {
                     bail!("--size-mm: give three sizes X,Y,Z in mm, got {}", v.len());
                 }
-                Ok(DVec3::new(v[0], v[1], v[2]))
+                Ok([v[0], v[1], v[2]])
             }
-            None => Ok(DVec3::splat(2.0 * default)),
+            None => Ok([2.0 * default; 3]),
         }
     };
     Ok(match args.shape {
-        Shape::Sphere => ObjectSurface::Sphere {
+        Shape::Sphere => PressShape::Sphere {
             radius_mm: args.radius_mm,
-            centre_mm: DVec2::ZERO,
         },
-        Shape::Ellipsoid => ObjectSurface::Ellipsoid {
-            semi_axes_mm: size(args.radius_mm)? / 2.0,
-            centre_mm: DVec2::ZERO,
-            yaw_rad: args.yaw_deg.to_radians(),
+        Shape::Ellipsoid => PressShape::Ellipsoid {
+            size_mm: size(args.radius_mm)?,
+            yaw_deg: args.yaw_deg,
         },
-        Shape::Box => ObjectSurface::Box {
-            size_mm: size(args.radius_mm)?.truncate(),
-            centre_mm: DVec2::ZERO,
-            yaw_rad: args.yaw_deg.to_radians(),
+        Shape::Box => PressShape::Box {
+            size_mm: size(args.radius_mm)?,
+            yaw_deg: args.yaw_deg,
         },
-        Shape::Mesh => {
-            let path = args
+        Shape::Mesh => PressShape::Mesh {
+            path: args
                 .mesh
-                .as_ref()
-                .context("--shape mesh needs --mesh FILE")?;
-            let mesh = tactex_sim::mesh::load(path)?;
-            mesh.validate(&path.display().to_string())?;
-            ObjectSurface::from_mesh_top(&mesh, args.mesh_scale * 1e3)
-        }
+                .clone()
+                .context("--shape mesh needs --mesh FILE")?,
+            scale: args.mesh_scale,
+        },
     })
 }
 
@@ -195,81 +142,46 @@ fn object(args: &PressArgs) -> Result<Hardness> {
     }
 }
 
-pub fn run(args: &PressArgs) -> Result<()> {
+/// The press the flags describe, the sensor's gel and markers overridden as they say.
+fn request(args: &PressArgs) -> Result<PressRequest> {
     let fidelity: Fidelity = args
         .fidelity
         .parse()
         .map_err(|e| anyhow::anyhow!("--fidelity: {e}"))?;
     let hardness = object(args)?;
-    let surface = surface(args)?;
-    let mut profile = crate::app::load_sensor(args.sensor.as_deref())?;
-    let spec = &mut profile.spec;
+    let shape = shape(args)?;
+    let mut sensor = crate::app::load_sensor(args.sensor.as_deref())?;
+    let spec = &mut sensor.spec;
     if let Some(grid) = &args.marker_grid {
-        let (cols, rows) = grid
-            .split_once(['x', 'X'])
-            .and_then(|(c, r)| Some((c.trim().parse::<u32>().ok()?, r.trim().parse::<u32>().ok()?)))
-            .with_context(|| {
-                format!("--marker-grid: '{grid}' is not COLSxROWS (e.g. 9x7, 11x9)")
-            })?;
-        let markers = u64::from(cols) * u64::from(rows);
-        if markers == 0 || markers > 10_000 {
-            bail!(
-                "--marker-grid: {cols}x{rows} is {markers} markers; a gel has 1 to 10000 (e.g. 9x7, 11x9)"
-            );
-        }
+        let (cols, rows) = parse_marker_grid(grid).context("--marker-grid")?;
         spec.markers.cols = cols;
         spec.markers.rows = rows;
     }
     if let Some(pitch) = args.marker_pitch_mm {
         spec.markers.pitch_mm = pitch;
     }
-    let mut gel = spec.gel;
     if let Some(t) = args.gel_thickness_mm {
-        gel.thickness_mm = t;
+        spec.gel.thickness_mm = t;
     }
     if let Some(e) = args.gel_modulus_mpa {
-        gel.modulus_mpa = e;
+        spec.gel.modulus_mpa = e;
     }
-    spec.gel = gel;
-    let pad = Rect::centred(DVec2::from(spec.pad_size_mm()) / 2.0);
-    let problem = ContactProblem {
-        surface: &surface,
-        object: Elastic {
-            modulus_mpa: hardness.modulus_mpa(),
-            poisson: args.object_poisson,
-        },
-        gel,
-        pad,
-        approach_mm: args.depth_mm,
-        cell_mm: args.grid_mm,
-    };
-    let mut solver = ContactSolver::new();
-    solver.settings.tolerance = args.tolerance;
-    let solution = solver.solve(&problem, fidelity)?;
-    let shown = tactex_core::hardness::scale::HardnessReport::from(hardness);
-    let report = PressReport {
-        fidelity: fidelity.to_string(),
-        sensor: profile.id(),
-        shape: format!("{:?}", args.shape).to_lowercase(),
-        depth_mm: args.depth_mm,
-        force_n: solution.force_n,
-        contact_radius_mm: solution.contact_radius_mm,
-        contact_area_mm2: solution.contact_area_mm2,
-        max_pressure_mpa: solution.max_pressure_mpa,
-        gel_max_indentation_mm: solution.gel_max_indentation_mm,
-        object_max_indentation_mm: solution.object_max_indentation_mm,
-        gel_modulus_mpa: gel.modulus_mpa,
-        gel_poisson: gel.poisson,
-        gel_thickness_mm: gel.thickness_mm,
-        object_modulus_mpa: hardness.modulus_mpa(),
+    Ok(PressRequest {
+        shape,
+        hardness,
         object_poisson: args.object_poisson,
-        object_shore_a: shown.shore_a,
-        object_shore_00: shown.shore_00,
-        grid: (&solution.grid).into(),
-        iterations: solution.iterations,
-        residual: solution.residual,
-        warnings: solution.warnings.clone(),
-    };
+        depth_mm: args.depth_mm,
+        fidelity,
+        cell_mm: args.grid_mm,
+        tolerance: args.tolerance,
+        sensor,
+        seed: args.seed,
+    })
+}
+
+pub fn run(args: &PressArgs) -> Result<()> {
+    let request = request(args)?;
+    let mut press = request.solve()?;
     if let Some(out) = &args.out {
         // The renderer first: a missing device fails before any file is written.
         let choice = open_renderer(args.device)?;
@@ -279,35 +191,16 @@ pub fn run(args: &PressArgs) -> Result<()> {
             eprintln!("note: {note}");
         }
         let mut renderer = choice.renderer;
-        write_maps(dir, &mut solver, &solution, &pad, &report)?;
-        let optics = SensorOptics::for_profile(&profile);
-        let fields = image_fields(&mut solver, &solution, &gel, &optics);
-        let flat = GelImageFields::flat(optics.width, optics.height);
-        // The no-contact frame draws its own camera noise, as a real one taken before the
-        // press would.
-        let mut frames = renderer.render_batch(
-            &optics,
-            &[
-                PressFrame {
-                    fields: &fields,
-                    seed: args.seed,
-                },
-                PressFrame {
-                    fields: &flat,
-                    seed: args.seed.wrapping_add(1),
-                },
-            ],
-        )?;
-        let reference = frames.pop().expect("two frames rendered");
-        let frame = frames.pop().expect("two frames rendered");
+        write_maps(dir, &mut press)?;
+        let (frame, reference) = press.render(&request, renderer.as_mut())?;
         write_png_atomic(&dir.join("tactile.png"), &frame)?;
         write_png_atomic(&dir.join("reference.png"), &reference)?;
         out.finish()?;
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        println!("{}", serde_json::to_string_pretty(&press.report)?);
     } else {
-        print_report(&report);
+        print_report(&press.report);
     }
     Ok(())
 }
@@ -370,21 +263,10 @@ struct MapEntry {
     grid: GridReport,
 }
 
-fn write_maps(
-    dir: &std::path::Path,
-    solver: &mut ContactSolver,
-    solution: &ContactSolution,
-    pad: &Rect,
-    report: &PressReport,
-) -> Result<()> {
-    // The gel moves beyond the solver grid: map it over the pad, at the solver's cell unless
-    // that would exceed 1024 cells a side.
-    let cells = pad.size().max_element() / solution.grid.cell_mm;
-    let fields: GelFields = if cells <= 1024.0 {
-        solver.fields_over(solution, pad)
-    } else {
-        solution.gel.clone()
-    };
+fn write_maps(dir: &std::path::Path, press: &mut SolvedPress) -> Result<()> {
+    // The gel moves beyond the solver grid: map it over the pad.
+    let fields: GelFields = press.pad_fields();
+    let (solution, report) = (&press.solution, &press.report);
     let maps: [(&str, &'static str, &'static str, &[f64], &Grid); 4] = [
         (
             "gel_normal.png",

@@ -1,0 +1,260 @@
+//! One press of the gel into a primitive or a mesh, solved at a chosen fidelity and rendered
+//! through a sensor profile: what `tactex press` and the Python package's `Sensor.press`
+//! both run, so that the same request gives the same frame bytes through either.
+
+use anyhow::{Context, Result, bail};
+use glam::{DVec2, DVec3};
+use image::RgbImage;
+use serde::Serialize;
+use std::path::PathBuf;
+use tactex_core::hardness::scale::{Hardness, HardnessReport};
+use tactex_core::hertz::Elastic;
+use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
+use tactex_sim::contact::{
+    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
+};
+use tactex_sim::render::gel::{
+    GelImageFields, GelRenderer, PressFrame, SensorOptics, image_fields,
+};
+
+/// What is pressed.
+#[derive(Clone, Debug)]
+pub enum PressShape {
+    Sphere {
+        radius_mm: f64,
+    },
+    /// Full extents X, Y, Z (mm), turned by `yaw_deg` about the pressing axis.
+    Ellipsoid {
+        size_mm: [f64; 3],
+        yaw_deg: f64,
+    },
+    Box {
+        size_mm: [f64; 3],
+        yaw_deg: f64,
+    },
+    /// A mesh file pressed at the middle of its top; `scale` turns mesh units into metres.
+    Mesh {
+        path: PathBuf,
+        scale: f64,
+    },
+}
+
+impl PressShape {
+    pub fn name(&self) -> &'static str {
+        match self {
+            PressShape::Sphere { .. } => "sphere",
+            PressShape::Ellipsoid { .. } => "ellipsoid",
+            PressShape::Box { .. } => "box",
+            PressShape::Mesh { .. } => "mesh",
+        }
+    }
+
+    /// The object's surface over the pad, centred on it.
+    pub fn surface(&self) -> Result<ObjectSurface> {
+        Ok(match self {
+            PressShape::Sphere { radius_mm } => ObjectSurface::Sphere {
+                radius_mm: *radius_mm,
+                centre_mm: DVec2::ZERO,
+            },
+            PressShape::Ellipsoid { size_mm, yaw_deg } => ObjectSurface::Ellipsoid {
+                semi_axes_mm: DVec3::from_array(*size_mm) / 2.0,
+                centre_mm: DVec2::ZERO,
+                yaw_rad: yaw_deg.to_radians(),
+            },
+            PressShape::Box { size_mm, yaw_deg } => ObjectSurface::Box {
+                size_mm: DVec3::from_array(*size_mm).truncate(),
+                centre_mm: DVec2::ZERO,
+                yaw_rad: yaw_deg.to_radians(),
+            },
+            PressShape::Mesh { path, scale } => {
+                let mesh = tactex_sim::mesh::load(path)?;
+                mesh.validate(&path.display().to_string())?;
+                ObjectSurface::from_mesh_top(&mesh, scale * 1e3)
+            }
+        })
+    }
+}
+
+/// One press: the object, how far past first touch, the physics, and the sensor (its gel
+/// and markers already as wanted).
+#[derive(Clone, Debug)]
+pub struct PressRequest {
+    pub shape: PressShape,
+    pub hardness: Hardness,
+    pub object_poisson: f64,
+    /// The sensor's travel past first touch (mm): total approach of gel and object.
+    pub depth_mm: f64,
+    pub fidelity: Fidelity,
+    /// Solver cell (mm); None picks one from the contact's size.
+    pub cell_mm: Option<f64>,
+    /// Relative pressure change at which the contact solve stops.
+    pub tolerance: f64,
+    pub sensor: SensorProfile,
+    /// Seed of the rendered frame's camera noise; the no-contact frame takes seed + 1.
+    pub seed: u32,
+}
+
+#[derive(Serialize)]
+pub struct GridReport {
+    pub cell_mm: f64,
+    pub nx: usize,
+    pub ny: usize,
+    pub origin_mm: [f64; 2],
+}
+
+impl From<&Grid> for GridReport {
+    fn from(g: &Grid) -> Self {
+        Self {
+            cell_mm: g.cell_mm,
+            nx: g.nx,
+            ny: g.ny,
+            origin_mm: [g.origin_mm.x, g.origin_mm.y],
+        }
+    }
+}
+
+#[derive(Serialize)]
+pub struct PressReport {
+    pub fidelity: String,
+    /// The sensor profile (after the gel and marker flags) the press used.
+    pub sensor: ProfileId,
+    pub shape: String,
+    pub depth_mm: f64,
+    pub force_n: f64,
+    pub contact_radius_mm: f64,
+    pub contact_area_mm2: f64,
+    pub max_pressure_mpa: f64,
+    pub gel_max_indentation_mm: f64,
+    pub object_max_indentation_mm: f64,
+    pub gel_modulus_mpa: f64,
+    pub gel_poisson: f64,
+    pub gel_thickness_mm: f64,
+    pub object_modulus_mpa: Option<f64>,
+    pub object_poisson: f64,
+    pub object_shore_a: f64,
+    pub object_shore_00: f64,
+    pub grid: GridReport,
+    pub iterations: usize,
+    pub residual: f64,
+    pub warnings: Vec<String>,
+}
+
+/// A press solved: its figures, and the solution with the solver that can extend its fields.
+pub struct SolvedPress {
+    pub report: PressReport,
+    pub solution: ContactSolution,
+    pub solver: ContactSolver,
+    pub pad: Rect,
+}
+
+impl PressRequest {
+    /// Solves the contact and reports its figures.
+    pub fn solve(&self) -> Result<SolvedPress> {
+        let surface = self.shape.surface()?;
+        let gel = self.sensor.spec.gel;
+        let pad = Rect::centred(DVec2::from(self.sensor.spec.pad_size_mm()) / 2.0);
+        let problem = ContactProblem {
+            surface: &surface,
+            object: Elastic {
+                modulus_mpa: self.hardness.modulus_mpa(),
+                poisson: self.object_poisson,
+            },
+            gel,
+            pad,
+            approach_mm: self.depth_mm,
+            cell_mm: self.cell_mm,
+        };
+        let mut solver = ContactSolver::new();
+        solver.settings.tolerance = self.tolerance;
+        let solution = solver.solve(&problem, self.fidelity)?;
+        let shown = HardnessReport::from(self.hardness);
+        let report = PressReport {
+            fidelity: self.fidelity.to_string(),
+            sensor: self.sensor.id(),
+            shape: self.shape.name().into(),
+            depth_mm: self.depth_mm,
+            force_n: solution.force_n,
+            contact_radius_mm: solution.contact_radius_mm,
+            contact_area_mm2: solution.contact_area_mm2,
+            max_pressure_mpa: solution.max_pressure_mpa,
+            gel_max_indentation_mm: solution.gel_max_indentation_mm,
+            object_max_indentation_mm: solution.object_max_indentation_mm,
+            gel_modulus_mpa: gel.modulus_mpa,
+            gel_poisson: gel.poisson,
+            gel_thickness_mm: gel.thickness_mm,
+            object_modulus_mpa: self.hardness.modulus_mpa(),
+            object_poisson: self.object_poisson,
+            object_shore_a: shown.shore_a,
+            object_shore_00: shown.shore_00,
+            grid: (&solution.grid).into(),
+            iterations: solution.iterations,
+            residual: solution.residual,
+            warnings: solution.warnings.clone(),
+        };
+        Ok(SolvedPress {
+            report,
+            solution,
+            solver,
+            pad,
+        })
+    }
+}
+
+impl SolvedPress {
+    /// The pressed frame (seed) and a no-contact frame (seed + 1, its own camera noise, as a
+    /// real one taken before the press would have) through `renderer`.
+    pub fn render(
+        &mut self,
+        request: &PressRequest,
+        renderer: &mut dyn GelRenderer,
+    ) -> Result<(RgbImage, RgbImage)> {
+        let optics = SensorOptics::for_profile(&request.sensor);
+        let fields = image_fields(
+            &mut self.solver,
+            &self.solution,
+            &request.sensor.spec.gel,
+            &optics,
+        );
+        let flat = GelImageFields::flat(optics.width, optics.height);
+        let mut frames = renderer.render_batch(
+            &optics,
+            &[
+                PressFrame {
+                    fields: &fields,
+                    seed: request.seed,
+                },
+                PressFrame {
+                    fields: &flat,
+                    seed: request.seed.wrapping_add(1),
+                },
+            ],
+        )?;
+        let reference = frames.pop().context("the renderer returned no frames")?;
+        let frame = frames.pop().context("the renderer returned one frame")?;
+        Ok((frame, reference))
+    }
+
+    /// The gel's displacement over the whole pad, at the solver's cell unless that would
+    /// exceed 1024 cells a side (then over the solver grid alone).
+    pub fn pad_fields(&mut self) -> GelFields {
+        let cells = self.pad.size().max_element() / self.solution.grid.cell_mm;
+        if cells <= 1024.0 {
+            self.solver.fields_over(&self.solution, &self.pad)
+        } else {
+            self.solution.gel.clone()
+        }
+    }
+}
+
+/// A marker grid given as COLSxROWS ("9x7"), checked: 1 to 10000 markers.
+pub fn parse_marker_grid(text: &str) -> Result<(u32, u32)> {
+    let (cols, rows) = text
+        .split_once(['x', 'X'])
+        .and_then(|(c, r)| Some((c.trim().parse::<u32>().ok()?, r.trim().parse::<u32>().ok()?)))
+        .with_context(|| format!("'{text}' is not COLSxROWS (e.g. 9x7, 11x9)"))?;
+    let markers = u64::from(cols) * u64::from(rows);
+    if markers == 0 || markers > 10_000 {
+        bail!("{cols}x{rows} is {markers} markers; a gel has 1 to 10000 (e.g. 9x7, 11x9)");
+    }
+    Ok((cols, rows))
+}
