@@ -16,6 +16,7 @@ pub mod sample_space;
 pub mod scene;
 pub mod sensor;
 pub mod single_press;
+pub mod tactile_samples;
 pub mod twin;
 pub mod twin_options;
 

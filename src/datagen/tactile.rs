@@ -14,7 +14,7 @@
 //! manifest line is appended; a rerun skips every sample with a complete line and redoes the
 //! rest, so an interrupted run resumes and gives the same bytes as an uninterrupted one.
 
-use crate::app::sample_space::sample_space;
+use crate::app::tactile_samples::{TactileSample, TactileSampleSource};
 use crate::report::npz::{NpyArray, npz_bytes};
 use crate::report::output::{write_bytes_atomic, write_json_atomic};
 use anyhow::{Context, Result, bail};
@@ -25,14 +25,10 @@ use serde::Serialize;
 use std::collections::BTreeSet;
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
-use tactex_core::catalog::FruitCatalog;
 use tactex_core::press::protocol::PressProtocol;
-use tactex_core::tactile::contact::ContactEvidence;
 use tactex_core::tactile::sensor_profile::ProfileId;
 use tactex_sim::contact::ContactSolver;
-use tactex_sim::datagen::press_protocol::PlannedPress;
-use tactex_sim::datagen::tactile_sample::{SampleDraw, SampleSpace};
-use tactex_sim::render::gel::{CpuRenderer, DeviceChoice, GelRenderer, open_renderer};
+use tactex_sim::render::gel::{DeviceChoice, GelRenderer, open_renderer};
 
 const FORMAT: &str = "tactex-tactile-dataset/1";
 /// Redraws of a sample whose press found no contact before the run gives up on it.
@@ -98,26 +94,6 @@ struct DatasetInfo {
     sensor: ProfileId,
 }
 
-#[derive(Serialize)]
-struct FrameFacts {
-    travel_mm: Vec<f64>,
-    approach_mm: Vec<f64>,
-    force_n: Vec<f64>,
-    contact_radius_mm: Vec<f64>,
-    gel_max_indentation_mm: Vec<f64>,
-}
-
-#[derive(Serialize)]
-struct ManifestLine<'a> {
-    files: Vec<String>,
-    #[serde(flatten)]
-    draw: &'a SampleDraw,
-    search_steps: usize,
-    contact: &'a ContactEvidence,
-    press: FrameFacts,
-    warnings: &'a [String],
-}
-
 fn parse_shard(text: &str) -> Result<(u64, u64)> {
     let parsed = text
         .split_once('/')
@@ -171,38 +147,7 @@ fn resume(manifest: &Path) -> Result<BTreeSet<u64>> {
     Ok(done)
 }
 
-struct Sample {
-    draw: SampleDraw,
-    press: PlannedPress,
-    images: Option<Vec<image::RgbImage>>,
-}
-
-/// Draws sample `index` and plans its press (redrawing where no contact shows), rendering it
-/// here unless a batch renderer will.
-fn press_sample(
-    solver: &mut ContactSolver,
-    space: &SampleSpace,
-    catalog: &FruitCatalog,
-    seed: u64,
-    index: u64,
-    render_here: bool,
-) -> Result<Sample> {
-    let (draw, press) = space
-        .press(solver, catalog, seed, index)
-        .with_context(|| format!("sample {index}"))?;
-    let images = if render_here {
-        Some(press.render(&mut CpuRenderer, &draw.optics())?)
-    } else {
-        None
-    };
-    Ok(Sample {
-        draw,
-        press,
-        images,
-    })
-}
-
-fn write_sample(dir: &Path, format: SampleFormat, s: &Sample) -> Result<Vec<String>> {
+fn write_sample(dir: &Path, format: SampleFormat, s: &TactileSample) -> Result<Vec<String>> {
     let images = s.images.as_ref().expect("rendered before writing");
     let stem = sample_stem(s.draw.index);
     match format {
@@ -245,27 +190,6 @@ fn write_sample(dir: &Path, format: SampleFormat, s: &Sample) -> Result<Vec<Stri
             Ok(vec![name])
         }
     }
-}
-
-fn manifest_line(s: &Sample, files: Vec<String>) -> Result<String> {
-    let f = &s.press.frames;
-    let line = ManifestLine {
-        files,
-        draw: &s.draw,
-        search_steps: s.press.search_steps,
-        contact: &s.press.contact,
-        press: FrameFacts {
-            travel_mm: f.iter().map(|x| x.travel_mm).collect(),
-            approach_mm: f.iter().map(|x| x.approach_mm).collect(),
-            force_n: f.iter().map(|x| x.force_n).collect(),
-            contact_radius_mm: f.iter().map(|x| x.contact_radius_mm).collect(),
-            gel_max_indentation_mm: f.iter().map(|x| x.gel_max_indentation_mm).collect(),
-        },
-        warnings: &s.press.warnings,
-    };
-    let mut text = serde_json::to_string(&line)?;
-    text.push('\n');
-    Ok(text)
 }
 
 /// Prepares DIR: checks or writes dataset.json. Errors name the path or the differing field.
@@ -327,14 +251,14 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
     if args.count == 0 {
         bail!("--count: must be at least 1");
     }
-    // The stock data sets keep their own marker grids; a profile draws around its own.
-    let space = match args.sensor {
-        Some(_) => sample_space(&args.fidelity, &args.shapes)?
-            .around(crate::app::load_sensor(args.sensor.as_deref())?),
-        None => sample_space(&args.fidelity, &args.shapes)?,
-    };
+    let source = TactileSampleSource::new(
+        &args.fidelity,
+        &args.shapes,
+        args.sensor.as_deref(),
+        args.seed,
+    )?;
+    let space = &source.space;
     let sensor = space.sensor.id();
-    let catalog = FruitCatalog::builtin();
     let protocol = PressProtocol::default();
     let optics = tactex_sim::render::gel::SensorOptics::for_profile(&space.sensor);
     let info = DatasetInfo {
@@ -394,15 +318,15 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
     let chunk = 4 * rayon::current_num_threads().max(1);
     let render_here = renderer.is_none();
     for indices in todo.chunks(chunk) {
-        let mut samples: Vec<Sample> = indices
+        let mut samples: Vec<TactileSample> = indices
             .par_iter()
             .map_init(ContactSolver::new, |solver, &i| {
-                press_sample(solver, &space, &catalog, args.seed, i, render_here)
+                source.sample(solver, i, render_here)
             })
             .collect::<Result<_>>()?;
         if let Some(gpu) = renderer.as_mut() {
             for s in &mut samples {
-                s.images = Some(s.press.render(gpu.as_mut(), &s.draw.optics())?);
+                s.render_with(gpu.as_mut())?;
             }
         }
         let files: Vec<Vec<String>> = samples
@@ -413,7 +337,7 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
             redraws += s.draw.attempt as u64;
             search_steps += s.press.search_steps as u64;
             manifest
-                .write_all(manifest_line(s, files)?.as_bytes())
+                .write_all(s.manifest_line(files)?.as_bytes())
                 .with_context(|| format!("{}: write failed", manifest_path.display()))?;
             bar.inc(1);
         }
