@@ -59,7 +59,8 @@ pub enum Backend {
     Replay,
 }
 
-pub fn run(args: &AskArgs) -> Result<()> {
+/// The answer `tactex ask` prints, as a value (the Python package's `ask` returns it).
+pub fn answer(args: &AskArgs) -> Result<Answer> {
     let catalog = FruitCatalog::builtin();
     // The prompt is checked before any device is opened so that a bad question fails fast.
     tactex_core::query::parse(&args.prompt, &catalog)?;
@@ -120,6 +121,11 @@ pub fn run(args: &AskArgs) -> Result<()> {
             }
         }
     };
+    Ok(answer)
+}
+
+pub fn run(args: &AskArgs) -> Result<()> {
+    let answer = answer(args)?;
     if args.json {
         println!(
             "{}",

@@ -142,8 +142,15 @@ fn object(args: &PressArgs) -> Result<Hardness> {
     }
 }
 
+impl PressArgs {
+    /// The device that renders the frames.
+    pub fn device(&self) -> DeviceChoice {
+        self.device
+    }
+}
+
 /// The press the flags describe, the sensor's gel and markers overridden as they say.
-fn request(args: &PressArgs) -> Result<PressRequest> {
+pub fn request(args: &PressArgs) -> Result<PressRequest> {
     let fidelity: Fidelity = args
         .fidelity
         .parse()

@@ -1,0 +1,325 @@
+"""TactEx twin in Python: GelSight presses rendered into numpy arrays, a stream of pretraining
+samples drawn exactly as ``tactex datagen tactile`` draws them, and the whole question
+pipeline.
+
+Everything here runs the same Rust library as the ``tactex`` command line: a press, a sample
+or an answer is the same bytes from Python as from the CLI at the same seed. Arguments are
+checked by the CLI's own parser; a bad one raises ``ValueError`` (a missing file
+``FileNotFoundError``, a failure of the machinery ``RuntimeError``) with the CLI's one-line
+message, which names the flag (``--depth-mm``) that the keyword argument (``depth_mm``)
+stands for.
+
+    >>> import tactex
+    >>> press = tactex.Sensor().press("sphere", radius_mm=6, hardness="40A", depth_mm=1.0)
+    >>> press.frame.shape, press.force_n > 0
+    ((240, 320, 3), True)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _tactex
+
+__all__ = [
+    "Sensor",
+    "Press",
+    "Sample",
+    "generate",
+    "shard_indices",
+    "worker_shard",
+    "ask",
+    "SHAPE_FAMILIES",
+    "FIDELITIES",
+    "__version__",
+]
+
+__version__: str = _tactex.__version__
+
+#: The contact physics a press can be solved at, cheapest first.
+FIDELITIES: Tuple[str, ...] = ("rigid", "hertz", "halfspace", "layer")
+#: The shape families pretraining samples are drawn from.
+SHAPE_FAMILIES: Tuple[str, ...] = ("sphere", "ellipsoid", "box", "fruit", "blob")
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _flags(**values: Any) -> List[str]:
+    """Keyword arguments as CLI flags: ``depth_mm=1`` -> ``--depth-mm 1``; None is left out,
+    True is a bare flag, a sequence is comma-joined."""
+    out: List[str] = []
+    for name, value in values.items():
+        if value is None or value is False:
+            continue
+        flag = "--" + name.replace("_", "-")
+        if value is True:
+            out.append(flag)
+        elif isinstance(value, (list, tuple)):
+            out += [flag, ",".join(str(v) for v in value)]
+        else:
+            out += [flag, os.fspath(value) if isinstance(value, os.PathLike) else str(value)]
+    return out
+
+
+@dataclass(frozen=True)
+class Press:
+    """One press of the gel into an object, solved and rendered.
+
+    ``frame`` and ``reference`` are (H, W, 3) uint8 RGB: the pressed frame and a no-contact
+    frame with its own camera noise. ``fields`` holds float32 maps, rows x columns: the gel's
+    normal and lateral displacement over the pad (``gel_normal_mm``, ``gel_lateral_x_mm``,
+    ``gel_lateral_y_mm``; grid in ``field_grid``) and the contact pressure over the solver
+    grid (``pressure_mpa``; grid in ``pressure_grid``). A grid is ``(cell_mm, (x0_mm,
+    y0_mm))``, the first cell's corner in the pad frame. ``report`` is what ``tactex press
+    --json`` prints.
+    """
+
+    frame: np.ndarray
+    reference: np.ndarray
+    fields: Dict[str, np.ndarray]
+    field_grid: Tuple[float, Tuple[float, float]]
+    pressure_grid: Tuple[float, Tuple[float, float]]
+    report: Dict[str, Any]
+
+    @property
+    def force_n(self) -> float:
+        """Total contact force (N)."""
+        return float(self.report["force_n"])
+
+    @property
+    def contact_radius_mm(self) -> float:
+        """Radius of the circle with the contact's area (mm)."""
+        return float(self.report["contact_radius_mm"])
+
+    @property
+    def gel_indentation_mm(self) -> float:
+        """The gel's largest normal displacement (mm)."""
+        return float(self.report["gel_max_indentation_mm"])
+
+    @property
+    def object_indentation_mm(self) -> float:
+        """The object's largest indentation (mm)."""
+        return float(self.report["object_max_indentation_mm"])
+
+    @property
+    def warnings(self) -> List[str]:
+        """What the solver warns of (a contact cut by the pad's edge, a gel bottoming out)."""
+        return list(self.report["warnings"])
+
+
+class Sensor:
+    """A GelSight sensor: the built-in GelSight Mini, or a sensor profile file (TOML, as
+    ``tactex calibrate`` writes it).
+
+    >>> Sensor().size
+    (320, 240)
+    """
+
+    def __init__(self, profile: Optional[PathLike] = None) -> None:
+        self.profile: Optional[str] = None if profile is None else os.fspath(profile)
+        info = _tactex.sensor_info(self.profile)
+        #: The profile's name and content hash, as every output names it.
+        self.id: str = info["id"]
+        self.name: str = info["name"]
+        #: Frame size (width, height) in pixels, and the scale.
+        self.size: Tuple[int, int] = (info["width"], info["height"])
+        self.mm_per_px: float = info["mm_per_px"]
+        self.gel_modulus_mpa: float = info["gel_modulus_mpa"]
+        self.gel_thickness_mm: float = info["gel_thickness_mm"]
+        #: Marker grid (columns, rows).
+        self.markers: Tuple[int, int] = tuple(info["markers"])  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"Sensor({self.id!r}, {self.size[0]}x{self.size[1]} px)"
+
+    def press(
+        self,
+        shape: str = "sphere",
+        *,
+        depth_mm: float,
+        radius_mm: Optional[float] = None,
+        size_mm: Optional[Sequence[float]] = None,
+        yaw_deg: Optional[float] = None,
+        mesh: Optional[PathLike] = None,
+        mesh_scale: Optional[float] = None,
+        hardness: Optional[str] = None,
+        modulus_mpa: Optional[float] = None,
+        object_poisson: Optional[float] = None,
+        fidelity: str = "layer",
+        grid_mm: Optional[float] = None,
+        tolerance: Optional[float] = None,
+        gel_modulus_mpa: Optional[float] = None,
+        gel_thickness_mm: Optional[float] = None,
+        marker_grid: Optional[str] = None,
+        marker_pitch_mm: Optional[float] = None,
+        seed: int = 0,
+        device: str = "cpu",
+    ) -> Press:
+        """Presses the gel ``depth_mm`` past first touch into a ``sphere`` (``radius_mm``),
+        ``ellipsoid`` or ``box`` (``size_mm`` X, Y, Z full extents, turned ``yaw_deg``) or a
+        ``mesh`` file, of ``hardness`` ("35A", "55 00", "rigid") or ``modulus_mpa``, at
+        ``fidelity`` (rigid, hertz, halfspace, layer). ``seed`` seeds the frame's camera
+        noise. Same arguments as ``tactex press``; the frame equals its ``tactile.png``.
+        """
+        argv = _flags(
+            shape=shape,
+            radius_mm=radius_mm,
+            size_mm=size_mm,
+            yaw_deg=yaw_deg,
+            mesh=mesh,
+            mesh_scale=mesh_scale,
+            hardness=hardness,
+            modulus_mpa=modulus_mpa,
+            object_poisson=object_poisson,
+            depth_mm=depth_mm,
+            fidelity=fidelity,
+            grid_mm=grid_mm,
+            tolerance=tolerance,
+            gel_modulus_mpa=gel_modulus_mpa,
+            gel_thickness_mm=gel_thickness_mm,
+            marker_grid=marker_grid,
+            marker_pitch_mm=marker_pitch_mm,
+            seed=seed,
+            device=device,
+            sensor=self.profile,
+        )
+        out = _tactex.press(argv)
+        return Press(
+            frame=out["frame"],
+            reference=out["reference"],
+            fields=dict(out["fields"]),
+            field_grid=_grid(out["field_grid"]),
+            pressure_grid=_grid(out["pressure_grid"]),
+            report=json.loads(out["report"]),
+        )
+
+
+def _grid(g: Any) -> Tuple[float, Tuple[float, float]]:
+    return (float(g[0]), (float(g[1][0]), float(g[1][1])))
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One pretraining sample, as ``tactex datagen tactile`` writes sample ``index``:
+    ``frames`` (9, H, W, 3) uint8 with the no-contact reference first and then the 8 frames
+    from first contact, 0.25 mm apart; ``labels`` the manifest line's fields (hardness in
+    Shore A, Shore 00 and MPa, shape, pose, sensor, seeds, fidelity, and the press's travel,
+    force and contact radius per frame)."""
+
+    index: int
+    frames: np.ndarray
+    labels: Dict[str, Any] = field(repr=False)
+
+    @property
+    def reference(self) -> np.ndarray:
+        """The no-contact frame (H, W, 3)."""
+        return self.frames[0]
+
+    @property
+    def press_frames(self) -> np.ndarray:
+        """The 8 recorded frames (8, H, W, 3)."""
+        return self.frames[1:]
+
+    @property
+    def modulus_mpa(self) -> float:
+        return float(self.labels["modulus_mpa"])
+
+    @property
+    def shore_a(self) -> float:
+        return float(self.labels["shore_a"])
+
+
+def shard_indices(count: int, shard: Tuple[int, int] = (0, 1), start: int = 0) -> range:
+    """The sample indices of ``shard`` (i, n) of a data set of ``count``: i, i + n, ...,
+    from ``start`` on, as ``datagen tactile --shard i/n`` takes them."""
+    i, n = shard
+    if not (isinstance(n, int) and isinstance(i, int) and n >= 1 and 0 <= i < n):
+        raise ValueError(f"shard: {shard!r} is not (i, n) with 0 <= i < n")
+    if count < 0 or start < 0:
+        raise ValueError(f"count and start must be at least 0, got {count} and {start}")
+    first = start + (i - start) % n
+    return range(first, count, n)
+
+
+def worker_shard(shard: Tuple[int, int], worker: int, workers: int) -> Tuple[int, int]:
+    """Worker ``worker`` of ``workers`` takes every ``workers``-th index of shard (i, n): the
+    shard (i + worker * n, n * workers). The workers' shards partition the shard's, so that
+    data-loader workers drawing their own shard yield each sample exactly once."""
+    i, n = shard
+    if not (isinstance(workers, int) and workers >= 1 and 0 <= worker < workers):
+        raise ValueError(f"worker {worker} of {workers}: not 0 <= worker < workers")
+    return (i + worker * n, n * workers)
+
+
+def generate(
+    count: int,
+    seed: int = 0,
+    *,
+    shard: Tuple[int, int] = (0, 1),
+    start: int = 0,
+    fidelity: str = "layer",
+    shapes: Optional[Sequence[str]] = None,
+    sensor: Optional[PathLike] = None,
+    batch: Optional[int] = None,
+) -> Iterator[Sample]:
+    """Samples ``start`` .. ``count`` - 1 of shard (i, n) of the data set ``datagen tactile
+    --count COUNT --seed SEED --fidelity F --shapes S [--sensor P]`` would write, drawn in
+    memory: same seed and index, same frames and labels. Samples are drawn ``batch`` at a
+    time (default 4 per Rust thread) in parallel, without the GIL.
+    """
+    shape_list = list(SHAPE_FAMILIES if shapes is None else shapes)
+    profile = None if sensor is None else os.fspath(sensor)
+    indices = list(shard_indices(count, shard, start))
+    step = batch if batch is not None else 4 * _tactex.threads()
+    if step < 1:
+        raise ValueError(f"batch: must be at least 1, got {step}")
+    for k in range(0, len(indices), step):
+        chunk = indices[k : k + step]
+        drawn = _tactex.generate_samples(fidelity, shape_list, profile, seed, chunk)
+        for index, (labels, frames) in zip(chunk, drawn):
+            yield Sample(index=index, frames=frames, labels=json.loads(labels))
+
+
+def ask(
+    prompt: str,
+    *,
+    scene: Optional[PathLike] = None,
+    seed: int = 0,
+    fidelity: str = "layer",
+    estimator: Optional[str] = None,
+    intervals: Optional[PathLike] = None,
+    detector: Optional[str] = None,
+    device: Optional[str] = None,
+    sensor: Optional[PathLike] = None,
+    explainer: Optional[str] = None,
+    llm_config: Optional[PathLike] = None,
+    gel_modulus_mpa: Optional[float] = None,
+    reproducible: bool = True,
+) -> Dict[str, Any]:
+    """Asks the twin ``prompt`` ("Which fruit is the softest?") on ``scene`` (default the
+    built-in demo) and returns the object ``tactex ask --json`` prints: the query, every
+    object touched with position, hardness, interval and ripeness, the answer text, timings.
+    With ``reproducible`` (the default) wall-clock times are left out, so that the same
+    arguments give the same result, equal to ``ask --json --reproducible``.
+    """
+    argv = _flags(
+        scene=scene,
+        seed=seed,
+        fidelity=fidelity,
+        estimator=estimator,
+        intervals=intervals,
+        detector=detector,
+        device=device,
+        sensor=sensor,
+        explainer=explainer,
+        llm_config=llm_config,
+        gel_modulus_mpa=gel_modulus_mpa,
+        reproducible=reproducible,
+        json=True,
+    )
+    return json.loads(_tactex.ask(argv + ["--", prompt]))

@@ -1,0 +1,25 @@
+"""Type stubs of the native module (python/src/lib.rs); use the ``tactex`` package instead."""
+
+from typing import Any, Dict, List, Optional, Tuple
+
+import numpy as np
+
+__version__: str
+
+def press(argv: List[str]) -> Dict[str, Any]:
+    """One press from ``tactex press`` flags: report (JSON text), frame, reference, fields,
+    field_grid, pressure_grid."""
+
+def generate_samples(
+    fidelity: str, shapes: List[str], sensor: Optional[str], seed: int, indices: List[int]
+) -> List[Tuple[str, np.ndarray]]:
+    """Samples at ``indices``: (labels JSON text, frames (9, H, W, 3) uint8)."""
+
+def ask(argv: List[str]) -> str:
+    """``tactex ask --json`` from its flags (prompt last): the answer as JSON text."""
+
+def sensor_info(path: Optional[str] = None) -> Dict[str, Any]:
+    """A profile's id, name, width, height, mm_per_px, gel and markers."""
+
+def threads() -> int:
+    """Threads of the Rust pool that draws samples."""

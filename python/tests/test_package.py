@@ -1,0 +1,141 @@
+"""The Python package against the command line: the same press, samples and answer, byte for
+byte; bad arguments raise with the CLI's one-line message; data-loader workers share a data
+set without overlap."""
+
+import json
+import multiprocessing
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import tactex
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_a_press_frame_equals_the_clis_tactile_png(cli, tmp_path):
+    args = dict(radius_mm=6, hardness="40A", depth_mm=0.9, seed=5)
+    for fidelity in ["rigid", "layer"]:
+        out = tmp_path / fidelity
+        cli("press", "--shape", "sphere", "--radius-mm", "6", "--hardness", "40A", "--depth-mm", "0.9",
+            "--seed", "5", "--fidelity", fidelity, "--device", "cpu", "--out", str(out), "--json")
+        press = tactex.Sensor().press("sphere", fidelity=fidelity, **args)
+        assert press.frame.dtype == np.uint8 and press.frame.shape == (240, 320, 3)
+        assert np.array_equal(press.frame, np.asarray(Image.open(out / "tactile.png")))
+        assert np.array_equal(press.reference, np.asarray(Image.open(out / "reference.png")))
+        report = json.loads((out / "maps.json").read_text())["press"]
+        assert press.report == report
+        assert press.force_n > 0 and press.contact_radius_mm > 0
+
+
+def test_a_press_through_a_calibrated_profile_uses_its_frame(cli, tmp_path):
+    profile = ROOT / "tests/fixtures/fots/profile/fots-9.toml"
+    sensor = tactex.Sensor(profile)
+    assert sensor.size == (240, 320) and sensor.name == "fots-9"
+    press = sensor.press("box", size_mm=(6, 4, 3), yaw_deg=30, modulus_mpa=1.5, depth_mm=0.5, seed=2)
+    out = tmp_path / "fots"
+    cli("press", "--shape", "box", "--size-mm", "6,4,3", "--yaw-deg", "30", "--modulus-mpa", "1.5",
+        "--depth-mm", "0.5", "--seed", "2", "--device", "cpu", "--sensor", str(profile), "--out", str(out))
+    assert press.frame.shape == (320, 240, 3)
+    assert np.array_equal(press.frame, np.asarray(Image.open(out / "tactile.png")))
+
+
+def test_the_press_fields_are_the_gels_displacement_over_the_pad():
+    press = tactex.Sensor().press("sphere", radius_mm=5, modulus_mpa=2.0, depth_mm=0.5)
+    normal = press.fields["gel_normal_mm"]
+    assert normal.dtype == np.float32
+    # The gel takes part of the approach, never more than all of it.
+    assert 0 < normal.max() <= 0.5 + 1e-6
+    assert abs(normal.max() - press.gel_indentation_mm) < 1e-4
+    cell, (x0, y0) = press.field_grid
+    rows, cols = normal.shape
+    # The map covers the pad (GelSight Mini: 320 x 240 px of 0.0634 mm).
+    assert cols * cell >= 320 * 0.0634 - cell and rows * cell >= 240 * 0.0634 - cell
+
+
+def test_generated_samples_equal_the_data_set_datagen_writes(cli, tmp_path):
+    out = tmp_path / "set"
+    cli("datagen", "tactile", "--count", "6", "--seed", "11", "--format", "npz", "--shard", "1/2",
+        "--out", str(out))
+    lines = [json.loads(line) for line in (out / "shard-1-of-2.jsonl").read_text().splitlines()]
+    samples = list(tactex.generate(6, seed=11, shard=(1, 2)))
+    assert [s.index for s in samples] == [1, 3, 5] == [line["index"] for line in lines]
+    for s, line in zip(samples, lines):
+        with np.load(out / line.pop("files")[0]) as z:
+            assert np.array_equal(s.frames, z["frames"])
+        assert s.labels == line
+
+
+def test_generate_starts_anywhere_and_samples_depend_on_seed_and_index_alone():
+    whole = {s.index: s for s in tactex.generate(4, seed=3)}
+    tail = list(tactex.generate(4, seed=3, start=2, batch=1))
+    assert [s.index for s in tail] == [2, 3]
+    for s in tail:
+        assert np.array_equal(s.frames, whole[s.index].frames) and s.labels == whole[s.index].labels
+    other = next(iter(tactex.generate(1, seed=4)))
+    assert not np.array_equal(other.frames, whole[0].frames)
+
+
+def test_ask_returns_what_ask_json_reproducible_prints(cli):
+    prompt = "Which fruit is the softest?"
+    printed = json.loads(cli("ask", "--json", "--reproducible", "--seed", "2", prompt).stdout)
+    assert tactex.ask(prompt, seed=2) == printed
+    assert printed["objects"], "the demo's fruit are touched"
+
+
+@pytest.mark.parametrize(
+    "call, error, names",
+    [
+        (lambda: tactex.Sensor().press(depth_mm=-1), ValueError, "--depth-mm"),
+        (lambda: tactex.Sensor().press(depth_mm=1, fidelity="soft"), ValueError, "--fidelity"),
+        (lambda: tactex.Sensor().press(depth_mm=1, hardness="hard as nails"), ValueError, "--hardness"),
+        (lambda: tactex.Sensor().press("box", depth_mm=1, size_mm=(1, 2), hardness="40A"), ValueError, "--size-mm"),
+        (lambda: tactex.Sensor("no/such/profile.toml"), FileNotFoundError, "profile.toml"),
+        (lambda: tactex.Sensor().press("mesh", depth_mm=1, mesh="no/such.obj", hardness="40A"), FileNotFoundError, "no/such.obj"),
+        (lambda: list(tactex.generate(2, fidelity="soft")), ValueError, "--fidelity"),
+        (lambda: list(tactex.generate(2, shapes=["cube"])), ValueError, "--shapes"),
+        (lambda: list(tactex.generate(2, shard=(2, 2))), ValueError, "shard"),
+        (lambda: tactex.ask(""), ValueError, "prompt"),
+        (lambda: tactex.ask("Which car is the fastest?"), ValueError, "prompt"),
+        (lambda: tactex.ask("Which fruit is the softest?", scene="no/such/scene.toml"), FileNotFoundError, "scene.toml"),
+        (lambda: tactex.ask("Which fruit is the softest?", fidelity="soft"), ValueError, "fidelity"),
+    ],
+)
+def test_bad_arguments_raise_with_one_line_naming_them(call, error, names):
+    with pytest.raises(error) as raised:
+        call()
+    message = str(raised.value)
+    assert names in message, message
+    assert "\n" not in message, message
+
+
+def _draw_worker_share(args):
+    count, seed, worker, workers = args
+    share = tactex.worker_shard((0, 1), worker, workers)
+    return [(s.index, s.frames.tobytes()) for s in tactex.generate(count, seed, shard=share)]
+
+
+def test_two_worker_processes_draw_each_sample_exactly_once():
+    count, seed = 5, 21
+    with multiprocessing.get_context("spawn").Pool(2) as pool:
+        shares = pool.map(_draw_worker_share, [(count, seed, w, 2) for w in range(2)])
+    drawn = sorted(i for share in shares for i, _ in share)
+    assert drawn == list(range(count))
+    alone = {s.index: s.frames.tobytes() for s in tactex.generate(count, seed)}
+    for share in shares:
+        for i, frames in share:
+            assert frames == alone[i]
+
+
+def test_a_torch_data_loader_with_two_workers_yields_each_sample_once():
+    torch = pytest.importorskip("torch", reason="torch is not installed (tactex[torch])")
+    from tactex.torch import TactileStream
+
+    stream = TactileStream(5, seed=21)
+    loader = torch.utils.data.DataLoader(stream, batch_size=None, num_workers=2)
+    targets = sorted(float(t) for _, t in loader)
+    alone = sorted(float(np.log(s.modulus_mpa)) for s in tactex.generate(5, 21))
+    assert len(targets) == 5 and np.allclose(targets, alone)
