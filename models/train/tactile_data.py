@@ -1,4 +1,5 @@
-"""Press sequences written by `tactex datagen tactile`, as training tensors.
+"""Press sequences written by `tactex datagen tactile`, or drawn on the fly by the `tactex`
+Python package, as training tensors.
 
 A sample is the first contact frame followed by the frames the model reads (DESIGN.md stage 4:
 frames 2 and 8, or 2, 4, 6 and 8, counted from 1 at first contact), raw RGB in 0..255 and
@@ -74,6 +75,60 @@ class PressDataset(torch.utils.data.Dataset):
                     progress.update(1)
         if not self.records:
             raise SystemExit(f"{', '.join(map(str, roots))}: no samples of families {families}")
+        self.targets = torch.tensor([ln_modulus(r) for r in self.records], dtype=torch.float32)
+
+    def __len__(self):
+        return len(self.records)
+
+    def __getitem__(self, i):
+        return torch.from_numpy(self.frames[i]).float(), self.targets[i]
+
+
+class StreamedPresses(torch.utils.data.IterableDataset):
+    """Fresh presses drawn by the twin as training consumes them (`tactex.generate`, the
+    Python package): `count` per epoch, epoch e drawing the data set of seed `seed + e`, so
+    that no press is seen twice. Each DataLoader worker draws its own share of the indices
+    (`tactex.worker_shard`), so N workers yield each press of an epoch exactly once."""
+
+    def __init__(self, count, seed, frames=2, families=None, sensor=None):
+        import tactex
+
+        self.tactex = tactex
+        self.count, self.seed, self.picks = count, seed, FRAME_PICKS[frames]
+        self.families = sorted(families) if families else None
+        self.sensor = sensor
+        self.epoch = 0
+
+    def __len__(self):
+        return self.count
+
+    def set_epoch(self, epoch):
+        self.epoch = epoch
+
+    def __iter__(self):
+        info = torch.utils.data.get_worker_info()
+        shard = (0, 1) if info is None else self.tactex.worker_shard((0, 1), info.id, info.num_workers)
+        for s in self.tactex.generate(
+            self.count, self.seed + self.epoch, shard=shard, shapes=self.families, sensor=self.sensor
+        ):
+            picked = np.stack([s.frames[1 + k] for k in self.picks])
+            yield torch.from_numpy(picked).float(), torch.tensor(ln_modulus(s.labels), dtype=torch.float32)
+
+
+class DrawnPresses(torch.utils.data.Dataset):
+    """A fixed set of presses drawn by the twin in memory (`tactex.generate`): the
+    validation set of a streamed run, with the records a folder's manifest would hold."""
+
+    def __init__(self, count, seed, frames=2, families=None, sensor=None, progress=None):
+        import tactex
+
+        picks = FRAME_PICKS[frames]
+        self.records, self.frames = [], []
+        for s in tactex.generate(count, seed, shapes=sorted(families) if families else None, sensor=sensor):
+            self.records.append(s.labels)
+            self.frames.append(np.stack([s.frames[1 + k] for k in picks]))
+            if progress is not None:
+                progress.update(1)
         self.targets = torch.tensor([ln_modulus(r) for r in self.records], dtype=torch.float32)
 
     def __len__(self):

@@ -2,6 +2,12 @@
 
     python train.py --model small --train DATA/train --heldout DATA/heldout --out runs/small
     python train.py --model resnet50_lstm3 --init runs/r50-pretrain/model.pt --train REAL ...
+    python train.py --model small --stream 1000 --heldout DATA/heldout --out runs/streamed
+
+With --stream N the training presses are not read from disk: the `tactex` Python package
+(`pip install ./python`) draws N fresh presses for every epoch as training consumes them
+(epoch e is the data set of seed --stream-seed + e), and a validation set of --val-count
+presses from a seed no epoch uses.
 
 Writes to --out: model.pt (weights and recipe), model.onnx with model.json (what the Rust
 `OnnxEstimator` reads), metrics.json (held-out scores) and predictions.jsonl.
@@ -23,7 +29,7 @@ from tqdm import tqdm
 
 import architectures as arch
 from shore import modulus_to_shore_a
-from tactile_data import FRAME_PICKS, PressDataset, augment
+from tactile_data import FRAME_PICKS, DrawnPresses, PressDataset, StreamedPresses, augment
 
 FORMAT = "tactex-hardness-model/1"
 
@@ -31,7 +37,13 @@ FORMAT = "tactex-hardness-model/1"
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--model", required=True, choices=arch.MODELS)
-    p.add_argument("--train", nargs="+", required=True, help="datagen directories to train on")
+    source = p.add_mutually_exclusive_group(required=True)
+    source.add_argument("--train", nargs="+", help="datagen directories to train on")
+    source.add_argument("--stream", type=int, metavar="N", help="train on N fresh presses per epoch drawn by the tactex package")
+    p.add_argument("--stream-seed", type=int, default=0, help="epoch e of --stream draws the data set of this seed + e")
+    p.add_argument("--val-count", type=int, default=200, help="validation presses drawn for --stream")
+    p.add_argument("--sensor", default=None, help="sensor profile --stream draws around (default the built-in GelSight Mini)")
+    p.add_argument("--workers", type=int, default=0, help="DataLoader worker processes drawing --stream presses")
     p.add_argument("--families", default=None, help="comma-separated shape families to train on")
     p.add_argument("--heldout", nargs="*", default=[], help="datagen directories of unseen shapes to score")
     p.add_argument("--out", required=True)
@@ -138,11 +150,18 @@ def training_sensor(dirs):
     return json.loads(only) if only else None
 
 
+def streamed_sensor(path):
+    """The profile (name, sha256) a --stream run draws around, as datagen names it."""
+    import tactex
+
+    return tactex.Sensor(path).profile_id
+
+
 def main():
     args = parse_args()
     # Before any loading: a mix of sensors fails first, and so does a missing onnxruntime,
     # which the export after training checks the graph with.
-    sensor = training_sensor(args.train)
+    sensor = streamed_sensor(args.sensor) if args.stream else training_sensor(args.train)
     import onnxruntime  # noqa: F401
     torch.manual_seed(args.seed)
     torch.set_num_threads(args.threads)
@@ -151,18 +170,27 @@ def main():
     families = set(args.families.split(",")) if args.families else None
 
     with tqdm(desc="loading", unit=" presses") as bar:
-        data = PressDataset(args.train, args.frames, families, args.limit, bar)
         heldout = [PressDataset([d], args.frames, None, None, bar) for d in args.heldout]
-    height, width = data.frames[0].shape[1:3]
-
+        if args.stream:
+            # Validation presses from a seed no epoch draws (epochs use stream-seed + e).
+            val_seed = args.stream_seed + 1_000_003
+            val_set = DrawnPresses(args.val_count, val_seed, args.frames, families, args.sensor, bar)
+            train_set = StreamedPresses(args.stream, args.stream_seed, args.frames, families, args.sensor)
+            records, train_targets = val_set.records, val_set.targets
+            n_train, n_val = args.stream, len(val_set)
+        else:
+            data = PressDataset(args.train, args.frames, families, args.limit, bar)
     gen = torch.Generator().manual_seed(args.seed)
-    order = torch.randperm(len(data), generator=gen).tolist()
-    n_val = max(1, int(round(args.val_fraction * len(data))))
-    val_idx, train_idx = order[:n_val], order[n_val:]
-    train_set = torch.utils.data.Subset(data, train_idx)
-    val_set = torch.utils.data.Subset(data, val_idx)
-    val_set.targets = data.targets[val_idx]
-    val_set.records = [data.records[i] for i in val_idx]
+    if not args.stream:
+        order = torch.randperm(len(data), generator=gen).tolist()
+        n_val = max(1, int(round(args.val_fraction * len(data))))
+        val_idx, train_idx = order[:n_val], order[n_val:]
+        train_set = torch.utils.data.Subset(data, train_idx)
+        val_set = torch.utils.data.Subset(data, val_idx)
+        val_set.targets = data.targets[val_idx]
+        val_set.records = [data.records[i] for i in val_idx]
+        records, train_targets, n_train = data.records, data.targets[train_idx], len(train_idx)
+    height, width = (val_set.frames[0] if args.stream else data.frames[0]).shape[1:3]
 
     if args.init:
         ckpt = torch.load(args.init, map_location="cpu", weights_only=False)
@@ -170,7 +198,8 @@ def main():
             raise SystemExit(f"--init {args.init}: a {ckpt['recipe']['model']} on {ckpt['recipe']['frames']} frames, not {args.model} on {args.frames}")
         mean, sd = ckpt["target_mean"], ckpt["target_sd"]
     else:
-        t = data.targets[train_idx]
+        # A streamed run standardises by its validation draw, from the same distribution.
+        t = train_targets
         mean, sd = float(t.mean()), float(t.std())
     model = arch.HardnessModel(arch.build(args.model, args.frames, args.dropout), mean, sd, height, width)
     if args.init:
@@ -185,15 +214,23 @@ def main():
         [{"params": early, "lr": args.lr_early}, {"params": late, "lr": args.lr_late}],
         weight_decay=args.weight_decay,
     )
-    loader = torch.utils.data.DataLoader(
-        train_set, batch_size=args.batch, shuffle=True, drop_last=True, generator=gen
-    )
+    if args.stream:
+        loader = torch.utils.data.DataLoader(
+            train_set, batch_size=args.batch, drop_last=True, num_workers=args.workers
+        )
+    else:
+        loader = torch.utils.data.DataLoader(
+            train_set, batch_size=args.batch, shuffle=True, drop_last=True, generator=gen
+        )
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=max(1, args.epochs * len(loader)))
-    print(f"{args.model}: {arch.parameter_count(model):,} parameters, {len(train_idx)} train / {n_val} validation presses")
+    what = f"{n_train} fresh presses per epoch" if args.stream else f"{n_train} train"
+    print(f"{args.model}: {arch.parameter_count(model):,} parameters, {what} / {n_val} validation presses")
 
     best, history = None, []
     started = time.time()
     for epoch in range(args.epochs):
+        if args.stream:
+            train_set.set_epoch(epoch)
         model.train()
         total, count = 0.0, 0
         for frames, target in tqdm(loader, desc=f"epoch {epoch + 1}/{args.epochs}", leave=False):
@@ -222,9 +259,13 @@ def main():
         "model": args.model,
         "frames": args.frames,
         "frame_picks": FRAME_PICKS[args.frames],
-        "train": [str(d) for d in args.train],
-        "families": sorted({r["family"] for r in data.records}),
-        "train_presses": len(train_idx),
+        "train": (
+            [f"tactex.generate: {args.stream} presses per epoch, seeds {args.stream_seed}..{args.stream_seed + args.epochs - 1}"]
+            if args.stream
+            else [str(d) for d in args.train]
+        ),
+        "families": sorted({r["family"] for r in records}),
+        "train_presses": n_train * args.epochs if args.stream else n_train,
         "validation_presses": n_val,
         "epochs": args.epochs,
         "best_epoch": best[2],

@@ -15,10 +15,40 @@ use pyo3::exceptions::{PyFileNotFoundError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
+use std::sync::{Arc, Mutex};
 use tactex::app::tactile_samples::{TactileSample, TactileSampleSource};
 use tactex::cli::{Cli, Command, error_line};
 use tactex_sim::contact::ContactSolver;
 use tactex_sim::render::gel::open_renderer;
+
+/// The thread pool native calls run on. rayon's global pool does not survive a fork (a
+/// DataLoader worker is a forked copy of the training process, whose pool threads are not
+/// copied), so each process makes its own pool, on first use after it was started or forked.
+fn pool() -> PyResult<Arc<rayon::ThreadPool>> {
+    static POOL: Mutex<Option<(u32, Arc<rayon::ThreadPool>)>> = Mutex::new(None);
+    let pid = std::process::id();
+    let mut slot = POOL.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    if let Some((owner, pool)) = slot.as_ref()
+        && *owner == pid
+    {
+        return Ok(pool.clone());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .build()
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start the thread pool: {e}")))?;
+    let pool = Arc::new(pool);
+    *slot = Some((pid, pool.clone()));
+    Ok(pool)
+}
+
+/// Runs `work` without the GIL on this process's pool.
+fn off_the_gil<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> anyhow::Result<T> + Send,
+) -> PyResult<T> {
+    let pool = pool()?;
+    py.detach(|| pool.install(work)).map_err(to_py)
+}
 
 /// An error as a Python exception carrying the CLI's one-line message: FileNotFoundError
 /// when a file is missing, ValueError when an argument is bad, RuntimeError otherwise.
@@ -46,6 +76,7 @@ fn is_input_error(line: &str) -> bool {
         "cannot be used with",
         "names no known fruit",
         "is not",
+        "is outside",
         "must be",
     ]
     .iter()
@@ -88,7 +119,7 @@ fn press(py: Python<'_>, argv: Vec<String>) -> PyResult<Bound<'_, PyDict>> {
         unreachable!("the argv starts with press")
     };
     let device = args.device();
-    let solved = py.detach(|| -> anyhow::Result<_> {
+    let solved = off_the_gil(py, || -> anyhow::Result<_> {
         let request = tactex::commands::press::request(&args)?;
         let mut press = request.solve()?;
         let mut renderer = open_renderer(device)?.renderer;
@@ -122,7 +153,7 @@ fn press(py: Python<'_>, argv: Vec<String>) -> PyResult<Bound<'_, PyDict>> {
             grids,
         ))
     });
-    let (report, frame, reference, arrays, pressure, grids) = solved.map_err(to_py)?;
+    let (report, frame, reference, arrays, pressure, grids) = solved?;
     let out = PyDict::new(py);
     out.set_item("report", report)?;
     out.set_item("frame", frame.into_pyarray(py))?;
@@ -138,6 +169,45 @@ fn press(py: Python<'_>, argv: Vec<String>) -> PyResult<Bound<'_, PyDict>> {
     Ok(out)
 }
 
+/// The paper's press protocol on one object (`argv`: `tactex press` flags; `--depth-mm` is
+/// required there but the protocol decides the travel): frames [9, H, W, 3] uint8 (the
+/// no-contact reference, then the 8 recorded frames) and the press's facts (JSON text).
+#[pyfunction]
+fn press_sequence<'py>(
+    py: Python<'py>,
+    argv: Vec<String>,
+    phase_mm: f64,
+) -> PyResult<(Bound<'py, PyArray4<u8>>, String)> {
+    let Command::Press(args) = parse(std::iter::once("press".into()).chain(argv).collect())? else {
+        unreachable!("the argv starts with press")
+    };
+    if !(phase_mm.is_finite() && (0.0..0.25).contains(&phase_mm)) {
+        return Err(PyValueError::new_err(format!(
+            "phase_mm: {phase_mm} is outside [0, 0.25): first touch falls within one 0.25 mm step"
+        )));
+    }
+    let done = off_the_gil(py, || -> anyhow::Result<(Array4<u8>, String)> {
+        let request = tactex::commands::press::request(&args)?;
+        let (press, images) = request.press_sequence(phase_mm)?;
+        let f = &press.frames;
+        let facts = serde_json::json!({
+            "travel_mm": f.iter().map(|x| x.travel_mm).collect::<Vec<_>>(),
+            "approach_mm": f.iter().map(|x| x.approach_mm).collect::<Vec<_>>(),
+            "force_n": f.iter().map(|x| x.force_n).collect::<Vec<_>>(),
+            "contact_radius_mm": f.iter().map(|x| x.contact_radius_mm).collect::<Vec<_>>(),
+            "gel_max_indentation_mm": f.iter().map(|x| x.gel_max_indentation_mm).collect::<Vec<_>>(),
+            "search_steps": press.search_steps,
+            "contact": press.contact,
+            "warnings": press.warnings,
+            "fidelity": request.fidelity.name(),
+            "sensor": request.sensor.id(),
+        });
+        Ok((stack(images), serde_json::to_string(&facts)?))
+    });
+    let (frames, facts) = done?;
+    Ok((frames.into_pyarray(py), facts))
+}
+
 /// What a data set of `datagen tactile` would hold at `indices`, drawn in parallel: each
 /// sample's labels (the manifest line without its files, JSON text) and its frames
 /// [9, H, W, 3] uint8, the no-contact reference first.
@@ -151,7 +221,7 @@ fn generate_samples<'py>(
     seed: u64,
     indices: Vec<u64>,
 ) -> PyResult<Vec<(String, Bound<'py, PyArray4<u8>>)>> {
-    let drawn = py.detach(|| -> anyhow::Result<Vec<(String, Array4<u8>)>> {
+    let drawn = off_the_gil(py, || -> anyhow::Result<Vec<(String, Array4<u8>)>> {
         let source = TactileSampleSource::new(&fidelity, &shapes, sensor.as_deref(), seed)?;
         indices
             .par_iter()
@@ -161,7 +231,7 @@ fn generate_samples<'py>(
             })
             .collect()
     });
-    let drawn = drawn.map_err(to_py)?;
+    let drawn = drawn?;
     Ok(drawn
         .into_iter()
         .map(|(labels, frames)| (labels, frames.into_pyarray(py)))
@@ -177,7 +247,11 @@ fn labels(sample: &TactileSample) -> anyhow::Result<String> {
 }
 
 fn frames(sample: TactileSample) -> Array4<u8> {
-    let images = sample.images.expect("rendered on the CPU");
+    stack(sample.images.expect("rendered on the CPU"))
+}
+
+/// Frames of one size as one [N, H, W, 3] array.
+fn stack(images: Vec<image::RgbImage>) -> Array4<u8> {
     let (w, h) = images[0].dimensions();
     let n = images.len();
     let raw: Vec<u8> = images.into_iter().flat_map(|i| i.into_raw()).collect();
@@ -192,11 +266,10 @@ fn ask(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
     let Command::Ask(args) = parse(std::iter::once("ask".into()).chain(argv).collect())? else {
         unreachable!("the argv starts with ask")
     };
-    py.detach(|| -> anyhow::Result<String> {
+    off_the_gil(py, || -> anyhow::Result<String> {
         let answer = tactex::commands::ask::answer(&args)?;
         serde_json::to_string_pretty(&answer).context("serialising the answer")
     })
-    .map_err(to_py)
 }
 
 /// A sensor profile's identity and geometry: the built-in GelSight Mini, or the profile
@@ -208,6 +281,9 @@ fn sensor_info(py: Python<'_>, path: Option<std::path::PathBuf>) -> PyResult<Bou
     let out = PyDict::new(py);
     let spec = &profile.spec;
     out.set_item("id", profile.id().to_string())?;
+    let id =
+        serde_json::to_string(&profile.id()).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    out.set_item("profile_id", id)?;
     out.set_item("name", profile.name())?;
     out.set_item("width", spec.width_px)?;
     out.set_item("height", spec.height_px)?;
@@ -220,13 +296,14 @@ fn sensor_info(py: Python<'_>, path: Option<std::path::PathBuf>) -> PyResult<Bou
 
 /// Threads of the Rust pool that draws samples (RAYON_NUM_THREADS, else one per core).
 #[pyfunction]
-fn threads() -> usize {
-    rayon::current_num_threads()
+fn threads() -> PyResult<usize> {
+    Ok(pool()?.current_num_threads())
 }
 
 #[pymodule]
 fn _tactex(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(press, m)?)?;
+    m.add_function(wrap_pyfunction!(press_sequence, m)?)?;
     m.add_function(wrap_pyfunction!(generate_samples, m)?)?;
     m.add_function(wrap_pyfunction!(ask, m)?)?;
     m.add_function(wrap_pyfunction!(sensor_info, m)?)?;

@@ -29,6 +29,7 @@ from . import _tactex
 __all__ = [
     "Sensor",
     "Press",
+    "PressSequence",
     "Sample",
     "generate",
     "shard_indices",
@@ -125,6 +126,8 @@ class Sensor:
         info = _tactex.sensor_info(self.profile)
         #: The profile's name and content hash, as every output names it.
         self.id: str = info["id"]
+        #: The profile's name and SHA-256, as data sets and model cards record it.
+        self.profile_id: Dict[str, Any] = json.loads(info["profile_id"])
         self.name: str = info["name"]
         #: Frame size (width, height) in pixels, and the scale.
         self.size: Tuple[int, int] = (info["width"], info["height"])
@@ -136,6 +139,57 @@ class Sensor:
 
     def __repr__(self) -> str:
         return f"Sensor({self.id!r}, {self.size[0]}x{self.size[1]} px)"
+
+    def _press_flags(self, shape: str, depth_mm: float, **kw: Any) -> List[str]:
+        return _flags(shape=shape, depth_mm=depth_mm, sensor=self.profile, **kw)
+
+    def press_sequence(
+        self,
+        shape: str = "sphere",
+        *,
+        radius_mm: Optional[float] = None,
+        size_mm: Optional[Sequence[float]] = None,
+        yaw_deg: Optional[float] = None,
+        mesh: Optional[PathLike] = None,
+        mesh_scale: Optional[float] = None,
+        hardness: Optional[str] = None,
+        modulus_mpa: Optional[float] = None,
+        object_poisson: Optional[float] = None,
+        fidelity: str = "layer",
+        grid_mm: Optional[float] = None,
+        gel_modulus_mpa: Optional[float] = None,
+        gel_thickness_mm: Optional[float] = None,
+        marker_grid: Optional[str] = None,
+        marker_pitch_mm: Optional[float] = None,
+        phase_mm: float = 0.0,
+        seed: int = 0,
+    ) -> "PressSequence":
+        """The paper's press protocol on the object (arguments as for :meth:`press`): two
+        no-contact frames, a descent in 0.25 mm steps until the contact criterion fires
+        (local SSIM against the no-contact frame, or marker motion), then 8 frames from
+        the first contact frame, 0.25 mm apart. First touch falls ``phase_mm`` (0 to 0.25)
+        before a step. Rendered on the CPU; ``seed`` seeds every frame's camera noise."""
+        argv = self._press_flags(
+            shape,
+            0.0,
+            radius_mm=radius_mm,
+            size_mm=size_mm,
+            yaw_deg=yaw_deg,
+            mesh=mesh,
+            mesh_scale=mesh_scale,
+            hardness=hardness,
+            modulus_mpa=modulus_mpa,
+            object_poisson=object_poisson,
+            fidelity=fidelity,
+            grid_mm=grid_mm,
+            gel_modulus_mpa=gel_modulus_mpa,
+            gel_thickness_mm=gel_thickness_mm,
+            marker_grid=marker_grid,
+            marker_pitch_mm=marker_pitch_mm,
+            seed=seed,
+        )
+        frames, facts = _tactex.press_sequence(argv, float(phase_mm))
+        return PressSequence(reference=frames[0], frames=frames[1:], labels=json.loads(facts))
 
     def press(
         self,
@@ -201,6 +255,28 @@ class Sensor:
 
 def _grid(g: Any) -> Tuple[float, Tuple[float, float]]:
     return (float(g[0]), (float(g[1][0]), float(g[1][1])))
+
+
+@dataclass(frozen=True)
+class PressSequence:
+    """A press by the paper's protocol: ``reference`` (H, W, 3) uint8, the no-contact frame;
+    ``frames`` (8, H, W, 3) uint8 from the first contact frame, 0.25 mm apart; ``labels``
+    the travel, approach, force, contact radius and gel indentation per frame, the search
+    steps before contact, the contact criterion's evidence, warnings, fidelity and sensor."""
+
+    reference: np.ndarray
+    frames: np.ndarray
+    labels: Dict[str, Any] = field(repr=False)
+
+    @property
+    def travel_mm(self) -> List[float]:
+        """Each frame's travel past the first contact frame (mm)."""
+        return list(self.labels["travel_mm"])
+
+    @property
+    def force_n(self) -> List[float]:
+        """Each frame's contact force (N)."""
+        return list(self.labels["force_n"])
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,10 @@ def press(argv: List[str]) -> Dict[str, Any]:
     """One press from ``tactex press`` flags: report (JSON text), frame, reference, fields,
     field_grid, pressure_grid."""
 
+def press_sequence(argv: List[str], phase_mm: float) -> Tuple[np.ndarray, str]:
+    """The paper's press protocol from ``tactex press`` flags: frames (9, H, W, 3) uint8 and
+    the press's facts (JSON text)."""
+
 def generate_samples(
     fidelity: str, shapes: List[str], sensor: Optional[str], seed: int, indices: List[int]
 ) -> List[Tuple[str, np.ndarray]]:

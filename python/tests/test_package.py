@@ -56,6 +56,22 @@ def test_the_press_fields_are_the_gels_displacement_over_the_pad():
     assert cols * cell >= 320 * 0.0634 - cell and rows * cell >= 240 * 0.0634 - cell
 
 
+def test_a_press_sequence_is_eight_frames_from_first_contact_and_harder_pushes_back_harder():
+    soft = tactex.Sensor().press_sequence("sphere", radius_mm=8, modulus_mpa=0.3, seed=4)
+    hard = tactex.Sensor().press_sequence("sphere", radius_mm=8, modulus_mpa=3.0, seed=4)
+    for seq in (soft, hard):
+        assert seq.frames.shape == (8, 240, 320, 3) and seq.reference.shape == (240, 320, 3)
+        assert seq.travel_mm == [0.25 * k for k in range(8)]
+        forces = seq.force_n
+        assert all(b > a for a, b in zip(forces, forces[1:])), forces
+        assert seq.labels["contact"]["fired_by"], seq.labels["contact"]
+    # Hertz: at equal travel a stiffer object takes more force (and less of the approach).
+    assert hard.force_n[-1] > 1.5 * soft.force_n[-1]
+    # The recorded frames change against the reference, more as the press deepens.
+    change = [np.abs(f.astype(int) - soft.reference.astype(int)).mean() for f in soft.frames]
+    assert change[-1] > change[0] > 0
+
+
 def test_generated_samples_equal_the_data_set_datagen_writes(cli, tmp_path):
     out = tmp_path / "set"
     cli("datagen", "tactile", "--count", "6", "--seed", "11", "--format", "npz", "--shard", "1/2",
@@ -94,6 +110,7 @@ def test_ask_returns_what_ask_json_reproducible_prints(cli):
         (lambda: tactex.Sensor().press(depth_mm=1, hardness="hard as nails"), ValueError, "--hardness"),
         (lambda: tactex.Sensor().press("box", depth_mm=1, size_mm=(1, 2), hardness="40A"), ValueError, "--size-mm"),
         (lambda: tactex.Sensor("no/such/profile.toml"), FileNotFoundError, "profile.toml"),
+        (lambda: tactex.Sensor().press_sequence(modulus_mpa=1, phase_mm=0.3), ValueError, "phase_mm"),
         (lambda: tactex.Sensor().press("mesh", depth_mm=1, mesh="no/such.obj", hardness="40A"), FileNotFoundError, "no/such.obj"),
         (lambda: list(tactex.generate(2, fidelity="soft")), ValueError, "--fidelity"),
         (lambda: list(tactex.generate(2, shapes=["cube"])), ValueError, "--shapes"),
@@ -134,8 +151,10 @@ def test_a_torch_data_loader_with_two_workers_yields_each_sample_once():
     torch = pytest.importorskip("torch", reason="torch is not installed (tactex[torch])")
     from tactex.torch import TactileStream
 
-    stream = TactileStream(5, seed=21)
-    loader = torch.utils.data.DataLoader(stream, batch_size=None, num_workers=2)
-    targets = sorted(float(t) for _, t in loader)
+    # Drawn here first, so that the workers are forked from a process whose thread pool runs:
+    # a pool that did not survive the fork would hang them.
     alone = sorted(float(np.log(s.modulus_mpa)) for s in tactex.generate(5, 21))
+    stream = TactileStream(5, seed=21)
+    loader = torch.utils.data.DataLoader(stream, batch_size=None, num_workers=2, timeout=300)
+    targets = sorted(float(t) for _, t in loader)
     assert len(targets) == 5 and np.allclose(targets, alone)

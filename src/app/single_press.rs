@@ -9,12 +9,14 @@ use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::hardness::scale::{Hardness, HardnessReport};
 use tactex_core::hertz::Elastic;
+use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_sim::contact::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
 };
+use tactex_sim::datagen::press_protocol::{PlannedPress, PressSetup, plan_press};
 use tactex_sim::render::gel::{
-    GelImageFields, GelRenderer, PressFrame, SensorOptics, image_fields,
+    CpuRenderer, GelImageFields, GelRenderer, PressFrame, SensorOptics, image_fields,
 };
 
 /// What is pressed.
@@ -197,6 +199,36 @@ impl PressRequest {
             solver,
             pad,
         })
+    }
+}
+
+impl PressRequest {
+    /// The paper's press protocol on this object: two no-contact frames, a descent in
+    /// 0.25 mm steps until the contact criterion fires, then 8 frames from the first
+    /// contact frame (`depth_mm` is not used: the protocol decides how far to go). First
+    /// touch falls `phase_mm` (0 to 0.25) before a step. Returns the press and its frames,
+    /// rendered on the CPU: the no-contact reference first, then the 8 recorded frames.
+    pub fn press_sequence(&self, phase_mm: f64) -> Result<(PlannedPress, Vec<RgbImage>)> {
+        let surface = self.shape.surface()?;
+        let optics = SensorOptics::for_profile(&self.sensor);
+        let setup = PressSetup {
+            surface: &surface,
+            object: Elastic {
+                modulus_mpa: self.hardness.modulus_mpa(),
+                poisson: self.object_poisson,
+            },
+            gel: self.sensor.spec.gel,
+            fidelity: self.fidelity,
+            optics: &optics,
+            phase_mm,
+            cell_mm: self.cell_mm,
+            seed: self.seed,
+        };
+        let mut solver = ContactSolver::new();
+        solver.settings.tolerance = self.tolerance;
+        let press = plan_press(&mut solver, &setup, &PressProtocol::default())?;
+        let frames = press.render(&mut CpuRenderer, &optics)?;
+        Ok((press, frames))
     }
 }
 
