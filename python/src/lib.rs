@@ -239,11 +239,7 @@ fn generate_samples<'py>(
 }
 
 fn labels(sample: &TactileSample) -> anyhow::Result<String> {
-    let mut value = serde_json::to_value(sample.labels(Vec::new()))?;
-    if let Some(map) = value.as_object_mut() {
-        map.remove("files");
-    }
-    Ok(serde_json::to_string(&value)?)
+    Ok(serde_json::to_string(&sample.labels(Vec::new()))?)
 }
 
 fn frames(sample: TactileSample) -> Array4<u8> {

@@ -141,6 +141,7 @@ class Sensor:
         return f"Sensor({self.id!r}, {self.size[0]}x{self.size[1]} px)"
 
     def _press_flags(self, shape: str, depth_mm: float, **kw: Any) -> List[str]:
+        """``tactex press`` flags for this sensor: one place that names the profile."""
         return _flags(shape=shape, depth_mm=depth_mm, sensor=self.profile, **kw)
 
     def press_sequence(
@@ -220,8 +221,9 @@ class Sensor:
         ``fidelity`` (rigid, hertz, halfspace, layer). ``seed`` seeds the frame's camera
         noise. Same arguments as ``tactex press``; the frame equals its ``tactile.png``.
         """
-        argv = _flags(
-            shape=shape,
+        argv = self._press_flags(
+            shape,
+            depth_mm,
             radius_mm=radius_mm,
             size_mm=size_mm,
             yaw_deg=yaw_deg,
@@ -230,7 +232,6 @@ class Sensor:
             hardness=hardness,
             modulus_mpa=modulus_mpa,
             object_poisson=object_poisson,
-            depth_mm=depth_mm,
             fidelity=fidelity,
             grid_mm=grid_mm,
             tolerance=tolerance,
@@ -240,7 +241,6 @@ class Sensor:
             marker_pitch_mm=marker_pitch_mm,
             seed=seed,
             device=device,
-            sensor=self.profile,
         )
         out = _tactex.press(argv)
         return Press(

@@ -4,7 +4,6 @@ set without overlap."""
 
 import json
 import multiprocessing
-import sys
 from pathlib import Path
 
 import numpy as np

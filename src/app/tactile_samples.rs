@@ -89,7 +89,8 @@ impl TactileSample {
         Ok(text)
     }
 
-    /// The labels and press facts, as the manifest line holds them.
+    /// The labels and press facts, as the manifest line holds them; with no `files`, the
+    /// labels alone (what the Python package hands over with the frames).
     pub fn labels(&self, files: Vec<String>) -> impl Serialize + '_ {
         let f = &self.press.frames;
         ManifestLine {
@@ -120,6 +121,7 @@ struct FrameFacts {
 
 #[derive(Serialize)]
 struct ManifestLine<'a> {
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     files: Vec<String>,
     #[serde(flatten)]
     draw: &'a SampleDraw,
