@@ -4,6 +4,7 @@ set without overlap."""
 
 import json
 import multiprocessing
+import os
 from pathlib import Path
 
 import numpy as np
@@ -146,8 +147,18 @@ def test_two_worker_processes_draw_each_sample_exactly_once():
             assert frames == alone[i]
 
 
+def _torch():
+    """torch, or a skip where it is not installed; CI sets TACTEX_REQUIRE_TORCH, so that there
+    a missing torch fails instead of passing by skipping."""
+    if os.environ.get("TACTEX_REQUIRE_TORCH"):
+        import torch
+
+        return torch
+    return pytest.importorskip("torch", reason="torch is not installed (tactex[torch])")
+
+
 def test_a_torch_data_loader_with_two_workers_yields_each_sample_once():
-    torch = pytest.importorskip("torch", reason="torch is not installed (tactex[torch])")
+    torch = _torch()
     from tactex.torch import TactileStream
 
     # Drawn here first, so that the workers are forked from a process whose thread pool runs:
@@ -157,3 +168,22 @@ def test_a_torch_data_loader_with_two_workers_yields_each_sample_once():
     loader = torch.utils.data.DataLoader(stream, batch_size=None, num_workers=2, timeout=300)
     targets = sorted(float(t) for _, t in loader)
     assert len(targets) == 5 and np.allclose(targets, alone)
+
+
+def test_a_torch_folder_reads_every_shard_datagen_wrote_in_index_order(cli, tmp_path):
+    torch = _torch()
+    from tactex.torch import TactileFolder
+
+    out = tmp_path / "set"
+    for shard in ("0/2", "1/2"):
+        cli("datagen", "tactile", "--count", "3", "--seed", "5", "--shard", shard, "--out", str(out))
+    folder = TactileFolder(out)
+    drawn = list(tactex.generate(3, seed=5))
+    assert len(folder) == 3 and [line["index"] for line in folder.lines] == [0, 1, 2]
+    for k, s in enumerate(drawn):
+        frames, target = folder[k]
+        assert frames.dtype == torch.uint8 and tuple(frames.shape) == s.frames.shape
+        assert np.array_equal(frames.numpy(), s.frames)
+        assert abs(float(target) - float(np.log(s.modulus_mpa))) < 1e-6
+    with pytest.raises(FileNotFoundError, match="dataset.json"):
+        TactileFolder(tmp_path / "nothing")
