@@ -51,8 +51,9 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 def _flags(**values: Any) -> List[str]:
-    """Keyword arguments as CLI flags: ``depth_mm=1`` -> ``--depth-mm 1``; None is left out,
-    True is a bare flag, a sequence is comma-joined."""
+    """Keyword arguments as CLI flags: ``depth_mm=1`` -> ``--depth-mm=1`` (joined, so that a
+    value such as ``-2,3`` is not read as a flag); None is left out, True is a bare flag, a
+    sequence is comma-joined."""
     out: List[str] = []
     for name, value in values.items():
         if value is None or value is False:
@@ -61,10 +62,21 @@ def _flags(**values: Any) -> List[str]:
         if value is True:
             out.append(flag)
         elif isinstance(value, (list, tuple)):
-            out += [flag, ",".join(str(v) for v in value)]
+            out.append(f"{flag}={','.join(str(v) for v in value)}")
         else:
-            out += [flag, os.fspath(value) if isinstance(value, os.PathLike) else str(value)]
+            out.append(f"{flag}={os.fspath(value) if isinstance(value, os.PathLike) else value}")
     return out
+
+
+def _pose_flags(pose: Optional[Tuple[float, float, float]]) -> Dict[str, Any]:
+    """``pose=(x_mm, y_mm, yaw_deg)`` as ``tactex press``'s --at-mm and --yaw-deg."""
+    if pose is None:
+        return {}
+    try:
+        x, y, yaw = (float(v) for v in pose)
+    except (TypeError, ValueError):
+        raise ValueError(f"pose: give (x_mm, y_mm, yaw_deg), got {pose!r}") from None
+    return {"at_mm": (x, y), "yaw_deg": yaw}
 
 
 @dataclass(frozen=True)
@@ -150,7 +162,7 @@ class Sensor:
         *,
         radius_mm: Optional[float] = None,
         size_mm: Optional[Sequence[float]] = None,
-        yaw_deg: Optional[float] = None,
+        pose: Optional[Tuple[float, float, float]] = None,
         mesh: Optional[PathLike] = None,
         mesh_scale: Optional[float] = None,
         hardness: Optional[str] = None,
@@ -175,7 +187,7 @@ class Sensor:
             0.0,
             radius_mm=radius_mm,
             size_mm=size_mm,
-            yaw_deg=yaw_deg,
+            **_pose_flags(pose),
             mesh=mesh,
             mesh_scale=mesh_scale,
             hardness=hardness,
@@ -199,7 +211,7 @@ class Sensor:
         depth_mm: float,
         radius_mm: Optional[float] = None,
         size_mm: Optional[Sequence[float]] = None,
-        yaw_deg: Optional[float] = None,
+        pose: Optional[Tuple[float, float, float]] = None,
         mesh: Optional[PathLike] = None,
         mesh_scale: Optional[float] = None,
         hardness: Optional[str] = None,
@@ -216,17 +228,21 @@ class Sensor:
         device: str = "cpu",
     ) -> Press:
         """Presses the gel ``depth_mm`` past first touch into a ``sphere`` (``radius_mm``),
-        ``ellipsoid`` or ``box`` (``size_mm`` X, Y, Z full extents, turned ``yaw_deg``) or a
-        ``mesh`` file, of ``hardness`` ("35A", "55 00", "rigid") or ``modulus_mpa``, at
-        ``fidelity`` (rigid, hertz, halfspace, layer). ``seed`` seeds the frame's camera
-        noise. Same arguments as ``tactex press``; the frame equals its ``tactile.png``.
+        ``ellipsoid`` or ``box`` (``size_mm`` X, Y, Z full extents) or a ``mesh`` file, of
+        ``hardness`` ("35A", "55 00", "rigid") or ``modulus_mpa``, at ``fidelity`` (rigid,
+        hertz, halfspace, layer). ``pose`` is ``(x_mm, y_mm, yaw_deg)``: where on the pad
+        (origin at its centre) the object's lowest point stands, a mesh's the middle of its
+        top, and its turn about the pressing axis; default the centre, unturned. An object
+        that reaches past the pad's edge is cut there (``warnings`` says so). ``seed`` seeds
+        the frame's camera noise. Same arguments as ``tactex press`` (``pose`` is its
+        ``--at-mm X,Y --yaw-deg YAW``); the frame equals its ``tactile.png``.
         """
         argv = self._press_flags(
             shape,
             depth_mm,
             radius_mm=radius_mm,
             size_mm=size_mm,
-            yaw_deg=yaw_deg,
+            **_pose_flags(pose),
             mesh=mesh,
             mesh_scale=mesh_scale,
             hardness=hardness,

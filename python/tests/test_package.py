@@ -35,9 +35,9 @@ def test_a_press_through_a_calibrated_profile_uses_its_frame(cli, tmp_path):
     profile = ROOT / "tests/fixtures/fots/profile/fots-9.toml"
     sensor = tactex.Sensor(profile)
     assert sensor.size == (240, 320) and sensor.name == "fots-9"
-    press = sensor.press("box", size_mm=(6, 4, 3), yaw_deg=30, modulus_mpa=1.5, depth_mm=0.5, seed=2)
+    press = sensor.press("box", size_mm=(6, 4, 3), pose=(1.5, -1, 30), modulus_mpa=1.5, depth_mm=0.5, seed=2)
     out = tmp_path / "fots"
-    cli("press", "--shape", "box", "--size-mm", "6,4,3", "--yaw-deg", "30", "--modulus-mpa", "1.5",
+    cli("press", "--shape", "box", "--size-mm", "6,4,3", "--at-mm", "1.5,-1", "--yaw-deg", "30", "--modulus-mpa", "1.5",
         "--depth-mm", "0.5", "--seed", "2", "--device", "cpu", "--sensor", str(profile), "--out", str(out))
     assert press.frame.shape == (320, 240, 3)
     assert np.array_equal(press.frame, np.asarray(Image.open(out / "tactile.png")))
@@ -54,6 +54,25 @@ def test_the_press_fields_are_the_gels_displacement_over_the_pad():
     rows, cols = normal.shape
     # The map covers the pad (GelSight Mini: 320 x 240 px of 0.0634 mm).
     assert cols * cell >= 320 * 0.0634 - cell and rows * cell >= 240 * 0.0634 - cell
+
+
+def test_a_press_imprint_stands_where_the_pose_puts_the_object():
+    for x, y in [(0.0, 0.0), (3.0, -2.0), (-6.5, 4.0)]:
+        press = tactex.Sensor().press("sphere", radius_mm=4, modulus_mpa=1.0, depth_mm=0.4, pose=(x, y, 0))
+        normal = press.fields["gel_normal_mm"]
+        cell, (x0, y0) = press.field_grid
+        row, col = np.unravel_index(np.argmax(normal), normal.shape)
+        deepest = (x0 + (col + 0.5) * cell, y0 + (row + 0.5) * cell)
+        assert np.hypot(deepest[0] - x, deepest[1] - y) <= 1.5 * cell, (x, y, deepest)
+        assert press.report["at_mm"] == [x, y]
+    # A box's imprint turns with it: its long side along x, then along y.
+    def extent(yaw):
+        normal = tactex.Sensor().press("box", size_mm=(8, 3, 5), modulus_mpa=1.0, depth_mm=0.3,
+                                       pose=(0, 0, yaw)).fields["gel_normal_mm"]
+        rows, cols = np.nonzero(normal > 0.5 * normal.max())
+        return np.ptp(cols), np.ptp(rows)
+    (wx, wy), (tx, ty) = extent(0), extent(90)
+    assert wx > 2 * wy and ty > 2 * tx
 
 
 def test_a_press_sequence_is_eight_frames_from_first_contact_and_harder_pushes_back_harder():
@@ -111,6 +130,8 @@ def test_ask_returns_what_ask_json_reproducible_prints(cli):
         (lambda: tactex.Sensor().press("box", depth_mm=1, size_mm=(1, 2), hardness="40A"), ValueError, "--size-mm"),
         (lambda: tactex.Sensor("no/such/profile.toml"), FileNotFoundError, "profile.toml"),
         (lambda: tactex.Sensor().press_sequence(modulus_mpa=1, phase_mm=0.3), ValueError, "phase_mm"),
+        (lambda: tactex.Sensor().press(depth_mm=1, modulus_mpa=1, pose=(30, 0, 0)), ValueError, "--at-mm"),
+        (lambda: tactex.Sensor().press(depth_mm=1, modulus_mpa=1, pose=(1, 2)), ValueError, "pose"),
         (lambda: tactex.Sensor().press("mesh", depth_mm=1, mesh="no/such.obj", hardness="40A"), FileNotFoundError, "no/such.obj"),
         (lambda: list(tactex.generate(2, fidelity="soft")), ValueError, "--fidelity"),
         (lambda: list(tactex.generate(2, shapes=["cube"])), ValueError, "--shapes"),

@@ -3,7 +3,7 @@
 //! both run, so that the same request gives the same frame bytes through either.
 
 use anyhow::{Context, Result, bail};
-use glam::{DVec2, DVec3};
+use glam::{DQuat, DVec2, DVec3};
 use image::RgbImage;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -19,26 +19,32 @@ use tactex_sim::render::gel::{
     CpuRenderer, GelImageFields, GelRenderer, PressFrame, SensorOptics, image_fields,
 };
 
-/// What is pressed.
+/// What is pressed, in its own frame.
 #[derive(Clone, Debug)]
 pub enum PressShape {
     Sphere {
         radius_mm: f64,
     },
-    /// Full extents X, Y, Z (mm), turned by `yaw_deg` about the pressing axis.
+    /// Full extents X, Y, Z (mm).
     Ellipsoid {
         size_mm: [f64; 3],
-        yaw_deg: f64,
     },
     Box {
         size_mm: [f64; 3],
-        yaw_deg: f64,
     },
     /// A mesh file pressed at the middle of its top; `scale` turns mesh units into metres.
     Mesh {
         path: PathBuf,
         scale: f64,
     },
+}
+
+/// Where the object stands on the pad: its lowest point (a mesh: the middle of its top) at
+/// `at_mm` in the pad frame, turned `yaw_deg` about the pressing axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PressPose {
+    pub at_mm: [f64; 2],
+    pub yaw_deg: f64,
 }
 
 impl PressShape {
@@ -51,27 +57,35 @@ impl PressShape {
         }
     }
 
-    /// The object's surface over the pad, centred on it.
-    pub fn surface(&self) -> Result<ObjectSurface> {
+    /// The object's surface over the pad, placed at `pose`.
+    pub fn surface(&self, pose: PressPose) -> Result<ObjectSurface> {
+        let centre_mm = DVec2::from_array(pose.at_mm);
+        let yaw_rad = pose.yaw_deg.to_radians();
         Ok(match self {
             PressShape::Sphere { radius_mm } => ObjectSurface::Sphere {
                 radius_mm: *radius_mm,
-                centre_mm: DVec2::ZERO,
+                centre_mm,
             },
-            PressShape::Ellipsoid { size_mm, yaw_deg } => ObjectSurface::Ellipsoid {
+            PressShape::Ellipsoid { size_mm } => ObjectSurface::Ellipsoid {
                 semi_axes_mm: DVec3::from_array(*size_mm) / 2.0,
-                centre_mm: DVec2::ZERO,
-                yaw_rad: yaw_deg.to_radians(),
+                centre_mm,
+                yaw_rad,
             },
-            PressShape::Box { size_mm, yaw_deg } => ObjectSurface::Box {
+            PressShape::Box { size_mm } => ObjectSurface::Box {
                 size_mm: DVec3::from_array(*size_mm).truncate(),
-                centre_mm: DVec2::ZERO,
-                yaw_rad: yaw_deg.to_radians(),
+                centre_mm,
+                yaw_rad,
             },
             PressShape::Mesh { path, scale } => {
                 let mesh = tactex_sim::mesh::load(path)?;
                 mesh.validate(&path.display().to_string())?;
-                ObjectSurface::from_mesh_top(&mesh, scale * 1e3)
+                let ObjectSurface::Mesh(top) = ObjectSurface::from_mesh_top(&mesh, scale * 1e3)
+                else {
+                    unreachable!("from_mesh_top gives a mesh")
+                };
+                ObjectSurface::Mesh(
+                    top.transformed(DQuat::from_rotation_z(yaw_rad), centre_mm.extend(0.0)),
+                )
             }
         })
     }
@@ -82,6 +96,7 @@ impl PressShape {
 #[derive(Clone, Debug)]
 pub struct PressRequest {
     pub shape: PressShape,
+    pub pose: PressPose,
     pub hardness: Hardness,
     pub object_poisson: f64,
     /// The sensor's travel past first touch (mm): total approach of gel and object.
@@ -121,6 +136,9 @@ pub struct PressReport {
     /// The sensor profile (after the gel and marker flags) the press used.
     pub sensor: ProfileId,
     pub shape: String,
+    /// Where the object's lowest point stands on the pad (mm, pad frame) and its turn.
+    pub at_mm: [f64; 2],
+    pub yaw_deg: f64,
     pub depth_mm: f64,
     pub force_n: f64,
     pub contact_radius_mm: f64,
@@ -152,7 +170,7 @@ pub struct SolvedPress {
 impl PressRequest {
     /// Solves the contact and reports its figures.
     pub fn solve(&self) -> Result<SolvedPress> {
-        let surface = self.shape.surface()?;
+        let surface = self.shape.surface(self.pose)?;
         let gel = self.sensor.spec.gel;
         let pad = Rect::centred(DVec2::from(self.sensor.spec.pad_size_mm()) / 2.0);
         let problem = ContactProblem {
@@ -174,6 +192,8 @@ impl PressRequest {
             fidelity: self.fidelity.to_string(),
             sensor: self.sensor.id(),
             shape: self.shape.name().into(),
+            at_mm: self.pose.at_mm,
+            yaw_deg: self.pose.yaw_deg,
             depth_mm: self.depth_mm,
             force_n: solution.force_n,
             contact_radius_mm: solution.contact_radius_mm,
@@ -209,7 +229,7 @@ impl PressRequest {
     /// touch falls `phase_mm` (0 to 0.25) before a step. Returns the press and its frames,
     /// rendered on the CPU: the no-contact reference first, then the 8 recorded frames.
     pub fn press_sequence(&self, phase_mm: f64) -> Result<(PlannedPress, Vec<RgbImage>)> {
-        let surface = self.shape.surface()?;
+        let surface = self.shape.surface(self.pose)?;
         let optics = SensorOptics::for_profile(&self.sensor);
         let setup = PressSetup {
             surface: &surface,

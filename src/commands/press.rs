@@ -3,7 +3,7 @@
 
 use crate::app::flag_range::{above, within};
 use crate::app::single_press::{
-    GridReport, PressReport, PressRequest, PressShape, SolvedPress, parse_marker_grid,
+    GridReport, PressPose, PressReport, PressRequest, PressShape, SolvedPress, parse_marker_grid,
 };
 use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic, write_png16_atomic};
 use anyhow::{Context, Result, bail};
@@ -35,9 +35,13 @@ pub struct PressArgs {
     /// cube or ball of 2 radii.
     #[arg(long, value_delimiter = ',', value_parser = above(0.0, 1000.0))]
     size_mm: Option<Vec<f64>>,
-    /// Turn of an ellipsoid or box about the pressing axis (degrees, -360 to 360).
+    /// Turn of the object about the pressing axis (degrees, -360 to 360).
     #[arg(long, default_value_t = 0.0, value_parser = within(-360.0, 360.0))]
     yaw_deg: f64,
+    /// Where on the pad the object's lowest point (a mesh: the middle of its top) stands,
+    /// X,Y (mm, pad frame, origin at the pad's centre; within the pad). Default the centre.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = within(-100.0, 100.0))]
+    at_mm: Option<Vec<f64>>,
     /// Mesh file (.obj, .gltf, .glb) for --shape mesh, pressed at the middle of its top.
     #[arg(long)]
     mesh: Option<PathBuf>,
@@ -118,11 +122,9 @@ fn shape(args: &PressArgs) -> Result<PressShape> {
         },
         Shape::Ellipsoid => PressShape::Ellipsoid {
             size_mm: size(args.radius_mm)?,
-            yaw_deg: args.yaw_deg,
         },
         Shape::Box => PressShape::Box {
             size_mm: size(args.radius_mm)?,
-            yaw_deg: args.yaw_deg,
         },
         Shape::Mesh => PressShape::Mesh {
             path: args
@@ -140,6 +142,23 @@ fn object(args: &PressArgs) -> Result<Hardness> {
         (None, Some(e)) => Ok(Hardness::ModulusMpa(e)),
         (None, None) => bail!("give the object's --hardness (e.g. \"35A\") or --modulus-mpa"),
     }
+}
+
+/// `--at-mm X,Y`, checked to lie on the pad (a contact may still be cut by its edge).
+fn at_on_pad(at: Option<&[f64]>, pad_mm: [f64; 2]) -> Result<[f64; 2]> {
+    let Some(at) = at else {
+        return Ok([0.0, 0.0]);
+    };
+    let [x, y] = at else {
+        bail!("--at-mm: give X,Y in mm, got {} values", at.len());
+    };
+    let [hw, hh] = pad_mm.map(|s| s / 2.0);
+    if x.abs() > hw || y.abs() > hh {
+        bail!(
+            "--at-mm: ({x}, {y}) mm is off the pad, which spans X -{hw:.2}..{hw:.2} and Y -{hh:.2}..{hh:.2} mm"
+        );
+    }
+    Ok([*x, *y])
 }
 
 impl PressArgs {
@@ -173,8 +192,13 @@ pub fn request(args: &PressArgs) -> Result<PressRequest> {
     if let Some(e) = args.gel_modulus_mpa {
         spec.gel.modulus_mpa = e;
     }
+    let pose = PressPose {
+        at_mm: at_on_pad(args.at_mm.as_deref(), sensor.spec.pad_size_mm())?,
+        yaw_deg: args.yaw_deg,
+    };
     Ok(PressRequest {
         shape,
+        pose,
         hardness,
         object_poisson: args.object_poisson,
         depth_mm: args.depth_mm,
