@@ -16,6 +16,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
+use tactex::app::error_kind::ErrorKind;
 use tactex::app::tactile_samples::{TactileSample, TactileSampleSource};
 use tactex::cli::{Cli, Command, error_line};
 use tactex_sim::contact::ContactSolver;
@@ -50,37 +51,16 @@ fn off_the_gil<T: Send>(
     py.detach(|| pool.install(work)).map_err(to_py)
 }
 
-/// An error as a Python exception carrying the CLI's one-line message: FileNotFoundError
-/// when a file is missing, ValueError when an argument is bad, RuntimeError otherwise.
+/// An error as a Python exception carrying the CLI's one-line message, by the kind of
+/// mistake its chain holds: FileNotFoundError for a missing file, ValueError for bad input,
+/// RuntimeError for a failure of the machinery.
 fn to_py(e: anyhow::Error) -> PyErr {
     let line = error_line(&e);
-    let missing = e.chain().any(|c| {
-        c.downcast_ref::<std::io::Error>()
-            .is_some_and(|io| io.kind() == std::io::ErrorKind::NotFound)
-    }) || line.contains("No such file or directory");
-    if missing {
-        PyFileNotFoundError::new_err(line)
-    } else if line.starts_with("--") || line.starts_with("prompt") || is_input_error(&line) {
-        PyValueError::new_err(line)
-    } else {
-        PyRuntimeError::new_err(line)
+    match ErrorKind::of(&e) {
+        ErrorKind::Missing => PyFileNotFoundError::new_err(line),
+        ErrorKind::BadInput => PyValueError::new_err(line),
+        ErrorKind::Failure => PyRuntimeError::new_err(line),
     }
-}
-
-/// Messages that name what was given wrong rather than a failure of the machinery.
-fn is_input_error(line: &str) -> bool {
-    [
-        "invalid value",
-        "unexpected argument",
-        "required",
-        "cannot be used with",
-        "names no known fruit",
-        "is not",
-        "is outside",
-        "must be",
-    ]
-    .iter()
-    .any(|p| line.contains(p))
 }
 
 /// The CLI parses `argv` (without the program name); a parse error is one line, as
@@ -268,6 +248,35 @@ fn ask(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
     })
 }
 
+/// `tactex calibrate` (flags in `argv`): fits and writes a sensor profile; returns what
+/// `calibrate --json` prints (JSON text).
+#[pyfunction]
+fn calibrate(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
+    let Command::Calibrate(args) =
+        parse(std::iter::once("calibrate".into()).chain(argv).collect())?
+    else {
+        unreachable!("the argv starts with calibrate")
+    };
+    off_the_gil(py, || -> anyhow::Result<String> {
+        let fit = tactex::sim2real::calibrate::calibrate(&args)?;
+        serde_json::to_string_pretty(&fit).context("serialising the calibration")
+    })
+}
+
+/// `tactex compare` (flags in `argv`): ball presses or a recorded session rebuilt in the
+/// twin and scored; returns what `compare --json` prints (JSON text).
+#[pyfunction]
+fn compare(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
+    let Command::Compare(args) = parse(std::iter::once("compare".into()).chain(argv).collect())?
+    else {
+        unreachable!("the argv starts with compare")
+    };
+    off_the_gil(py, || -> anyhow::Result<String> {
+        let report = tactex::sim2real::compare::compare(&args)?;
+        serde_json::to_string_pretty(&report).context("serialising the comparison")
+    })
+}
+
 /// A sensor profile's identity and geometry: the built-in GelSight Mini, or the profile
 /// file at `path`.
 #[pyfunction]
@@ -302,6 +311,8 @@ fn _tactex(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(press_sequence, m)?)?;
     m.add_function(wrap_pyfunction!(generate_samples, m)?)?;
     m.add_function(wrap_pyfunction!(ask, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(sensor_info, m)?)?;
     m.add_function(wrap_pyfunction!(threads, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -1,6 +1,6 @@
 """TactEx twin in Python: GelSight presses rendered into numpy arrays, a stream of pretraining
-samples drawn exactly as ``tactex datagen tactile`` draws them, and the whole question
-pipeline.
+samples drawn exactly as ``tactex datagen tactile`` draws them, the whole question
+pipeline, and a real sensor's calibration and sim-to-real comparison.
 
 Everything here runs the same Rust library as the ``tactex`` command line: a press, a sample
 or an answer is the same bytes from Python as from the CLI at the same seed. Arguments are
@@ -35,6 +35,8 @@ __all__ = [
     "shard_indices",
     "worker_shard",
     "ask",
+    "calibrate",
+    "compare",
     "SHAPE_FAMILIES",
     "FIDELITIES",
     "__version__",
@@ -415,3 +417,105 @@ def ask(
         json=True,
     )
     return json.loads(_tactex.ask(argv + ["--", prompt]))
+
+
+def calibrate(
+    images: PathLike,
+    annotations: PathLike,
+    background: PathLike,
+    *,
+    ball_radius_mm: float,
+    mm_per_px: float,
+    out: PathLike,
+    name: Optional[str] = None,
+    markers: Optional[PathLike] = None,
+    gel_modulus_mpa: Optional[float] = None,
+    gel_thickness_mm: Optional[float] = None,
+    gel_poisson: Optional[float] = None,
+    frame_rate_hz: Optional[float] = None,
+    split: str = "calib",
+    mag_bins: int = 12,
+    dir_bins: int = 24,
+    mag_max: float = 2.5,
+    smoothness: float = 20.0,
+    source: str = "",
+    glow: bool = True,
+    fidelity: str = "layer",
+) -> Dict[str, Any]:
+    """Calibrates a real sensor from ball presses, as ``tactex calibrate``: the gradient ->
+    colour table from the frames in ``images`` (circles in the ``annotations`` CSV:
+    image,center_x_px,center_y_px,contact_radius_px) against the no-contact ``background``,
+    the glow round a contact (unless ``glow`` is False), the camera's noise, and the marker
+    grid of a ``markers`` frame when given. Writes the sensor profile to ``out`` (its
+    background beside it) and returns what ``calibrate --json`` prints: the profile's path
+    and id, presses and pixels fitted, the table's rms residual per channel, the noise and
+    the markers read. ``Sensor(out)`` then presses through it."""
+    argv = _flags(
+        images=images,
+        annotations=annotations,
+        background=background,
+        ball_radius_mm=ball_radius_mm,
+        mm_per_px=mm_per_px,
+        out=out,
+        name=name,
+        markers=markers,
+        gel_modulus_mpa=gel_modulus_mpa,
+        gel_thickness_mm=gel_thickness_mm,
+        gel_poisson=gel_poisson,
+        frame_rate_hz=frame_rate_hz,
+        split=split,
+        mag_bins=mag_bins,
+        dir_bins=dir_bins,
+        mag_max=mag_max,
+        smoothness=smoothness,
+        source=source or None,
+        no_glow=not glow,
+        fidelity=fidelity,
+    )
+    return json.loads(_tactex.calibrate(argv))
+
+
+def compare(
+    sensor: Optional[PathLike] = None,
+    images: Optional[PathLike] = None,
+    annotations: Optional[PathLike] = None,
+    *,
+    session: Optional[PathLike] = None,
+    scene: Optional[PathLike] = None,
+    seed: Optional[int] = None,
+    gel_modulus_mpa: Optional[float] = None,
+    estimator: Optional[str] = None,
+    split: str = "eval",
+    fidelity: str = "layer",
+    device: str = "auto",
+    glow: bool = True,
+    out: Optional[PathLike] = None,
+) -> Dict[str, Any]:
+    """Sim-to-real, as ``tactex compare``, returning what ``compare --json`` prints.
+
+    Ball presses: each annotated press in ``images``/``annotations`` (the ``split``: eval,
+    every third, held out of calibration; calib; all) is rebuilt in the twin at
+    ``fidelity``, rendered through the calibrated profile ``sensor``, and scored against the
+    real frame (SSIM and MAE, whole frame and contact box, and the contact circle).
+
+    A recorded ``session`` (``tactex ask --record DIR``): every press rebuilt in the twin
+    (``sensor`` default the built-in Mini; ``scene``, ``seed``, ``gel_modulus_mpa`` and
+    ``estimator`` as for ``ask``) and scored recorded against rebuilt, with the hardness
+    each reads. ``out`` writes the side-by-side images and the JSON there."""
+    argv = _flags(
+        sensor=sensor,
+        images=images,
+        annotations=annotations,
+        session=session,
+        scene=scene,
+        seed=seed,
+        gel_modulus_mpa=gel_modulus_mpa,
+        estimator=estimator,
+        split=split,
+        fidelity=fidelity,
+        device=device,
+        no_glow=not glow,
+        out=out,
+        json=True,
+    )
+    return json.loads(_tactex.compare(argv))

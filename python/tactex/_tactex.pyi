@@ -22,6 +22,13 @@ def generate_samples(
 def ask(argv: List[str]) -> str:
     """``tactex ask --json`` from its flags (prompt last): the answer as JSON text."""
 
+def calibrate(argv: List[str]) -> str:
+    """``tactex calibrate --json`` from its flags: writes the profile, returns the fit (JSON
+    text)."""
+
+def compare(argv: List[str]) -> str:
+    """``tactex compare --json`` from its flags: the comparison as JSON text."""
+
 def sensor_info(path: Optional[str] = None) -> Dict[str, Any]:
     """A profile's id, name, width, height, mm_per_px, gel and markers."""
 

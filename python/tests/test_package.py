@@ -121,6 +121,55 @@ def test_ask_returns_what_ask_json_reproducible_prints(cli):
     assert printed["objects"], "the demo's fruit are touched"
 
 
+FOTS = ROOT / "tests/fixtures/fots"
+FOTS_SCALE = dict(ball_radius_mm=2.35, mm_per_px=0.051072522982635343)
+
+
+def test_calibrate_writes_the_profile_the_cli_writes_and_returns_its_fit(cli, tmp_path):
+    inputs = dict(images=FOTS / "ball-presses", annotations=FOTS / "ball-presses/annotations.csv",
+                  background=FOTS / "background.png")
+    fit = tactex.calibrate(**inputs, **FOTS_SCALE, markers=FOTS / "markers/press.png", out=tmp_path / "py/mine.toml")
+    printed = json.loads(cli(
+        "calibrate", "--images", str(inputs["images"]), "--annotations", str(inputs["annotations"]),
+        "--background", str(inputs["background"]), "--ball-radius-mm", "2.35",
+        "--mm-per-px", "0.051072522982635343", "--markers", str(FOTS / "markers/press.png"),
+        "--out", str(tmp_path / "cli/mine.toml"), "--json").stdout)
+    assert fit.pop("profile") == str(tmp_path / "py/mine.toml")
+    printed.pop("profile")
+    assert fit == printed
+    for name in ["mine.toml", "mine.background.png"]:
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
+    # Six of the nine presses (every third is held out), a table that fits them within a few
+    # grey levels, and the real sensor's 9 x 11 marker grid read from its frame.
+    assert fit["presses"] == 6 and max(fit["rms_grey"]) < 10 and fit["glow"]
+    assert (fit["markers"]["cols"], fit["markers"]["rows"]) == (9, 11)
+    sensor = tactex.Sensor(tmp_path / "py/mine.toml")
+    assert sensor.name == "mine" and sensor.size == (240, 320) and sensor.markers == (9, 11)
+
+
+def test_compare_scores_held_out_real_presses_as_the_cli_does(cli):
+    profile = FOTS / "profile/fots-9.toml"
+    scored = tactex.compare(profile, FOTS / "ball-presses", FOTS / "ball-presses/annotations.csv", device="cpu")
+    printed = json.loads(cli(
+        "compare", "--sensor", str(profile), "--images", str(FOTS / "ball-presses"),
+        "--annotations", str(FOTS / "ball-presses/annotations.csv"), "--device", "cpu", "--json").stdout)
+    assert scored == printed
+    assert [p["image"] for p in scored["presses"]] == ["0005.png", "0009.png", "0014.png"]
+    # The rendered press is closer to the real frame over the contact than the bare
+    # background is: the press, not the background, carries the score.
+    assert scored["mean"]["ssim_contact"] > scored["background_only_mean"]["ssim_contact"]
+
+
+def test_compare_rebuilds_a_recorded_session_as_the_cli_does(cli, tmp_path):
+    session = tmp_path / "session"
+    cli("ask", "--record", str(session), "--seed", "3", "Which fruit is the softest?")
+    scored = tactex.compare(session=session)
+    printed = json.loads(cli("compare", "--session", str(session), "--json").stdout)
+    assert scored == printed
+    # A twin session rebuilt by the same twin: every press agrees with itself.
+    assert scored["presses"] and scored["mean_ssim"] > 0.99
+
+
 @pytest.mark.parametrize(
     "call, error, names",
     [
@@ -140,14 +189,33 @@ def test_ask_returns_what_ask_json_reproducible_prints(cli):
         (lambda: tactex.ask("Which car is the fastest?"), ValueError, "prompt"),
         (lambda: tactex.ask("Which fruit is the softest?", scene="no/such/scene.toml"), FileNotFoundError, "scene.toml"),
         (lambda: tactex.ask("Which fruit is the softest?", fidelity="soft"), ValueError, "fidelity"),
+        (lambda: tactex.calibrate(FOTS / "ball-presses", FOTS / "ball-presses/annotations.csv",
+                                  FOTS / "background.png", ball_radius_mm=0, mm_per_px=0.05, out="x.toml"),
+         ValueError, "--ball-radius-mm"),
+        (lambda: tactex.calibrate(FOTS / "ball-presses", FOTS / "no-such.csv", FOTS / "background.png",
+                                  **FOTS_SCALE, out="x.toml"), FileNotFoundError, "no-such.csv"),
+        (lambda: tactex.compare(ROOT / "tests/fixtures/fots/background.png", FOTS / "ball-presses",
+                                FOTS / "ball-presses/annotations.csv"), ValueError, "background.png"),
+        (lambda: tactex.compare(session=ROOT / "no/such/session"), FileNotFoundError, "no/such/session"),
     ],
 )
 def test_bad_arguments_raise_with_one_line_naming_them(call, error, names):
+    """The exception's type follows the kind of mistake, judged by the error's types in the
+    library (python/src/lib.rs, src/app/error_kind.rs), not by its words."""
     with pytest.raises(error) as raised:
         call()
     message = str(raised.value)
     assert names in message, message
     assert "\n" not in message, message
+
+
+def test_an_output_the_disk_refuses_is_a_runtime_error_naming_it(tmp_path):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    with pytest.raises(RuntimeError) as raised:
+        tactex.compare(FOTS / "profile/fots-9.toml", FOTS / "ball-presses", FOTS / "ball-presses/annotations.csv",
+                       device="cpu", out=blocker / "out")
+    assert "--out" in str(raised.value) and "\n" not in str(raised.value)
 
 
 def _draw_worker_share(args):

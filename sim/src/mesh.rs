@@ -13,6 +13,13 @@ pub struct TriMesh {
 
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
+    /// The file system would not give the file (missing, unreadable): its error kept, so
+    /// that a missing mesh can be told from a bad one.
+    #[error("{path}: cannot read mesh: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
     #[error("{path}: cannot read mesh: {message}")]
     Read { path: String, message: String },
     #[error("{path}: mesh has no triangles")]
@@ -394,7 +401,10 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
         message,
     };
     let bytes = std::fs::metadata(path)
-        .map_err(|e| read_err(e.to_string()))?
+        .map_err(|source| MeshError::Io {
+            path: shown.clone(),
+            source,
+        })?
         .len();
     if bytes > MAX_MESH_BYTES {
         return Err(read_err(format!(

@@ -44,6 +44,7 @@ pub fn load(
     split: Split,
     size: (u32, u32),
 ) -> Result<Vec<(BallPress, RgbImage)>> {
+    super::file_input::present(annotations, "")?;
     let presses = read_annotations(annotations)?;
     let mut out = Vec::new();
     for (k, press) in presses.into_iter().enumerate() {

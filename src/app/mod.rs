@@ -5,8 +5,10 @@
 
 pub mod ball_presses;
 pub mod detector_choice;
+pub mod error_kind;
 pub mod estimator_choice;
 pub mod explainer_choice;
+pub mod file_input;
 pub mod flag_range;
 pub mod hardware;
 pub mod image_input;

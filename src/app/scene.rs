@@ -26,6 +26,7 @@ pub fn load_scene(
     path: &Path,
     catalog: &FruitCatalog,
 ) -> Result<(Scene, tactex_sim::world::SimWorld)> {
+    super::file_input::present(path, "file: cannot read scene")?;
     let scene = Scene::load(path, catalog)?;
     let world = tactex_sim::world::SimWorld::from_scene(&scene)?;
     world

@@ -1,13 +1,18 @@
 //! The tactile sensor's profile: the built-in GelSight Mini, a profile file, a what-if gel.
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use std::path::Path;
 use tactex_core::tactile::sensor_profile::SensorProfile;
 
 /// The profile at `path` (`--sensor`), or the built-in GelSight Mini.
 pub fn load_sensor(path: Option<&Path>) -> Result<SensorProfile> {
     match path {
-        Some(p) => SensorProfile::load(p).map_err(|e| anyhow::anyhow!("--sensor: {e}")),
+        Some(p) => {
+            super::file_input::present(p, "file: cannot read").context("--sensor")?;
+            SensorProfile::load(p)
+                .map_err(anyhow::Error::new)
+                .context("--sensor")
+        }
         None => Ok(SensorProfile::gelsight_mini()),
     }
 }

@@ -8,13 +8,14 @@ use crate::report::output::write_profile_atomic;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbImage;
+use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::ground::centroid::median;
 use tactex_core::tactile::ball_calibration::{
     BallPress, SampleRule, camera_noise_sigma, samples_from_ball_press,
 };
 use tactex_core::tactile::gel_glow::{GelGlow, GlowPress};
-use tactex_core::tactile::sensor_profile::{CalibrationFit, SensorProfile};
+use tactex_core::tactile::sensor_profile::{CalibrationFit, ProfileId, SensorProfile};
 use tactex_core::tactile::shading_table::{ShadingTable, frame_position};
 use tactex_core::tactile::spec::{GelSpec, TactileSpec};
 use tactex_sim::contact::{ContactSolver, Fidelity};
@@ -87,6 +88,40 @@ pub struct CalibrateArgs {
     /// Contact model that rebuilds the presses the glow is fitted to.
     #[arg(long, default_value = "layer")]
     pub fidelity: Fidelity,
+    /// Print one JSON object on stdout: what was fitted.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What `calibrate` fitted and wrote: the profile, and how well its table fits the presses.
+#[derive(Serialize, Debug)]
+pub struct Calibration {
+    /// The profile file written (its background beside it).
+    pub profile: PathBuf,
+    pub sensor: ProfileId,
+    pub presses: usize,
+    /// Pixels the table was fitted to.
+    pub samples: usize,
+    pub mag_bins: u32,
+    pub dir_bins: u32,
+    /// The table's rms residual over those pixels, R, G, B (grey levels).
+    pub rms_grey: [f64; 3],
+    /// The camera's noise (1 sigma, grey levels), from the presses' flat gel.
+    pub noise_sigma_grey: f64,
+    /// The grid read from the marker frame, if one was given.
+    pub markers: Option<MarkerReading>,
+    /// Whether a glow was fitted.
+    pub glow: bool,
+}
+
+#[derive(Serialize, Debug)]
+pub struct MarkerReading {
+    pub frame: PathBuf,
+    pub cols: u32,
+    pub rows: u32,
+    pub pitch_mm: f64,
+    pub radius_mm: f64,
+    pub darkness: f64,
 }
 
 /// The glow's blurs (pixels): colour changes spread over 3-27 px, and a wider brightening
@@ -180,7 +215,8 @@ fn read_markers(
     ))
 }
 
-pub fn run(args: &CalibrateArgs) -> Result<()> {
+/// Fits the profile the flags describe and writes it to `--out`.
+pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
     let (radius, scale) = (args.ball_radius_mm, args.mm_per_px);
     let background = crate::app::load_rgb(&args.background)?;
     // Before the fit: a marker frame that cannot be read fails first.
@@ -261,18 +297,17 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
             .unwrap_or_else(|| "calibrated sensor".into()),
     };
     let noise_sigma_grey = median(&mut noise).unwrap_or(0.0);
-    let (grid, marker_darkness) = match markers {
+    let (grid, marker_darkness, markers) = match markers {
         Some((path, (grid, darkness))) => {
-            println!(
-                "{}: markers {} x {}, pitch {:.3} mm, dot radius {:.3} mm, darkness {:.2}",
-                path.display(),
-                grid.cols,
-                grid.rows,
-                grid.pitch_mm,
-                grid.radius_mm,
-                darkness
-            );
-            (grid, darkness)
+            let reading = MarkerReading {
+                frame: path.clone(),
+                cols: grid.cols,
+                rows: grid.rows,
+                pitch_mm: grid.pitch_mm,
+                radius_mm: grid.radius_mm,
+                darkness,
+            };
+            (grid, darkness, Some(reading))
         }
         // The ball presses carry no markers: a profile without a marker grid.
         None => (
@@ -282,6 +317,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
                 ..stock.spec.markers
             },
             stock.marker_darkness,
+            None,
         ),
     };
     let mut profile = SensorProfile {
@@ -319,20 +355,51 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         .validate()
         .map_err(|(field, message)| anyhow::anyhow!("the fitted profile: {field}: {message}"))?;
     write_profile_atomic(&args.out, &profile)?;
+    Ok(Calibration {
+        profile: args.out.clone(),
+        sensor: profile.id(),
+        presses: presses.len(),
+        samples: samples.len(),
+        mag_bins: args.mag_bins,
+        dir_bins: args.dir_bins,
+        rms_grey: rms,
+        noise_sigma_grey,
+        markers,
+        glow: profile.glow.is_some(),
+    })
+}
+
+pub fn run(args: &CalibrateArgs) -> Result<()> {
+    let fit = calibrate(args)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&fit)?);
+        return Ok(());
+    }
+    if let Some(m) = &fit.markers {
+        println!(
+            "{}: markers {} x {}, pitch {:.3} mm, dot radius {:.3} mm, darkness {:.2}",
+            m.frame.display(),
+            m.cols,
+            m.rows,
+            m.pitch_mm,
+            m.radius_mm,
+            m.darkness
+        );
+    }
     println!(
         "{}: fitted {} x {} bins to {} pixels of {} presses; rms residual R {:.2} G {:.2} B {:.2} grey levels",
-        args.out.display(),
-        args.mag_bins,
-        args.dir_bins,
-        samples.len(),
-        presses.len(),
-        rms[0],
-        rms[1],
-        rms[2]
+        fit.profile.display(),
+        fit.mag_bins,
+        fit.dir_bins,
+        fit.samples,
+        fit.presses,
+        fit.rms_grey[0],
+        fit.rms_grey[1],
+        fit.rms_grey[2]
     );
     println!(
-        "camera noise {noise_sigma_grey:.2} grey levels (1 sigma); profile {}",
-        profile.id()
+        "camera noise {:.2} grey levels (1 sigma); profile {}",
+        fit.noise_sigma_grey, fit.sensor
     );
     Ok(())
 }

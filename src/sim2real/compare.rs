@@ -11,7 +11,7 @@
 use crate::app::ball_presses::{self, Split, contact_box, rebuild};
 use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic};
 use crate::report::side_by_side::side_by_side;
-use crate::sim2real::compare_session::SessionCompare;
+use crate::sim2real::compare_session::{SessionCompare, SessionComparison, compare_session};
 use crate::sim2real::contact_circle_score::{CircleScore, CircleSummary, score_circle, summarise};
 use anyhow::{Result, bail};
 use clap::Args;
@@ -166,24 +166,57 @@ fn mean(all: impl Iterator<Item = Scores>) -> Scores {
     }
 }
 
+/// What `compare` found: ball presses or a recorded session, each rebuilt and scored.
+#[derive(Serialize, Debug)]
+#[serde(untagged)]
+pub enum Comparison {
+    BallPresses(CompareReport),
+    Session(SessionComparison),
+}
+
+impl CompareArgs {
+    fn session_compare(&self) -> Option<SessionCompare<'_>> {
+        let session = self.session.as_deref()?;
+        Some(SessionCompare {
+            session,
+            scene: self.scene.as_deref(),
+            seed: self.seed,
+            gel_modulus_mpa: self.gel_modulus_mpa,
+            sensor: self.sensor.as_deref(),
+            fidelity: self.fidelity,
+            estimator: &self.estimator,
+            out: self.out.as_deref(),
+            json: self.json,
+        })
+    }
+}
+
+/// Runs the comparison the flags name, writing `--out` when given.
+pub fn compare(args: &CompareArgs) -> Result<Comparison> {
+    match args.session_compare() {
+        Some(session) => Ok(Comparison::Session(compare_session(&session)?)),
+        None => Ok(Comparison::BallPresses(compare_ball_presses(args)?)),
+    }
+}
+
 pub fn run(args: &CompareArgs) -> Result<()> {
+    if let Some(session) = args.session_compare() {
+        return crate::sim2real::compare_session::run(&session);
+    }
+    let report = compare_ball_presses(args)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    print_report(&report);
+    Ok(())
+}
+
+fn compare_ball_presses(args: &CompareArgs) -> Result<CompareReport> {
     let (Some(profile_path), Some(images), Some(annotations)) =
         (&args.sensor, &args.images, &args.annotations)
     else {
-        let Some(session) = &args.session else {
-            bail!("compare: needs --sensor, --images and --annotations, or --session DIR");
-        };
-        return crate::sim2real::compare_session::run(&SessionCompare {
-            session,
-            scene: args.scene.as_deref(),
-            seed: args.seed,
-            gel_modulus_mpa: args.gel_modulus_mpa,
-            sensor: args.sensor.as_deref(),
-            fidelity: args.fidelity,
-            estimator: &args.estimator,
-            out: args.out.as_deref(),
-            json: args.json,
-        });
+        bail!("compare: needs --sensor, --images and --annotations, or --session DIR");
     };
     let profile = crate::app::load_sensor(Some(profile_path))?;
     let (Some(real_background), Some(fit)) = (&profile.background, &profile.fit) else {
@@ -281,10 +314,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         write_json_atomic(&dir.path().join("compare.json"), &report)?;
         dir.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-        return Ok(());
-    }
+    Ok(report)
+}
+
+fn print_report(report: &CompareReport) {
     println!(
         "{:<10} {:>6} {:>9} {:>8} | {:>6} {:>6} {:>8} {:>8} | background only: {:>6} {:>6} {:>8} {:>8}",
         "image",
@@ -359,5 +392,4 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             c.radius_error_mean_abs_px
         );
     }
-    Ok(())
 }

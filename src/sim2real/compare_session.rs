@@ -396,7 +396,9 @@ fn mean(values: &[f64]) -> Option<f64> {
     (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
 }
 
-pub fn run(args: &SessionCompare) -> Result<()> {
+/// Rebuilds every press of the session in the twin and scores recorded against rebuilt,
+/// writing `--out` when given.
+pub fn compare_session(args: &SessionCompare) -> Result<SessionComparison> {
     let catalog = FruitCatalog::builtin();
     let (manifest, ..) = open_session(args.session).context("--session")?;
     let (scene, scene_name) = session_scene(args, &manifest, &catalog)?;
@@ -501,6 +503,11 @@ pub fn run(args: &SessionCompare) -> Result<()> {
         write_outputs(out.path(), &report, &recorded, &rebuilt, &manifest)?;
         out.finish()?;
     }
+    Ok(report)
+}
+
+pub fn run(args: &SessionCompare) -> Result<()> {
+    let report = compare_session(args)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

@@ -19,6 +19,9 @@ pub fn partial_dir(dir: &Path) -> PathBuf {
 
 #[derive(Debug, thiserror::Error)]
 pub enum SessionError {
+    /// No session where one was named.
+    #[error("{path}: {message}")]
+    Missing { path: PathBuf, message: String },
     #[error("{path}: {message}")]
     File { path: PathBuf, message: String },
     #[error("{path}: {field}: {message}")]

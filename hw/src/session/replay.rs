@@ -28,7 +28,10 @@ pub fn open_session(
         } else {
             "no such session directory"
         };
-        return Err(SessionError::file(dir, why));
+        return Err(SessionError::Missing {
+            path: dir.to_path_buf(),
+            message: why.into(),
+        });
     }
     let path = dir.join(MANIFEST);
     let text = std::fs::read_to_string(&path).map_err(|e| SessionError::file(&path, e))?;

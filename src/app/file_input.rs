@@ -1,0 +1,18 @@
+//! Files named by the user, checked to be there before a loader reads them, so that a
+//! missing one keeps its I/O error in the chain (`error_kind` tells it from a bad one by
+//! type) while its message reads as the loader's would.
+
+use anyhow::Result;
+use std::path::Path;
+
+/// Ok when `path` can be looked up; else its I/O error under "PATH: READING" (READING may
+/// be empty), as in "scene.toml: file: cannot read scene: No such file or directory".
+pub fn present(path: &Path, reading: &str) -> Result<()> {
+    match std::fs::metadata(path) {
+        Ok(_) => Ok(()),
+        Err(e) if reading.is_empty() => {
+            Err(anyhow::Error::new(e).context(path.display().to_string()))
+        }
+        Err(e) => Err(anyhow::Error::new(e).context(format!("{}: {reading}", path.display()))),
+    }
+}
