@@ -321,10 +321,12 @@ class Sample:
 
     @property
     def modulus_mpa(self) -> float:
+        """The pressed object's Young's modulus (MPa): the label the models regress."""
         return float(self.labels["modulus_mpa"])
 
     @property
     def shore_a(self) -> float:
+        """The same hardness on the Shore A scale."""
         return float(self.labels["shore_a"])
 
 
