@@ -88,14 +88,34 @@ fn contact_ellipse(
     ]
 }
 
-/// Whether the region `inside` holds reaches the outermost two pixels of the frame.
-fn touches_border(depth: &[f64], w: usize, h: usize, inside: impl Fn(f64) -> bool) -> bool {
-    (0..h).any(|y| {
-        (0..w).any(|x| {
-            let edge = x < 2 || y < 2 || x + 2 >= w || y + 2 >= h;
-            edge && inside(depth[y * w + x])
-        })
+/// The frame's outermost two pixels, row-major indices.
+fn border(w: usize, h: usize) -> impl Iterator<Item = usize> {
+    (0..h).flat_map(move |y| {
+        (0..w)
+            .filter(move |x| *x < 2 || y < 2 || x + 2 >= w || y + 2 >= h)
+            .map(move |x| y * w + x)
     })
+}
+
+/// Whether an imprint of this peak lies within the frame: its half-depth region stays off
+/// the border, and the border is level (its deepest 5% lie less than half the peak below its
+/// shallowest 5%). The map's zero is the border's median, so a border pressed in on one side
+/// (a broad fruit whose contact outgrows the pad) lowers the zero and the peak reads short
+/// while the half-depth region, measured from that same zero, never reaches the edge.
+fn imprint_within_frame(depth: &[f64], valid: &[bool], w: usize, h: usize, peak: f64) -> bool {
+    if border(w, h).any(|i| depth[i] > 0.5 * peak) {
+        return false;
+    }
+    let mut edge: Vec<f64> = border(w, h)
+        .filter(|i| valid[*i])
+        .map(|i| depth[i])
+        .collect();
+    if edge.len() < 20 {
+        return true;
+    }
+    edge.sort_by(f64::total_cmp);
+    let at = |q: f64| edge[((edge.len() - 1) as f64 * q).round() as usize];
+    at(0.95) - at(0.05) <= 0.5 * peak
 }
 
 impl HardnessEstimator for IndentationEstimator {
@@ -130,7 +150,13 @@ impl HardnessEstimator for IndentationEstimator {
             let p = peak(&depth);
             let deep = |d: f64| d > 0.5 * p;
             contact_axes.push(contact_ellipse(&depth, slopes.width, deep, spec.mm_per_px));
-            within_frame.push(!touches_border(&depth, slopes.width, slopes.height, deep));
+            within_frame.push(imprint_within_frame(
+                &depth,
+                &slopes.valid,
+                slopes.width,
+                slopes.height,
+                p,
+            ));
             peaks.push(p);
         }
         if !peaks.last().is_some_and(|p| *p > 0.0) {
@@ -205,6 +231,44 @@ impl HardnessEstimator for IndentationEstimator {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A Gaussian dimple of depth 1 centred at (cx, cy) px with width `sigma` on a 160 x 120
+    /// frame, over a gel lowered by `tilt` at the top edge and not at the bottom (a broad
+    /// contact beyond the top edge), zeroed as `integrate_slopes` zeroes: the border's median.
+    fn imprint(cx: f64, cy: f64, sigma: f64, tilt: f64) -> Vec<f64> {
+        let (w, h) = (160usize, 120usize);
+        let mut depth: Vec<f64> = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f64 - cx, (i / w) as f64 - cy);
+                let lowered = tilt * (1.0 - (i / w) as f64 / (h - 1) as f64);
+                (-(x * x + y * y) / (2.0 * sigma * sigma)).exp() + lowered
+            })
+            .collect();
+        let mut edge: Vec<f64> = border(w, h).map(|i| depth[i]).collect();
+        edge.sort_by(f64::total_cmp);
+        let zero = edge[edge.len() / 2];
+        depth.iter_mut().for_each(|d| *d -= zero);
+        depth
+    }
+
+    #[test]
+    fn an_imprint_that_outgrows_the_pad_on_one_side_is_not_within_the_frame() {
+        let valid = vec![true; 160 * 120];
+        let within = |d: &[f64]| imprint_within_frame(d, &valid, 160, 120, peak(d));
+        // A small imprint in the middle leaves the border level, and a slightly lowered
+        // side is tolerated.
+        assert!(within(&imprint(80.0, 60.0, 12.0, 0.0)));
+        assert!(within(&imprint(80.0, 60.0, 12.0, 0.3)));
+        // The gel pressed in along the top edge by 0.7 of the imprint's depth: its
+        // half-depth region, measured from the border's lowered median, stays off the edge
+        // (the case the half-depth test alone missed), yet the zero is wrong.
+        let broad = imprint(80.0, 60.0, 12.0, 0.7);
+        let p = peak(&broad);
+        assert!(!border(160, 120).any(|i| broad[i] > 0.5 * p));
+        assert!(!within(&broad));
+        // An imprint whose half-depth region reaches the edge is cut as before.
+        assert!(!within(&imprint(3.0, 60.0, 12.0, 0.0)));
+    }
 
     #[test]
     fn an_elongated_turned_imprint_keeps_its_two_semi_axes() {
