@@ -28,7 +28,11 @@ fn main() {
             .map(|s| std::path::PathBuf::from(s.trim()))
     };
     if let (Some(dir), Some(common)) = (git_path("--git-dir"), git_path("--git-common-dir")) {
-        for path in [dir.join("HEAD"), common.join("refs/heads"), common.join("packed-refs")] {
+        for path in [
+            dir.join("HEAD"),
+            common.join("refs/heads"),
+            common.join("packed-refs"),
+        ] {
             if path.exists() {
                 println!("cargo:rerun-if-changed={}", path.display());
             }

@@ -7,8 +7,9 @@
 //! meeting point. Depth noise makes small false tops on one fruit; they meet their fruit's
 //! main basin within a few millimetres and merge. A small fruit leaning under a large one's
 //! flank stands only millimetres above the saddle as the camera sees it; it stays apart when
-//! both basins are large enough to have a colour and their chromaticities differ (a red
-//! strawberry under a dark avocado), as two parts of one fruit's surface do not.
+//! both basins are large enough to have a colour and their chromaticities or brightnesses
+//! differ (a red strawberry under a dark avocado, a yellow banana lying across an olive one),
+//! as two parts of one fruit's surface do not.
 
 /// One pixel of a blob: image coordinates, its height above the table (m) and its colour.
 #[derive(Clone, Copy, Debug)]
@@ -25,6 +26,11 @@ const COLOUR_MIN_PIXELS: usize = 100;
 /// kind spread by about 0.03 (the classical detector's scale), neighbours of different
 /// kinds usually differ by 0.1 or more.
 const CHROMA_APART: f64 = 0.06;
+
+/// Brightness ratio (ln) that tells two surfaces apart: a yellow overripe banana lying across
+/// an olive one differs from it by 0.03 in chromaticity but is 1.4 times as bright where seen
+/// (1.6 times in albedo); two basins of one fruit, both round its top, are lit alike.
+const BRIGHTNESS_APART_LN: f64 = 0.3;
 
 /// Running colour of a basin: sums of r, g, b and the pixels counted (saturated highlights
 /// and near-black pixels left out, as `colour_name::mean_surface_colour` does).
@@ -58,6 +64,11 @@ impl ColourSum {
         [self.rgb[0] / s, self.rgb[1] / s]
     }
 
+    /// Mean channel sum.
+    fn brightness(&self) -> f64 {
+        self.rgb.iter().sum::<f64>() / self.n.max(1) as f64
+    }
+
     /// Whether two basins' surfaces are of different colours (false while either is small).
     fn differs(&self, other: &ColourSum) -> bool {
         if self.n < COLOUR_MIN_PIXELS || other.n < COLOUR_MIN_PIXELS {
@@ -65,6 +76,7 @@ impl ColourSum {
         }
         let (a, b) = (self.chromaticity(), other.chromaticity());
         (a[0] - b[0]).hypot(a[1] - b[1]) > CHROMA_APART
+            || (self.brightness() / other.brightness()).ln().abs() > BRIGHTNESS_APART_LN
     }
 }
 
@@ -243,7 +255,7 @@ mod tests {
     }
 
     #[test]
-    fn a_small_fruit_under_a_large_ones_flank_stays_apart_by_its_colour() {
+    fn a_small_fruit_under_a_large_ones_flank_stays_apart_by_its_colour_or_brightness() {
         // A 28 mm fruit whose top stands 3 mm above the saddle, against a 64 mm one: by
         // height alone they are one; a red one against a dark green one are two.
         let mut pixels = hills(&[(100.0, 100.0, 32.0)], 0.0);
@@ -274,6 +286,14 @@ mod tests {
                     height_m: 0.025,
                     rgb: [50, 60, 25],
                 });
+            }
+        }
+        assert_eq!(split_by_height(&pixels, 0.005).len(), 2);
+        // Of one hue but 1.6 times as bright (a yellow banana lying across an olive one):
+        // two as well.
+        for p in &mut pixels {
+            if p.rgb == [210, 30, 35] {
+                p.rgb = [80, 96, 40];
             }
         }
         assert_eq!(split_by_height(&pixels, 0.005).len(), 2);
