@@ -13,6 +13,7 @@ use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_sim::contact::{
     ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
+    mesh_top,
 };
 use tactex_sim::datagen::press_protocol::{PlannedPress, PressSetup, plan_press};
 use tactex_sim::render::gel::{
@@ -79,12 +80,9 @@ impl PressShape {
             PressShape::Mesh { path, scale } => {
                 let mesh = tactex_sim::mesh::load(path)?;
                 mesh.validate(&path.display().to_string())?;
-                let ObjectSurface::Mesh(top) = ObjectSurface::from_mesh_top(&mesh, scale * 1e3)
-                else {
-                    unreachable!("from_mesh_top gives a mesh")
-                };
                 ObjectSurface::Mesh(
-                    top.transformed(DQuat::from_rotation_z(yaw_rad), centre_mm.extend(0.0)),
+                    mesh_top(&mesh, scale * 1e3)
+                        .transformed(DQuat::from_rotation_z(yaw_rad), centre_mm.extend(0.0)),
                 )
             }
         })

@@ -40,4 +40,4 @@ pub use problem::{ContactError, ContactProblem};
 pub use rigid::RIGID_SMOOTHING_MM;
 pub use solution::{ContactSolution, GelFields};
 pub use solver::{ContactSolver, DEFAULT_CELLS_ACROSS, DEFAULT_MAX_CELLS, MAX_CELLS};
-pub use surface::ObjectSurface;
+pub use surface::{ObjectSurface, mesh_top};

@@ -46,20 +46,27 @@ fn check_positive(name: &str, v: f64) -> Result<(), String> {
     }
 }
 
+/// A mesh in its own frame (z up, any unit times `scale_to_mm`) in the pad frame, the
+/// middle of its top at the origin: z flipped (and y, to stay right-handed), in mm. Callers
+/// that place or turn it on the pad start from here.
+pub fn mesh_top(mesh: &TriMesh, scale_to_mm: f64) -> TriMesh {
+    let (lo, hi) = mesh.bounds();
+    let centre = (lo + hi) / 2.0;
+    TriMesh {
+        vertices: mesh
+            .vertices
+            .iter()
+            .map(|v| DVec3::new(v.x - centre.x, -(v.y - centre.y), hi.z - v.z) * scale_to_mm)
+            .collect(),
+        triangles: mesh.triangles.clone(),
+    }
+}
+
 impl ObjectSurface {
     /// A mesh in its own frame (z up, any unit times `scale_to_mm`) pressed from above at the
     /// middle of its top: the pad frame flips z (and y, to stay right-handed).
     pub fn from_mesh_top(mesh: &TriMesh, scale_to_mm: f64) -> Self {
-        let (lo, hi) = mesh.bounds();
-        let centre = (lo + hi) / 2.0;
-        ObjectSurface::Mesh(TriMesh {
-            vertices: mesh
-                .vertices
-                .iter()
-                .map(|v| DVec3::new(v.x - centre.x, -(v.y - centre.y), hi.z - v.z) * scale_to_mm)
-                .collect(),
-            triangles: mesh.triangles.clone(),
-        })
+        ObjectSurface::Mesh(mesh_top(mesh, scale_to_mm))
     }
 
     /// The footprint corners of a box, counter-clockwise (empty for other shapes).

@@ -4,7 +4,7 @@
 //! markers and noise are randomised. Each sample is drawn from (seed, index, attempt) alone, so
 //! any shard of a data set can be generated anywhere, in any order.
 
-use crate::contact::{ContactSolver, Fidelity, ObjectSurface};
+use crate::contact::{ContactSolver, Fidelity, ObjectSurface, mesh_top};
 use crate::datagen::press_protocol::{PlannedPress, PressError, PressSetup, plan_press};
 use crate::mesh::{self, Lobe};
 use crate::render::gel::SensorOptics;
@@ -470,9 +470,7 @@ impl SampleDraw {
         let centre_mm = DVec2::from_array(self.offset_mm);
         let yaw_rad = self.yaw_deg.to_radians();
         let placed = |m: &mesh::TriMesh| {
-            let ObjectSurface::Mesh(top) = ObjectSurface::from_mesh_top(m, 1.0) else {
-                unreachable!("from_mesh_top gives a mesh")
-            };
+            let top = mesh_top(m, 1.0);
             // The highest point of an irregular body need not sit over its bounding box's
             // middle: centre the pad on it, as the robot centres on the top it sees.
             let apex = top
