@@ -12,8 +12,8 @@ use tactex_core::hertz::Elastic;
 use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_sim::contact::{
-    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
-    mesh_top,
+    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, MAX_CELLS,
+    ObjectSurface, Rect, mesh_top,
 };
 use tactex_sim::datagen::press_protocol::{PlannedPress, PressSetup, plan_press};
 use tactex_sim::render::gel::{
@@ -185,6 +185,15 @@ impl PressRequest {
         let mut solver = ContactSolver::new();
         solver.settings.tolerance = self.tolerance;
         let solution = solver.solve(&problem, self.fidelity)?;
+        // The gel's fields are rendered over the whole pad at the solver's cell: a contact
+        // far smaller than a pixel would ask for billions of cells (a 0.01 mm sphere: 7.8 GB).
+        let across = pad.size().max_element() / solution.grid.cell_mm;
+        if across > MAX_CELLS as f64 {
+            bail!(
+                "the object is too small to press: its {:.5} mm solver cells would need {across:.0} across the pad (at most {MAX_CELLS}); press a larger one (--radius-mm, --size-mm, --mesh-scale) or give --grid-mm",
+                solution.grid.cell_mm
+            );
+        }
         let shown = HardnessReport::from(self.hardness);
         let report = PressReport {
             fidelity: self.fidelity.to_string(),

@@ -192,3 +192,29 @@ fn ball_presses_too_small_or_too_large_for_the_frame_are_refused() {
         assert!(!out_dir.exists());
     }
 }
+
+#[test]
+fn an_object_too_small_for_the_pad_is_refused_not_rendered_out_of_memory() {
+    // A 0.01 mm sphere's solver cells are 0.5 um: rendered over the pad they asked for 7.8 GB.
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("speck");
+    let out = tactex(&[
+        "press",
+        "--shape",
+        "sphere",
+        "--radius-mm",
+        "0.01",
+        "--hardness",
+        "40A",
+        "--depth-mm",
+        "0.6",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let err = one_line_error(&out);
+    assert!(
+        err.contains("too small") && err.contains("--radius-mm"),
+        "{err}"
+    );
+    assert!(!out_dir.exists());
+}
