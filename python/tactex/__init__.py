@@ -435,14 +435,14 @@ def calibrate(
     gel_thickness_mm: Optional[float] = None,
     gel_poisson: Optional[float] = None,
     frame_rate_hz: Optional[float] = None,
-    split: str = "calib",
-    mag_bins: int = 12,
-    dir_bins: int = 24,
-    mag_max: float = 2.5,
-    smoothness: float = 20.0,
+    split: Optional[str] = None,
+    mag_bins: Optional[int] = None,
+    dir_bins: Optional[int] = None,
+    mag_max: Optional[float] = None,
+    smoothness: Optional[float] = None,
     source: str = "",
     glow: bool = True,
-    fidelity: str = "layer",
+    fidelity: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Calibrates a real sensor from ball presses, as ``tactex calibrate``: the gradient ->
     colour table from the frames in ``images`` (circles in the ``annotations`` CSV:
@@ -451,7 +451,8 @@ def calibrate(
     grid of a ``markers`` frame when given. Writes the sensor profile to ``out`` (its
     background beside it) and returns what ``calibrate --json`` prints: the profile's path
     and id, presses and pixels fitted, the table's rms residual per channel, the noise and
-    the markers read. ``Sensor(out)`` then presses through it."""
+    the markers read. ``Sensor(out)`` then presses through it. Arguments left as None take
+    the command's defaults (``tactex calibrate --help``)."""
     argv = _flags(
         images=images,
         annotations=annotations,
@@ -487,9 +488,9 @@ def compare(
     seed: Optional[int] = None,
     gel_modulus_mpa: Optional[float] = None,
     estimator: Optional[str] = None,
-    split: str = "eval",
-    fidelity: str = "layer",
-    device: str = "auto",
+    split: Optional[str] = None,
+    fidelity: Optional[str] = None,
+    device: Optional[str] = None,
     glow: bool = True,
     out: Optional[PathLike] = None,
 ) -> Dict[str, Any]:
@@ -503,7 +504,9 @@ def compare(
     A recorded ``session`` (``tactex ask --record DIR``): every press rebuilt in the twin
     (``sensor`` default the built-in Mini; ``scene``, ``seed``, ``gel_modulus_mpa`` and
     ``estimator`` as for ``ask``) and scored recorded against rebuilt, with the hardness
-    each reads. ``out`` writes the side-by-side images and the JSON there."""
+    each reads. ``out`` writes the side-by-side images and the JSON there. Arguments left
+    as None take the command's defaults (``tactex compare --help``: split eval, fidelity
+    layer, device auto)."""
     argv = _flags(
         sensor=sensor,
         images=images,
