@@ -32,8 +32,9 @@ struct GlowTerm {
     // Where the term's kernel starts in the stages' kernel array, and its radius (taps -r..=r).
     offset: u32,
     radius: u32,
-    // 1: the source is the change's magnitude (in channel 0).
-    magnitude: u32,
+    // The source (GlowSource::code): 0 the change, 1 its magnitude (in channel 0), 2 the
+    // gel's indentation in mm (in channel 0), 3 the change times the indentation.
+    source: u32,
     padding: u32,
 }
 

@@ -1,21 +1,34 @@
 // Glow, pass 1 of a term: the term's source (the shading's change from the flat gel's
-// shading, or that change's magnitude in channel 0) blurred along each row, edges extended.
+// shading, its magnitude, the gel's indentation, or the change times the indentation)
+// blurred along each row, edges extended.
 
 @group(0) @binding(1) var<uniform> term: GlowTerm;
 @group(0) @binding(2) var<storage, read> kernel: array<f32>;
 @group(0) @binding(3) var<storage, read> flat: array<f32>;
 @group(0) @binding(4) var<storage, read> shaded: array<f32>;
-@group(0) @binding(5) var<storage, read_write> along_rows: array<f32>;
+@group(0) @binding(5) var<storage, read> heights: array<f32>;
+@group(0) @binding(6) var<storage, read_write> along_rows: array<f32>;
 
 fn source(frame: u32, x: u32, y: u32) -> vec3<f32> {
     let pixel = y * params.width + x;
     let k = (frame * pixel_count() + pixel) * 3u;
     let f = pixel * 3u;
     let change = vec3<f32>(shaded[k] - flat[f], shaded[k + 1u] - flat[f + 1u], shaded[k + 2u] - flat[f + 2u]);
-    if (term.magnitude == 1u) {
-        return vec3<f32>(length(change), 0.0, 0.0);
+    let indentation = heights[frame * pixel_count() + pixel];
+    switch term.source {
+        case 1u: {
+            return vec3<f32>(length(change), 0.0, 0.0);
+        }
+        case 2u: {
+            return vec3<f32>(indentation, 0.0, 0.0);
+        }
+        case 3u: {
+            return change * indentation;
+        }
+        default: {
+            return change;
+        }
     }
-    return change;
 }
 
 @compute @workgroup_size(8, 8, 1)

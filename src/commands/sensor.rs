@@ -5,6 +5,7 @@ use anyhow::Result;
 use clap::{Args, Subcommand};
 use serde::Serialize;
 use std::path::PathBuf;
+use tactex_core::tactile::gel_glow::{ColourGlow, ScalarGlow};
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_core::tactile::ssim::{gray, ssim};
 use tactex_sim::render::gel::{CpuRenderer, GelImageFields, PressFrame, SensorOptics};
@@ -100,14 +101,20 @@ fn summary(p: &SensorProfile) -> Summary {
             None => "three analytic lights".into(),
         },
         glow: p.glow.as_ref().map(|g| {
-            let sigmas = |v: &mut dyn Iterator<Item = f32>| {
-                v.map(|s| s.to_string()).collect::<Vec<_>>().join(", ")
-            };
-            format!(
-                "colour blurred at {} px, magnitude at {} px",
-                sigmas(&mut g.colour.iter().map(|t| t.sigma_px)),
-                sigmas(&mut g.magnitude.iter().map(|t| t.sigma_px))
-            )
+            let sigmas = |s: Vec<f32>| s.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", ");
+            let colour = |t: &[ColourGlow]| sigmas(t.iter().map(|t| t.sigma_px).collect());
+            let scalar = |t: &[ScalarGlow]| sigmas(t.iter().map(|t| t.sigma_px).collect());
+            [
+                ("colour", colour(&g.colour)),
+                ("magnitude", scalar(&g.magnitude)),
+                ("indentation", scalar(&g.indentation)),
+                ("indented colour", colour(&g.indented_colour)),
+            ]
+            .iter()
+            .filter(|(_, s)| !s.is_empty())
+            .map(|(source, s)| format!("{source} blurred at {s} px"))
+            .collect::<Vec<_>>()
+            .join("; ")
         }),
         markers: if m.cols * m.rows == 0 {
             "none".into()

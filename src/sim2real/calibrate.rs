@@ -14,7 +14,7 @@ use tactex_core::ground::centroid::median;
 use tactex_core::tactile::ball_calibration::{
     BallPress, SampleRule, camera_noise_sigma, samples_from_ball_press,
 };
-use tactex_core::tactile::gel_glow::{GelGlow, GlowPress};
+use tactex_core::tactile::gel_glow::{GelGlow, GlowDesign, GlowPress};
 use tactex_core::tactile::sensor_profile::{CalibrationFit, ProfileId, SensorProfile};
 use tactex_core::tactile::shading_table::{ShadingTable, frame_position};
 use tactex_core::tactile::spec::{GelSpec, TactileSpec};
@@ -124,10 +124,15 @@ pub struct MarkerReading {
     pub darkness: f64,
 }
 
-/// The glow's blurs (pixels): colour changes spread over 3-27 px, and a wider brightening
-/// that follows the change's magnitude (chosen on the FOTS presses, docs/sensor_profile.md).
-const GLOW_COLOUR_SIGMAS_PX: [f32; 4] = [0.0, 3.0, 9.0, 27.0];
-const GLOW_MAGNITUDE_SIGMAS_PX: [f32; 3] = [9.0, 27.0, 81.0];
+/// The glow's blurs (pixels): colour changes spread over 3-27 px, a wider brightening that
+/// follows the change's magnitude, and unblurred indentation terms for the contact's inside
+/// (chosen on the FOTS presses, docs/sensor_profile.md).
+const GLOW_DESIGN: GlowDesign = GlowDesign {
+    colour: &[0.0, 3.0, 9.0, 27.0],
+    magnitude: &[9.0, 27.0, 81.0],
+    indentation: &[0.0],
+    indented_colour: &[0.0],
+};
 
 /// The glow that maps the twin's renders of the presses onto the real frames: each press
 /// rebuilt and shaded without glow, its change from the flat gel's shading fitted to the
@@ -161,24 +166,18 @@ fn fit_glow(
             .zip(&flat)
             .map(|(p, f)| std::array::from_fn(|c| f32::from(p[c]) - f[c]))
             .collect();
-        changes.push((change, target, contact_box(press, w, h)));
+        changes.push((change, fields.normal_mm, target, contact_box(press, w, h)));
     }
     let fitted: Vec<GlowPress> = changes
         .iter()
-        .map(|(change, target, window)| GlowPress {
+        .map(|(change, indentation_mm, target, window)| GlowPress {
             change,
+            indentation_mm,
             target,
             window: *window,
         })
         .collect();
-    GelGlow::fit(
-        &fitted,
-        w as usize,
-        h as usize,
-        &GLOW_COLOUR_SIGMAS_PX,
-        &GLOW_MAGNITUDE_SIGMAS_PX,
-    )
-    .context("fitting the glow")
+    GelGlow::fit(&fitted, w as usize, h as usize, &GLOW_DESIGN).context("fitting the glow")
 }
 
 /// The marker grid of a real marker frame, in the profile's orientation (a frame turned a

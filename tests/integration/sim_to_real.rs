@@ -87,14 +87,15 @@ fn calibrated_renderer_matches_held_out_real_presses() {
         "{mean} vs {bare}"
     );
     // The glow fitted on the calibration presses carries to the held-out ones: the real
-    // contacts' wider coloured glow is closer than the slopes' shading alone (on the
-    // fixtures 0.961 -> 0.971 and 9.9 -> 7.4 grey levels).
+    // contacts' wider coloured glow and darker inside are closer than the slopes' shading
+    // alone (on the fixtures 0.961 -> 0.976 and 9.9 -> 7.6 grey levels; without the
+    // indentation terms the glow reached 0.971).
     let plain = compare(&["--no-glow"]);
     assert_eq!(plain["glow"], false);
     let plain = &plain["mean"];
     eprintln!("without glow {plain}");
     assert!(
-        v(mean, "ssim_contact") > v(plain, "ssim_contact") + 0.005,
+        v(mean, "ssim_contact") > v(plain, "ssim_contact") + 0.012,
         "{mean} vs {plain}"
     );
     assert!(

@@ -1,7 +1,9 @@
 //! Light scattered in the gel: real GelSight frames show a coloured glow spreading round a
-//! contact, wider than the gel's slopes reach. The glow is a sum of Gaussian blurs of the
-//! shading's colour change (each mixed across channels) and of its magnitude, fitted by
-//! least squares to real presses in `tactex calibrate` and applied by both renderers.
+//! contact, wider than the gel's slopes reach, and a contact's inside darker than its slopes
+//! shade (the object seen through the thinned gel). The glow is a sum of Gaussian blurs of
+//! the shading's colour change (each mixed across channels), of its magnitude, of the gel's
+//! indentation and of the change weighted by the indentation, fitted by least squares to
+//! real presses in `tactex calibrate` and applied by both renderers.
 
 use serde::{Deserialize, Serialize};
 
@@ -17,9 +19,16 @@ pub struct GelGlow {
     /// Blurs of the colour change, mixed across channels.
     #[serde(default)]
     pub colour: Vec<ColourGlow>,
-    /// Blurs of the change's magnitude, each adding a colour.
+    /// Blurs of the change's magnitude (grey levels), each adding a colour.
     #[serde(default)]
-    pub magnitude: Vec<MagnitudeGlow>,
+    pub magnitude: Vec<ScalarGlow>,
+    /// Blurs of the gel's indentation (mm), each adding a colour.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub indentation: Vec<ScalarGlow>,
+    /// Blurs of the colour change times the indentation (grey levels x mm), mixed across
+    /// channels: how the change itself differs where the gel is pressed in.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub indented_colour: Vec<ColourGlow>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -27,32 +36,89 @@ pub struct GelGlow {
 pub struct ColourGlow {
     /// Blur (pixels, 1 sigma; 0: none).
     pub sigma_px: f32,
-    /// Output channel c gains `mix[c][k]` times the blurred change of channel k.
+    /// Output channel c gains `mix[c][k]` times the blurred source's channel k.
     pub mix: [[f32; 3]; 3],
 }
 
+/// A blurred one-channel source adding a colour.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct MagnitudeGlow {
+pub struct ScalarGlow {
     pub sigma_px: f32,
-    /// Grey levels added per grey level of blurred change magnitude, per channel.
+    /// Grey levels added per channel per unit of the blurred source.
     pub colour: [f32; 3],
 }
 
-/// One term as the renderers run it: a source (the change, or its magnitude in channel 0),
-/// its blur, and a 3x3 mix into the output.
+/// What a term blurs: per pixel, from the shading's change and the gel's indentation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GlowSource {
+    /// The colour change (grey levels).
+    Change,
+    /// Its magnitude, in channel 0.
+    Magnitude,
+    /// The gel's indentation (mm), in channel 0.
+    Indentation,
+    /// The colour change times the indentation.
+    IndentedChange,
+}
+
+impl GlowSource {
+    /// The value the renderers blur at one pixel.
+    pub fn at(self, change: [f32; 3], indentation_mm: f32) -> [f32; 3] {
+        match self {
+            GlowSource::Change => change,
+            GlowSource::Magnitude => [
+                (change[0] * change[0] + change[1] * change[1] + change[2] * change[2]).sqrt(),
+                0.0,
+                0.0,
+            ],
+            GlowSource::Indentation => [indentation_mm, 0.0, 0.0],
+            GlowSource::IndentedChange => change.map(|v| v * indentation_mm),
+        }
+    }
+
+    /// How many of the source's channels carry it.
+    fn channels(self) -> usize {
+        match self {
+            GlowSource::Change | GlowSource::IndentedChange => 3,
+            GlowSource::Magnitude | GlowSource::Indentation => 1,
+        }
+    }
+
+    /// Its number in the shaders' `GlowTerm.source`.
+    pub fn code(self) -> u32 {
+        match self {
+            GlowSource::Change => 0,
+            GlowSource::Magnitude => 1,
+            GlowSource::Indentation => 2,
+            GlowSource::IndentedChange => 3,
+        }
+    }
+}
+
+/// One term as the renderers run it: a source, its blur, and a 3x3 mix into the output.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GlowTerm {
-    pub magnitude: bool,
+    pub source: GlowSource,
     pub sigma_px: f32,
     pub mix: [[f32; 3]; 3],
 }
 
-/// One press a glow is fitted to: the rendered change without glow, the real change (the
-/// real frame minus the rendered no-contact frame), and the pixel box `[x0, y0, x1, y1)` to
-/// fit over.
+/// The blurs of a glow to fit, per source (pixels).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GlowDesign<'a> {
+    pub colour: &'a [f32],
+    pub magnitude: &'a [f32],
+    pub indentation: &'a [f32],
+    pub indented_colour: &'a [f32],
+}
+
+/// One press a glow is fitted to: the rendered change without glow, the gel's indentation
+/// (mm), the real change (the real frame minus the rendered no-contact frame), and the
+/// pixel box `[x0, y0, x1, y1)` to fit over.
 pub struct GlowPress<'a> {
     pub change: &'a [[f32; 3]],
+    pub indentation_mm: &'a [f32],
     pub target: &'a [[f32; 3]],
     pub window: [u32; 4],
 }
@@ -118,33 +184,95 @@ pub fn blur(src: &[[f32; 3]], width: usize, height: usize, sigma_px: f32) -> Vec
     out
 }
 
-/// The change's magnitude (grey levels) in channel 0.
-fn magnitude(change: &[[f32; 3]]) -> Vec<[f32; 3]> {
+/// A source over a whole frame.
+fn source_image(source: GlowSource, change: &[[f32; 3]], indentation_mm: &[f32]) -> Vec<[f32; 3]> {
     change
         .iter()
-        .map(|c| [(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt(), 0.0, 0.0])
+        .zip(indentation_mm)
+        .map(|(&c, &d)| source.at(c, d))
         .collect()
 }
 
 impl GelGlow {
-    /// Its terms in the order the renderers sum them: colour terms, then magnitude terms.
+    /// A glow with the design's blurs and no weights.
+    fn unweighted(design: &GlowDesign) -> Self {
+        let colour = |s: &[f32]| {
+            s.iter()
+                .map(|&sigma_px| ColourGlow {
+                    sigma_px,
+                    mix: [[0.0; 3]; 3],
+                })
+                .collect()
+        };
+        let scalar = |s: &[f32]| {
+            s.iter()
+                .map(|&sigma_px| ScalarGlow {
+                    sigma_px,
+                    colour: [0.0; 3],
+                })
+                .collect()
+        };
+        GelGlow {
+            colour: colour(design.colour),
+            magnitude: scalar(design.magnitude),
+            indentation: scalar(design.indentation),
+            indented_colour: colour(design.indented_colour),
+        }
+    }
+
+    /// Its terms in the order the renderers sum them: colour, magnitude, indentation, then
+    /// indented colour terms.
     pub fn terms(&self) -> Vec<GlowTerm> {
-        let colour = self.colour.iter().map(|t| GlowTerm {
-            magnitude: false,
-            sigma_px: t.sigma_px,
-            mix: t.mix,
-        });
-        let magnitude = self.magnitude.iter().map(|t| GlowTerm {
-            magnitude: true,
-            sigma_px: t.sigma_px,
-            mix: t.colour.map(|v| [v, 0.0, 0.0]),
-        });
-        colour.chain(magnitude).collect()
+        let colour = |source, terms: &[ColourGlow]| -> Vec<GlowTerm> {
+            terms
+                .iter()
+                .map(|t| GlowTerm {
+                    source,
+                    sigma_px: t.sigma_px,
+                    mix: t.mix,
+                })
+                .collect()
+        };
+        let scalar = |source, terms: &[ScalarGlow]| -> Vec<GlowTerm> {
+            terms
+                .iter()
+                .map(|t| GlowTerm {
+                    source,
+                    sigma_px: t.sigma_px,
+                    mix: t.colour.map(|v| [v, 0.0, 0.0]),
+                })
+                .collect()
+        };
+        [
+            colour(GlowSource::Change, &self.colour),
+            scalar(GlowSource::Magnitude, &self.magnitude),
+            scalar(GlowSource::Indentation, &self.indentation),
+            colour(GlowSource::IndentedChange, &self.indented_colour),
+        ]
+        .concat()
+    }
+
+    /// Sets the weights from the fit's unknowns, term by term in `terms()` order, each term
+    /// taking as many unknowns as its source has channels.
+    fn set_weights(&mut self, x: &[[f64; 3]]) {
+        let mut next = x.iter().map(|v| v.map(|w| w as f32));
+        let mut take = || next.next().expect("one unknown per source channel");
+        let colour = |terms: &mut Vec<ColourGlow>, take: &mut dyn FnMut() -> [f32; 3]| {
+            for t in terms {
+                let columns = [take(), take(), take()];
+                t.mix = std::array::from_fn(|c| std::array::from_fn(|k| columns[k][c]));
+            }
+        };
+        colour(&mut self.colour, &mut take);
+        for t in self.magnitude.iter_mut().chain(&mut self.indentation) {
+            t.colour = take();
+        }
+        colour(&mut self.indented_colour, &mut take);
     }
 
     /// Checks every term; Err is the field (under `optics.glow`) and what is wrong with it.
     pub fn validate(&self) -> Result<(), (String, String)> {
-        let count = self.colour.len() + self.magnitude.len();
+        let count = self.terms().len();
         if count == 0 || count > MAX_TERMS {
             return Err((
                 "optics.glow".into(),
@@ -153,49 +281,53 @@ impl GelGlow {
         }
         let sigma_ok = |s: f32| s.is_finite() && (0.0..=MAX_SIGMA_PX).contains(&s);
         let weight_ok = |v: &f32| v.is_finite() && v.abs() <= 100.0;
-        for (i, t) in self.colour.iter().enumerate() {
-            if !sigma_ok(t.sigma_px) {
+        let check = |list: &str, i: usize, sigma: f32, weights: &[f32], what: &str| {
+            if !sigma_ok(sigma) {
                 return Err((
-                    format!("optics.glow.colour[{i}].sigma_px"),
-                    format!("{}, expected 0..={MAX_SIGMA_PX} px", t.sigma_px),
+                    format!("optics.glow.{list}[{i}].sigma_px"),
+                    format!("{sigma}, expected 0..={MAX_SIGMA_PX} px"),
                 ));
             }
-            if !t.mix.as_flattened().iter().all(weight_ok) {
+            if !weights.iter().all(weight_ok) {
                 return Err((
-                    format!("optics.glow.colour[{i}].mix"),
+                    format!("optics.glow.{list}[{i}].{what}"),
                     "weights must be finite and within +-100".into(),
                 ));
+            }
+            Ok(())
+        };
+        for (list, terms) in [
+            ("colour", &self.colour),
+            ("indented_colour", &self.indented_colour),
+        ] {
+            for (i, t) in terms.iter().enumerate() {
+                check(list, i, t.sigma_px, t.mix.as_flattened(), "mix")?;
             }
         }
-        for (i, t) in self.magnitude.iter().enumerate() {
-            if !sigma_ok(t.sigma_px) {
-                return Err((
-                    format!("optics.glow.magnitude[{i}].sigma_px"),
-                    format!("{}, expected 0..={MAX_SIGMA_PX} px", t.sigma_px),
-                ));
-            }
-            if !t.colour.iter().all(weight_ok) {
-                return Err((
-                    format!("optics.glow.magnitude[{i}].colour"),
-                    "weights must be finite and within +-100".into(),
-                ));
+        for (list, terms) in [
+            ("magnitude", &self.magnitude),
+            ("indentation", &self.indentation),
+        ] {
+            for (i, t) in terms.iter().enumerate() {
+                check(list, i, t.sigma_px, &t.colour, "colour")?;
             }
         }
         Ok(())
     }
 
-    /// The glowing change of a frame's change (both row-major, width x height).
-    pub fn apply(&self, change: &[[f32; 3]], width: usize, height: usize) -> Vec<[f32; 3]> {
+    /// The glowing change of a frame's change and the gel's indentation (mm; both row-major,
+    /// width x height).
+    pub fn apply(
+        &self,
+        change: &[[f32; 3]],
+        indentation_mm: &[f32],
+        width: usize,
+        height: usize,
+    ) -> Vec<[f32; 3]> {
         let mut out = vec![[0.0f32; 3]; change.len()];
-        let mags = (!self.magnitude.is_empty()).then(|| magnitude(change));
         for term in self.terms() {
-            let src = if term.magnitude {
-                mags.as_deref()
-                    .expect("computed when there are magnitude terms")
-            } else {
-                change
-            };
-            let blurred = blur(src, width, height, term.sigma_px);
+            let src = source_image(term.source, change, indentation_mm);
+            let blurred = blur(&src, width, height, term.sigma_px);
             for (o, b) in out.iter_mut().zip(&blurred) {
                 for (c, row) in term.mix.iter().enumerate() {
                     o[c] += row[0] * b[0] + row[1] * b[1] + row[2] * b[2];
@@ -205,43 +337,39 @@ impl GelGlow {
         out
     }
 
-    /// The glow with the given blurs that best maps the rendered changes onto the real ones
-    /// inside the presses' windows (least squares, with a light ridge towards no glow beyond
-    /// the unblurred change).
+    /// The glow with the design's blurs that best maps the rendered changes onto the real
+    /// ones inside the presses' windows (least squares, with a light ridge towards no glow).
     pub fn fit(
         presses: &[GlowPress],
         width: usize,
         height: usize,
-        colour_sigmas: &[f32],
-        magnitude_sigmas: &[f32],
+        design: &GlowDesign,
     ) -> Result<Self, GlowError> {
-        let n = 3 * colour_sigmas.len() + magnitude_sigmas.len();
+        let mut glow = Self::unweighted(design);
+        let terms = glow.terms();
+        let n: usize = terms.iter().map(|t| t.source.channels()).sum();
         let mut normal = vec![0.0f64; n * n];
         let mut rhs = vec![[0.0f64; 3]; n];
         let mut pixels = 0usize;
         let mut row = vec![0.0f64; n];
         for press in presses {
-            let features: Vec<Vec<[f32; 3]>> = colour_sigmas
+            let features: Vec<(usize, Vec<[f32; 3]>)> = terms
                 .iter()
-                .map(|&s| blur(press.change, width, height, s))
-                .chain({
-                    let m = magnitude(press.change);
-                    magnitude_sigmas
-                        .iter()
-                        .map(move |&s| blur(&m, width, height, s))
+                .map(|t| {
+                    let src = source_image(t.source, press.change, press.indentation_mm);
+                    (t.source.channels(), blur(&src, width, height, t.sigma_px))
                 })
                 .collect();
             let [x0, y0, x1, y1] = press.window;
             for y in y0 as usize..(y1 as usize).min(height) {
                 for x in x0 as usize..(x1 as usize).min(width) {
                     let p = y * width + x;
-                    for (k, f) in features.iter().take(colour_sigmas.len()).enumerate() {
-                        for c in 0..3 {
-                            row[3 * k + c] = f64::from(f[p][c]);
+                    let mut k = 0;
+                    for (channels, f) in &features {
+                        for &v in &f[p][..*channels] {
+                            row[k] = f64::from(v);
+                            k += 1;
                         }
-                    }
-                    for (k, f) in features.iter().skip(colour_sigmas.len()).enumerate() {
-                        row[3 * colour_sigmas.len() + k] = f64::from(f[p][0]);
                     }
                     let target = press.target[p].map(f64::from);
                     for (i, (ri, rhs_i)) in row.iter().zip(rhs.iter_mut()).enumerate() {
@@ -264,31 +392,14 @@ impl GelGlow {
                 normal[j * n + i] = normal[i * n + j];
             }
         }
-        // A ridge scaled to the data keeps terms the presses cannot tell apart small.
-        let trace: f64 = (0..n).map(|i| normal[i * n + i]).sum::<f64>() / n as f64;
+        // A ridge scaled to each unknown's own data keeps terms the presses cannot tell
+        // apart small, whatever their units (grey levels, mm).
         for i in 0..n {
-            normal[i * n + i] += 1e-6 * trace.max(1e-12);
+            normal[i * n + i] = normal[i * n + i] * (1.0 + 1e-6) + 1e-12;
         }
         let x = crate::tactile::shading_table::solve_spd(&mut normal, n, &rhs)
             .ok_or(GlowError::Singular)?;
-        let glow = GelGlow {
-            colour: colour_sigmas
-                .iter()
-                .enumerate()
-                .map(|(k, &sigma_px)| ColourGlow {
-                    sigma_px,
-                    mix: std::array::from_fn(|c| std::array::from_fn(|j| x[3 * k + j][c] as f32)),
-                })
-                .collect(),
-            magnitude: magnitude_sigmas
-                .iter()
-                .enumerate()
-                .map(|(k, &sigma_px)| MagnitudeGlow {
-                    sigma_px,
-                    colour: x[3 * colour_sigmas.len() + k].map(|v| v as f32),
-                })
-                .collect(),
-        };
+        glow.set_weights(&x);
         glow.validate()
             .map_err(|(field, message)| GlowError::Invalid { field, message })?;
         Ok(glow)
@@ -336,10 +447,20 @@ mod tests {
         assert!(peak(&b) < 0.8 * peak(&s));
     }
 
+    /// A ball's imprint: 0.4 mm deep at the middle of the spot.
+    fn dent(w: usize, h: usize) -> Vec<f32> {
+        (0..w * h)
+            .map(|p| {
+                let (x, y) = ((p % w) as f32 - 20.0, (p / w) as f32 - 15.0);
+                (0.4 - 0.01 * (x * x + y * y)).max(0.0)
+            })
+            .collect()
+    }
+
     #[test]
     fn a_fit_recovers_the_glow_that_made_the_target() {
         let (w, h) = (40, 30);
-        let change = spot(w, h);
+        let (change, dent) = (spot(w, h), dent(w, h));
         let truth = GelGlow {
             colour: vec![
                 ColourGlow {
@@ -351,31 +472,67 @@ mod tests {
                     mix: [[0.4, 0.1, 0.0], [0.0, 0.3, 0.0], [0.0, 0.0, 0.5]],
                 },
             ],
-            magnitude: vec![MagnitudeGlow {
+            magnitude: vec![ScalarGlow {
                 sigma_px: 6.0,
                 colour: [0.2, 0.1, -0.1],
             }],
+            indentation: vec![ScalarGlow {
+                sigma_px: 0.0,
+                colour: [-20.0, -8.0, -6.0],
+            }],
+            indented_colour: vec![ColourGlow {
+                sigma_px: 0.0,
+                mix: [[0.5, 0.0, 0.0], [0.0, -0.3, 0.1], [0.0, 0.0, 0.2]],
+            }],
         };
-        let target = truth.apply(&change, w, h);
+        let target = truth.apply(&change, &dent, w, h);
         let fitted = GelGlow::fit(
             &[GlowPress {
                 change: &change,
+                indentation_mm: &dent,
                 target: &target,
                 window: [0, 0, w as u32, h as u32],
             }],
             w,
             h,
-            &[0.0, 4.0],
-            &[6.0],
+            &GlowDesign {
+                colour: &[0.0, 4.0],
+                magnitude: &[6.0],
+                indentation: &[0.0],
+                indented_colour: &[0.0],
+            },
         )
         .unwrap();
-        let again = fitted.apply(&change, w, h);
+        let again = fitted.apply(&change, &dent, w, h);
         let worst = again
             .iter()
             .zip(&target)
             .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
             .fold(0.0f32, f32::max);
         assert!(worst < 0.05, "worst residual {worst} grey levels");
+        let colour = fitted.indentation[0].colour;
+        assert!(
+            (colour[0] + 20.0).abs() < 0.5,
+            "indentation colour {colour:?}"
+        );
+    }
+
+    #[test]
+    fn the_indentation_darkens_only_where_the_gel_is_pressed_in() {
+        let (w, h) = (40, 30);
+        let glow = GelGlow {
+            colour: vec![],
+            magnitude: vec![],
+            indentation: vec![ScalarGlow {
+                sigma_px: 0.0,
+                colour: [-20.0, -8.0, -6.0],
+            }],
+            indented_colour: vec![],
+        };
+        let out = glow.apply(&vec![[0.0; 3]; w * h], &dent(w, h), w, h);
+        assert_eq!(out[0], [0.0; 3], "the corner is not pressed in");
+        let middle = out[15 * w + 20];
+        assert!((middle[0] + 8.0).abs() < 1e-4, "{middle:?}");
     }
 
     #[test]
@@ -386,6 +543,8 @@ mod tests {
                 mix: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
             }],
             magnitude: vec![],
+            indentation: vec![],
+            indented_colour: vec![],
         };
         assert!(g.validate().is_ok());
         g.colour[0].sigma_px = f32::NAN;
@@ -396,6 +555,16 @@ mod tests {
         g.colour[0].sigma_px = 1.0;
         g.colour[0].mix[1][2] = f32::INFINITY;
         assert_eq!(g.validate().unwrap_err().0, "optics.glow.colour[0].mix");
+        g.colour[0].mix[1][2] = 0.0;
+        g.indentation.push(ScalarGlow {
+            sigma_px: 0.0,
+            colour: [-300.0, 0.0, 0.0],
+        });
+        assert_eq!(
+            g.validate().unwrap_err().0,
+            "optics.glow.indentation[0].colour"
+        );
+        g.indentation.clear();
         g.colour.clear();
         assert_eq!(g.validate().unwrap_err().0, "optics.glow");
     }

@@ -608,9 +608,17 @@ mod tests {
                 sigma_px: 3.0,
                 mix: [[0.7, 0.1, 0.0], [0.0, 0.6, -0.05], [0.2, 0.0, 0.9]],
             }],
-            magnitude: vec![crate::tactile::gel_glow::MagnitudeGlow {
+            magnitude: vec![crate::tactile::gel_glow::ScalarGlow {
                 sigma_px: 27.0,
                 colour: [0.11, -0.02, 0.3],
+            }],
+            indentation: vec![crate::tactile::gel_glow::ScalarGlow {
+                sigma_px: 0.0,
+                colour: [-23.5, -9.1, -6.5],
+            }],
+            indented_colour: vec![crate::tactile::gel_glow::ColourGlow {
+                sigma_px: 0.0,
+                mix: [[0.2, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, -0.1]],
             }],
         });
         let path = dir.path().join("bench.toml");

@@ -4,7 +4,7 @@
 use glam::DVec2;
 use image::RgbImage;
 use tactex_core::hertz::Elastic;
-use tactex_core::tactile::gel_glow::{ColourGlow, GelGlow, MagnitudeGlow};
+use tactex_core::tactile::gel_glow::{ColourGlow, GelGlow, ScalarGlow};
 use tactex_core::tactile::shading_table::{ShadingSample, ShadingTable};
 use tactex_core::tactile::spec::TactileSpec;
 use tactex_sim::contact::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
@@ -153,7 +153,8 @@ fn gpu_and_cpu_paths_agree_on_a_set_of_presses() {
     let mut table = lights.clone();
     table.shading = Shading::Table(fitted_table(&lights));
     table.noise_sigma = 1.5;
-    // A glow of every kind: unblurred and blurred colour terms, a magnitude term.
+    // A glow of every kind: unblurred and blurred colour terms, magnitude, indentation and
+    // indented colour terms.
     let mut glowing = table.clone();
     glowing.glow = Some(GelGlow {
         colour: vec![
@@ -166,9 +167,17 @@ fn gpu_and_cpu_paths_agree_on_a_set_of_presses() {
                 mix: [[0.5, 0.0, -0.1], [0.1, 0.4, 0.0], [0.0, 0.2, 0.6]],
             },
         ],
-        magnitude: vec![MagnitudeGlow {
+        magnitude: vec![ScalarGlow {
             sigma_px: 9.0,
             colour: [0.3, 0.1, -0.2],
+        }],
+        indentation: vec![ScalarGlow {
+            sigma_px: 2.0,
+            colour: [-23.5, -9.1, -6.5],
+        }],
+        indented_colour: vec![ColourGlow {
+            sigma_px: 0.0,
+            mix: [[0.3, 0.0, 0.0], [0.0, -0.2, 0.1], [0.0, 0.0, 0.2]],
         }],
     });
     // And a camera exposed 1.7 times as long: bright parts saturate on both paths alike.

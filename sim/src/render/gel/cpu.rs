@@ -174,7 +174,7 @@ fn shading_change(
 }
 
 /// Stages 1-2 and the glow (gel_glow_*.wgsl): the flat gel's shading plus the glow of the
-/// frame's change from it.
+/// frame's change from it and of the gel's indentation.
 fn glowing(
     p: &RenderParams,
     optics: &SensorOptics,
@@ -182,7 +182,7 @@ fn glowing(
     heights: &[f32],
 ) -> Vec<[f32; 3]> {
     let (flat, change) = shading_change(p, optics, heights);
-    let mut out = glow.apply(&change, p.width as usize, p.height as usize);
+    let mut out = glow.apply(&change, heights, p.width as usize, p.height as usize);
     for (o, f) in out.iter_mut().zip(&flat) {
         *o = std::array::from_fn(|c| f[c] + o[c]);
     }

@@ -227,6 +227,7 @@ impl GpuRenderer {
                             &glow.kernel,
                             &glow.flat,
                             &shaded,
+                            &heights,
                             &along_rows,
                         ],
                     ),
@@ -324,7 +325,7 @@ struct GlowTermBlock {
     mix: [[f32; 4]; 3],
     offset: u32,
     radius: u32,
-    magnitude: u32,
+    source: u32,
     padding: u32,
 }
 
@@ -340,7 +341,7 @@ impl GpuRenderer {
                 mix: term.mix.map(|r| [r[0], r[1], r[2], 0.0]),
                 offset: kernel.len() as u32,
                 radius: (k.len() / 2) as u32,
-                magnitude: u32::from(term.magnitude),
+                source: term.source.code(),
                 padding: 0,
             };
             kernel.extend(k);
