@@ -474,7 +474,11 @@ mod tests {
         let one: Vec<[f32; 1]> = s.iter().map(|v| [v[0]]).collect();
         for sigma in [0.0, 1.5, 9.0] {
             let (a, b) = (blur(&three, w, h, sigma), blur(&one, w, h, sigma));
-            assert!(a.iter().zip(&b).all(|(a, b)| a[0].to_bits() == b[0].to_bits()));
+            assert!(
+                a.iter()
+                    .zip(&b)
+                    .all(|(a, b)| a[0].to_bits() == b[0].to_bits())
+            );
         }
     }
 
