@@ -105,7 +105,7 @@ pub struct GlowTerm {
 }
 
 /// The blurs of a glow to fit, per source (pixels).
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 pub struct GlowDesign<'a> {
     pub colour: &'a [f32],
     pub magnitude: &'a [f32],
@@ -214,29 +214,40 @@ fn blurred_source(
 }
 
 impl GelGlow {
-    /// A glow with the design's blurs and no weights.
-    fn unweighted(design: &GlowDesign) -> Self {
-        let colour = |s: &[f32]| {
-            s.iter()
-                .map(|&sigma_px| ColourGlow {
-                    sigma_px,
-                    mix: [[0.0; 3]; 3],
+    /// A glow with the design's blurs, its weights taken in `terms()` order from `next`, one
+    /// call per source channel (a column of the mix; a scalar term's colour).
+    fn from_design(design: &GlowDesign, next: &mut dyn FnMut() -> [f32; 3]) -> Self {
+        fn colour(sigmas: &[f32], next: &mut dyn FnMut() -> [f32; 3]) -> Vec<ColourGlow> {
+            sigmas
+                .iter()
+                .map(|&sigma_px| {
+                    let columns = [next(), next(), next()];
+                    ColourGlow {
+                        sigma_px,
+                        mix: std::array::from_fn(|c| std::array::from_fn(|k| columns[k][c])),
+                    }
                 })
                 .collect()
-        };
-        let scalar = |s: &[f32]| {
-            s.iter()
+        }
+        fn scalar(sigmas: &[f32], next: &mut dyn FnMut() -> [f32; 3]) -> Vec<ScalarGlow> {
+            sigmas
+                .iter()
                 .map(|&sigma_px| ScalarGlow {
                     sigma_px,
-                    colour: [0.0; 3],
+                    colour: next(),
                 })
                 .collect()
-        };
+        }
+        // Fields in `terms()` order: the unknowns are taken in that order.
+        let colour_terms = colour(design.colour, next);
+        let magnitude = scalar(design.magnitude, next);
+        let indentation = scalar(design.indentation, next);
+        let indented_colour = colour(design.indented_colour, next);
         GelGlow {
-            colour: colour(design.colour),
-            magnitude: scalar(design.magnitude),
-            indentation: scalar(design.indentation),
-            indented_colour: colour(design.indented_colour),
+            colour: colour_terms,
+            magnitude,
+            indentation,
+            indented_colour,
         }
     }
 
@@ -270,24 +281,6 @@ impl GelGlow {
             colour(GlowSource::IndentedChange, &self.indented_colour),
         ]
         .concat()
-    }
-
-    /// Sets the weights from the fit's unknowns, term by term in `terms()` order, each term
-    /// taking as many unknowns as its source has channels.
-    fn set_weights(&mut self, x: &[[f64; 3]]) {
-        let mut next = x.iter().map(|v| v.map(|w| w as f32));
-        let mut take = || next.next().expect("one unknown per source channel");
-        let colour = |terms: &mut Vec<ColourGlow>, take: &mut dyn FnMut() -> [f32; 3]| {
-            for t in terms {
-                let columns = [take(), take(), take()];
-                t.mix = std::array::from_fn(|c| std::array::from_fn(|k| columns[k][c]));
-            }
-        };
-        colour(&mut self.colour, &mut take);
-        for t in self.magnitude.iter_mut().chain(&mut self.indentation) {
-            t.colour = take();
-        }
-        colour(&mut self.indented_colour, &mut take);
     }
 
     /// Checks every term; Err is the field (under `optics.glow`) and what is wrong with it.
@@ -364,8 +357,7 @@ impl GelGlow {
         height: usize,
         design: &GlowDesign,
     ) -> Result<Self, GlowError> {
-        let mut glow = Self::unweighted(design);
-        let terms = glow.terms();
+        let terms = Self::from_design(design, &mut || [0.0; 3]).terms();
         let n: usize = terms.iter().map(|t| t.source.channels()).sum();
         let mut normal = vec![0.0f64; n * n];
         let mut rhs = vec![[0.0f64; 3]; n];
@@ -418,7 +410,10 @@ impl GelGlow {
         }
         let x = crate::tactile::shading_table::solve_spd(&mut normal, n, &rhs)
             .ok_or(GlowError::Singular)?;
-        glow.set_weights(&x);
+        let mut unknowns = x.iter().map(|v| v.map(|w| w as f32));
+        let glow = Self::from_design(design, &mut || {
+            unknowns.next().expect("one unknown per source channel")
+        });
         glow.validate()
             .map_err(|(field, message)| GlowError::Invalid { field, message })?;
         Ok(glow)
