@@ -53,6 +53,9 @@ pub enum Command {
     /// Contact or not against a no-contact frame (the paper's SSIM criterion), and the
     /// contact circle and region.
     Contact(commands::contact::ContactArgs),
+    /// What the twin reads from one tactile frame through a sensor's optics: the gel's
+    /// indentation map, the imprint's peak depth and the contact's size.
+    Read(commands::read::ReadArgs),
     /// A YOLOv8-seg ONNX model on one colour image: boxes, scores, masks, an overlay PNG.
     Detect(commands::detect::DetectArgs),
     /// Evaluations on the twin.
@@ -143,6 +146,7 @@ pub fn run(command: Command) -> Result<()> {
         Command::Compare(args) => sim2real::compare::run(&args),
         Command::Markers(args) => commands::markers::run(&args),
         Command::Contact(args) => commands::contact::run(&args),
+        Command::Read(args) => commands::read::run(&args),
         Command::Detect(args) => commands::detect::run(&args),
         Command::Eval {
             command: EvalCommand::Grounding(args),

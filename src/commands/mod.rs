@@ -8,5 +8,6 @@ pub mod detect;
 pub mod markers;
 pub mod parse;
 pub mod press;
+pub mod read;
 pub mod scene;
 pub mod sensor;

@@ -100,7 +100,7 @@ fn summary(p: &SensorProfile) -> Summary {
             ),
             None => "three analytic lights".into(),
         },
-        glow: p.glow.as_ref().map(|g| {
+        glow: p.spec.glow.as_ref().map(|g| {
             let sigmas = |s: Vec<f32>| s.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", ");
             let colour = |t: &[ColourGlow]| sigmas(t.iter().map(|t| t.sigma_px).collect());
             let scalar = |t: &[ScalarGlow]| sigmas(t.iter().map(|t| t.sigma_px).collect());

@@ -1,6 +1,7 @@
 //! What the commands write: files that appear whole or not at all (`output`), plots
 //! (`plot`), NumPy archives (`npz`), comparison images, overlay colours and summaries.
 
+pub mod indentation_view;
 pub mod npz;
 pub mod output;
 pub mod palette;

@@ -330,6 +330,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
             markers: grid,
             frame_rate_hz,
             table: Some(table),
+            glow: None,
             ..stock.spec.clone()
         },
         background: Some(flat_gel),
@@ -339,7 +340,6 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
         // The presses' own exposure: the background was taken at it.
         exposure: 1.0,
         marker_darkness,
-        glow: None,
         fit: Some(CalibrationFit {
             images: presses.iter().map(|(p, _)| p.image.clone()).collect(),
             samples: samples.len(),
@@ -348,7 +348,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
         }),
     };
     if !args.no_glow {
-        profile.glow = Some(fit_glow(&profile, &presses, radius, args.fidelity)?);
+        profile.spec.glow = Some(fit_glow(&profile, &presses, radius, args.fidelity)?);
     }
     profile
         .validate()
@@ -364,7 +364,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
         rms_grey: rms,
         noise_sigma_grey,
         markers,
-        glow: profile.glow.is_some(),
+        glow: profile.spec.glow.is_some(),
     })
 }
 

@@ -13,6 +13,7 @@ use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic};
 use crate::report::side_by_side::side_by_side;
 use crate::sim2real::compare_session::{SessionCompare, SessionComparison, compare_session};
 use crate::sim2real::contact_circle_score::{CircleScore, CircleSummary, score_circle, summarise};
+use crate::sim2real::reading_score::{self, ReadingScore, ReadingSummary, score_reading};
 use anyhow::{Result, bail};
 use clap::Args;
 use image::RgbImage;
@@ -98,6 +99,10 @@ pub struct PressComparison {
     /// frame) and on the rendered one (against the rendered no-contact frame).
     pub circle_real: Option<CircleScore>,
     pub circle_rendered: Option<CircleScore>,
+    /// The frame read through the profile (indentation map, as the estimators read it): its
+    /// peak depth against the rebuilt press's and its contact radius against the marked one.
+    pub reading_real: Option<ReadingScore>,
+    pub reading_rendered: Option<ReadingScore>,
     pub warnings: Vec<String>,
 }
 
@@ -115,6 +120,8 @@ pub struct CompareReport {
     pub background_only_mean: Scores,
     pub circle_real: CircleSummary,
     pub circle_rendered: CircleSummary,
+    pub reading_real: ReadingSummary,
+    pub reading_rendered: ReadingSummary,
 }
 
 /// Mean absolute difference over all channels (grey levels).
@@ -295,6 +302,8 @@ fn compare_ball_presses(args: &CompareArgs) -> Result<CompareReport> {
             background_only: scores(real, &background, press),
             circle_real: score_circle(real, real_background, press),
             circle_rendered: score_circle(rendered, &background, press),
+            reading_real: score_reading(real, real_background, spec, press, *depth),
+            reading_rendered: score_reading(rendered, &background, spec, press, *depth),
             warnings: warnings.clone(),
         });
     }
@@ -308,6 +317,10 @@ fn compare_ball_presses(args: &CompareArgs) -> Result<CompareReport> {
         background_only_mean: mean(out.iter().map(|p| p.background_only)),
         circle_real: summarise(out.iter().map(|p| &p.circle_real)),
         circle_rendered: summarise(out.iter().map(|p| &p.circle_rendered)),
+        reading_real: reading_score::summarise(out.iter().filter_map(|p| p.reading_real.as_ref())),
+        reading_rendered: reading_score::summarise(
+            out.iter().filter_map(|p| p.reading_rendered.as_ref()),
+        ),
         presses: out,
     };
     if let Some(dir) = out_dir {
@@ -390,6 +403,19 @@ fn print_report(report: &CompareReport) {
             c.centre_error_median_px,
             c.radius_error_median_px,
             c.radius_error_mean_abs_px
+        );
+    }
+    for (frames, r) in [
+        ("real", &report.reading_real),
+        ("rendered", &report.reading_rendered),
+    ] {
+        println!(
+            "read on the {frames} frames ({} presses): peak depth vs the model's {:+.1}% median ({:.1}% median |error|), contact radius vs the marked one {:+.1}% ({:.1}%)",
+            r.presses,
+            100.0 * r.depth_error_median,
+            100.0 * r.depth_error_median_abs,
+            100.0 * r.radius_error_median,
+            100.0 * r.radius_error_median_abs
         );
     }
 }

@@ -5,3 +5,4 @@ pub mod calibrate;
 pub mod compare;
 pub mod compare_session;
 pub mod contact_circle_score;
+pub mod reading_score;

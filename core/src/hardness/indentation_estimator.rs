@@ -16,10 +16,8 @@ use crate::hardness::gel_share_fit::{fit_gel_share, gel_share};
 use crate::hardness::layer_compliance::hertz_ellipse_centre_compliance_ratio;
 use crate::hardness::scale::Hardness;
 use crate::hertz::Elastic;
-use crate::tactile::depth::integrate_slopes;
-use crate::tactile::slopes::recover_slopes;
+use crate::tactile::frame_reading::read_frame;
 use crate::tactile::spec::TactileSpec;
-use std::f64::consts::PI;
 
 #[derive(Clone, Debug)]
 pub struct IndentationEstimator {
@@ -33,89 +31,6 @@ impl Default for IndentationEstimator {
             object_poisson: 0.35,
         }
     }
-}
-
-/// The peak of an indentation map: the mean of its 20 deepest pixels, which averages out the
-/// integration's pixel noise while staying within the contact's centre.
-fn peak(depth: &[f64]) -> f64 {
-    let mut sorted: Vec<f64> = depth.to_vec();
-    let n = sorted.len().min(20);
-    let k = sorted.len() - n;
-    sorted.select_nth_unstable_by(k, f64::total_cmp);
-    sorted[k..].iter().sum::<f64>() / n as f64
-}
-
-/// The contact's semi-axes (mm, wide then narrow) from the imprint's half-depth region (where
-/// `inside` holds), taken
-/// as the half-depth ellipse of a Hertz dimple: its area fixes the scale (the half-depth
-/// ellipse's axes are 0.866 of the contact's) and its second moments the aspect, so an
-/// elongated imprint (a banana's) keeps its narrow side. Empty: [0, 0].
-fn contact_ellipse(
-    depth: &[f64],
-    w: usize,
-    inside: impl Fn(f64) -> bool,
-    mm_per_px: f64,
-) -> [f64; 2] {
-    let (mut n, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for (i, d) in depth.iter().enumerate() {
-        if inside(*d) {
-            let (x, y) = ((i % w) as f64, (i / w) as f64);
-            n += 1.0;
-            sx += x;
-            sy += y;
-            sxx += x * x;
-            syy += y * y;
-            sxy += x * y;
-        }
-    }
-    if n == 0.0 {
-        return [0.0, 0.0];
-    }
-    let (mx, my) = (sx / n, sy / n);
-    let (cxx, cyy, cxy) = (sxx / n - mx * mx, syy / n - my * my, sxy / n - mx * my);
-    let mean = 0.5 * (cxx + cyy);
-    let spread = (0.25 * (cxx - cyy).powi(2) + cxy * cxy).sqrt();
-    // Eigenvalues of the covariance; a pixel's own 1/12 keeps a one-pixel line finite.
-    let (wide, narrow) = (
-        mean + spread + 1.0 / 12.0,
-        (mean - spread).max(0.0) + 1.0 / 12.0,
-    );
-    let aspect = (wide / narrow).sqrt();
-    let equal_area_radius = (n / PI).sqrt() * mm_per_px / 0.866;
-    [
-        equal_area_radius * aspect.sqrt(),
-        equal_area_radius / aspect.sqrt(),
-    ]
-}
-
-/// The frame's outermost two pixels, row-major indices.
-fn border(w: usize, h: usize) -> impl Iterator<Item = usize> {
-    (0..h).flat_map(move |y| {
-        (0..w)
-            .filter(move |x| *x < 2 || y < 2 || x + 2 >= w || y + 2 >= h)
-            .map(move |x| y * w + x)
-    })
-}
-
-/// Whether an imprint of this peak lies within the frame: its half-depth region stays off
-/// the border, and the border is level (its deepest 5% lie less than half the peak below its
-/// shallowest 5%). The map's zero is the border's median, so a border pressed in on one side
-/// (a broad fruit whose contact outgrows the pad) lowers the zero and the peak reads short
-/// while the half-depth region, measured from that same zero, never reaches the edge.
-fn imprint_within_frame(depth: &[f64], valid: &[bool], w: usize, h: usize, peak: f64) -> bool {
-    if border(w, h).any(|i| depth[i] > 0.5 * peak) {
-        return false;
-    }
-    let mut edge: Vec<f64> = border(w, h)
-        .filter(|i| valid[*i])
-        .map(|i| depth[i])
-        .collect();
-    if edge.len() < 20 {
-        return true;
-    }
-    edge.sort_by(f64::total_cmp);
-    let at = |q: f64| edge[((edge.len() - 1) as f64 * q).round() as usize];
-    at(0.95) - at(0.05) <= 0.5 * peak
 }
 
 impl HardnessEstimator for IndentationEstimator {
@@ -142,22 +57,13 @@ impl HardnessEstimator for IndentationEstimator {
         let mut contact_axes = Vec::with_capacity(n);
         let mut within_frame = Vec::with_capacity(n);
         for frame in &press.frames {
-            let slopes =
-                recover_slopes(&frame.image, &press.reference.image, spec).ok_or_else(|| {
+            let reading =
+                read_frame(&frame.image, &press.reference.image, spec).ok_or_else(|| {
                     EstimateError::BadSequence("frame and reference sizes differ".into())
                 })?;
-            let depth = integrate_slopes(&slopes, spec.mm_per_px);
-            let p = peak(&depth);
-            let deep = |d: f64| d > 0.5 * p;
-            contact_axes.push(contact_ellipse(&depth, slopes.width, deep, spec.mm_per_px));
-            within_frame.push(imprint_within_frame(
-                &depth,
-                &slopes.valid,
-                slopes.width,
-                slopes.height,
-                p,
-            ));
-            peaks.push(p);
+            contact_axes.push(reading.contact_axes_mm);
+            within_frame.push(reading.within_frame);
+            peaks.push(reading.peak_mm);
         }
         if !peaks.last().is_some_and(|p| *p > 0.0) {
             return Err(EstimateError::NoImprint);
@@ -225,72 +131,5 @@ impl HardnessEstimator for IndentationEstimator {
                 }),
             }),
         })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A Gaussian dimple of depth 1 centred at (cx, cy) px with width `sigma` on a 160 x 120
-    /// frame, over a gel lowered by `tilt` at the top edge and not at the bottom (a broad
-    /// contact beyond the top edge), zeroed as `integrate_slopes` zeroes: the border's median.
-    fn imprint(cx: f64, cy: f64, sigma: f64, tilt: f64) -> Vec<f64> {
-        let (w, h) = (160usize, 120usize);
-        let mut depth: Vec<f64> = (0..w * h)
-            .map(|i| {
-                let (x, y) = ((i % w) as f64 - cx, (i / w) as f64 - cy);
-                let lowered = tilt * (1.0 - (i / w) as f64 / (h - 1) as f64);
-                (-(x * x + y * y) / (2.0 * sigma * sigma)).exp() + lowered
-            })
-            .collect();
-        let mut edge: Vec<f64> = border(w, h).map(|i| depth[i]).collect();
-        edge.sort_by(f64::total_cmp);
-        let zero = edge[edge.len() / 2];
-        depth.iter_mut().for_each(|d| *d -= zero);
-        depth
-    }
-
-    #[test]
-    fn an_imprint_that_outgrows_the_pad_on_one_side_is_not_within_the_frame() {
-        let valid = vec![true; 160 * 120];
-        let within = |d: &[f64]| imprint_within_frame(d, &valid, 160, 120, peak(d));
-        // A small imprint in the middle leaves the border level, and a slightly lowered
-        // side is tolerated.
-        assert!(within(&imprint(80.0, 60.0, 12.0, 0.0)));
-        assert!(within(&imprint(80.0, 60.0, 12.0, 0.3)));
-        // The gel pressed in along the top edge by 0.7 of the imprint's depth: its
-        // half-depth region, measured from the border's lowered median, stays off the edge
-        // (the case the half-depth test alone missed), yet the zero is wrong.
-        let broad = imprint(80.0, 60.0, 12.0, 0.7);
-        let p = peak(&broad);
-        assert!(!border(160, 120).any(|i| broad[i] > 0.5 * p));
-        assert!(!within(&broad));
-        // An imprint whose half-depth region reaches the edge is cut as before.
-        assert!(!within(&imprint(3.0, 60.0, 12.0, 0.0)));
-    }
-
-    #[test]
-    fn an_elongated_turned_imprint_keeps_its_two_semi_axes() {
-        // A paraboloid dimple 1 - (x'/A)^2 - (y'/B)^2 turned 30 degrees: its half-depth ellipse
-        // has semi-axes A/sqrt 2 and B/sqrt 2, the contact's are those over 0.866.
-        let (w, h, big, small) = (160usize, 120usize, 40.0f64, 12.0f64);
-        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
-        let depth: Vec<f64> = (0..w * h)
-            .map(|i| {
-                let (x, y) = ((i % w) as f64 - 80.0, (i / w) as f64 - 60.0);
-                let (xr, yr) = (c * x + s * y, -s * x + c * y);
-                (1.0 - (xr / big).powi(2) - (yr / small).powi(2)).max(0.0)
-            })
-            .collect();
-        let [a, b] = contact_ellipse(&depth, w, |d| d > 0.5, 0.1);
-        let want = |axis: f64| axis / 2f64.sqrt() * 0.1 / 0.866;
-        assert!((a / want(big) - 1.0).abs() < 0.02, "{a} vs {}", want(big));
-        assert!(
-            (b / want(small) - 1.0).abs() < 0.03,
-            "{b} vs {}",
-            want(small)
-        );
-        assert_eq!(contact_ellipse(&[0.0; 4], 2, |d| d > 0.5, 0.1), [0.0, 0.0]);
     }
 }

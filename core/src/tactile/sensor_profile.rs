@@ -60,8 +60,6 @@ pub struct SensorProfile {
     pub exposure: f64,
     /// Fraction of the light a marker dot's centre blocks.
     pub marker_darkness: f64,
-    /// Light scattered in the gel round a contact (fitted by `calibrate`); None: no glow.
-    pub glow: Option<GelGlow>,
     pub fit: Option<CalibrationFit>,
 }
 
@@ -195,7 +193,6 @@ impl SensorProfile {
             vignette: 0.55,
             exposure: 1.0,
             marker_darkness: 0.82,
-            glow: None,
             fit: None,
         }
     }
@@ -291,6 +288,7 @@ impl SensorProfile {
                 },
                 photometric,
                 table,
+                glow: raw.optics.glow,
                 markers: MarkerGrid {
                     cols: m.cols,
                     rows: m.rows,
@@ -304,7 +302,6 @@ impl SensorProfile {
             vignette: c.vignette,
             exposure: c.exposure,
             marker_darkness: m.darkness,
-            glow: raw.optics.glow,
             fit: raw.fit,
         };
         profile
@@ -419,7 +416,7 @@ impl SensorProfile {
                 }
             }
         }
-        if let Some(glow) = &self.glow
+        if let Some(glow) = &s.glow
             && let Err((field, message)) = glow.validate()
         {
             return bad(&field, message);
@@ -511,7 +508,7 @@ impl SensorProfile {
                 shading: shading.into(),
                 lights,
                 table,
-                glow: self.glow.clone(),
+                glow: s.glow.clone(),
             },
             markers: MarkersSection {
                 cols: s.markers.cols,
@@ -603,7 +600,7 @@ mod tests {
         p.background = Some(RgbImage::from_fn(320, 240, |x, y| {
             image::Rgb([(x % 251) as u8, (y % 241) as u8, 90])
         }));
-        p.glow = Some(GelGlow {
+        p.spec.glow = Some(GelGlow {
             colour: vec![crate::tactile::gel_glow::ColourGlow {
                 sigma_px: 3.0,
                 mix: [[0.7, 0.1, 0.0], [0.0, 0.6, -0.05], [0.2, 0.0, 0.9]],

@@ -3,8 +3,10 @@
 //! sensor's profile read backwards). Marker dots and saturated pixels carry no shading and
 //! are left out.
 
+use crate::tactile::depth::integrate_slopes;
+use crate::tactile::glow_inverse::GlowInverse;
 use crate::tactile::photometric::PhotometricModel;
-use crate::tactile::shading_table::frame_position;
+use crate::tactile::shading_table::{ShadingTable, frame_position};
 use crate::tactile::spec::TactileSpec;
 use image::RgbImage;
 
@@ -60,28 +62,77 @@ pub fn recover_slopes(
             }
         }
     }
-    let mut gx = vec![0.0f32; w * h];
-    let mut gy = vec![0.0f32; w * h];
-    for (i, (p, r)) in frame.pixels().zip(reference.pixels()).enumerate() {
-        if !valid[i] {
-            continue;
+    let (mut gx, mut gy) = (vec![0.0f32; w * h], vec![0.0f32; w * h]);
+    match (&spec.table, &spec.glow) {
+        (Some(table), Some(glow)) => {
+            let observed: Vec<[f32; 3]> = frame
+                .pixels()
+                .zip(reference.pixels())
+                .zip(&valid)
+                .map(|((p, r), ok)| match ok {
+                    true => std::array::from_fn(|c| f32::from(p[c]) - f32::from(r[c])),
+                    false => [0.0; 3],
+                })
+                .collect();
+            let observed = without_drift(observed, &valid, w, h);
+            let inverse = GlowInverse::new(glow, w, h);
+            let mut change = inverse.solve(&observed);
+            read_table(table, &change, w, h, &mut valid, &mut gx, &mut gy);
+            if inverse.has_rest() {
+                // The glow's indentation and magnitude terms from this first reading,
+                // subtracted, and the change read again.
+                let field = SlopeField {
+                    width: w,
+                    height: h,
+                    gx: gx.clone(),
+                    gy: gy.clone(),
+                    valid: valid.clone(),
+                };
+                let depth: Vec<f32> = integrate_slopes(&field, spec.mm_per_px)
+                    .into_iter()
+                    .map(|d| d as f32)
+                    .collect();
+                let modelled: Vec<[f32; 3]> = (0..w * h)
+                    .map(|i| {
+                        let (u, v) =
+                            frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
+                        table.change(gx[i], gy[i], u, v)
+                    })
+                    .collect();
+                let rest = inverse.rest(&modelled, &depth);
+                let linear: Vec<[f32; 3]> = observed
+                    .iter()
+                    .zip(&rest)
+                    .map(|(o, r)| std::array::from_fn(|c| o[c] - r[c]))
+                    .collect();
+                change = inverse.solve(&linear);
+                read_table(table, &change, w, h, &mut valid, &mut gx, &mut gy);
+            }
         }
-        let slope = match &spec.table {
-            Some(table) => {
-                let (u, v) = frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
-                let change = std::array::from_fn(|c| f32::from(p[c]) - f32::from(r[c]));
-                table
-                    .slope_for_change(change, u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS)
-                    .map(|(sx, sy)| (f64::from(sx), f64::from(sy)))
+        _ => {
+            for (i, (p, r)) in frame.pixels().zip(reference.pixels()).enumerate() {
+                if !valid[i] {
+                    continue;
+                }
+                let slope = match &spec.table {
+                    Some(table) => {
+                        let (u, v) =
+                            frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
+                        let change = std::array::from_fn(|c| f32::from(p[c]) - f32::from(r[c]));
+                        table
+                            .slope_for_change(change, u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS)
+                            .map(|(sx, sy)| (f64::from(sx), f64::from(sy)))
+                    }
+                    None => lit_slope(&spec.photometric, p, r),
+                };
+                match slope {
+                    Some((sx, sy)) => {
+                        gx[i] = sx as f32;
+                        gy[i] = sy as f32;
+                    }
+                    None => valid[i] = false,
+                }
             }
-            None => lit_slope(&spec.photometric, p, r),
-        };
-        match slope {
-            Some((sx, sy)) => {
-                gx[i] = sx as f32;
-                gy[i] = sy as f32;
-            }
-            None => valid[i] = false,
         }
     }
     Some(SlopeField {
@@ -91,6 +142,62 @@ pub fn recover_slopes(
         gy,
         valid,
     })
+}
+
+/// Real frames drift in colour from shot to shot far from any contact (FOTS: up to 30 grey
+/// levels in blue), which the table would read as a tilt of the whole gel: the change's
+/// median over the frame's outer band is taken as that drift and removed.
+fn without_drift(mut observed: Vec<[f32; 3]>, valid: &[bool], w: usize, h: usize) -> Vec<[f32; 3]> {
+    let band = (w.min(h) / 16).max(2);
+    let edge: Vec<usize> = (0..w * h)
+        .filter(|i| {
+            let (x, y) = (i % w, i / w);
+            valid[*i] && (x < band || y < band || x + band >= w || y + band >= h)
+        })
+        .collect();
+    if edge.len() < 16 {
+        return observed;
+    }
+    let drift: [f32; 3] = std::array::from_fn(|c| {
+        let mut v: Vec<f32> = edge.iter().map(|i| observed[*i][c]).collect();
+        let k = v.len() / 2;
+        *v.select_nth_unstable_by(k, f32::total_cmp).1
+    });
+    for (o, ok) in observed.iter_mut().zip(valid) {
+        if *ok {
+            *o = std::array::from_fn(|c| o[c] - drift[c]);
+        }
+    }
+    observed
+}
+
+/// A calibrated table read backwards at every valid pixel of a shading change.
+fn read_table(
+    table: &ShadingTable,
+    change: &[[f32; 3]],
+    w: usize,
+    h: usize,
+    valid: &mut [bool],
+    gx: &mut [f32],
+    gy: &mut [f32],
+) {
+    for (i, c) in change.iter().enumerate() {
+        if !valid[i] {
+            continue;
+        }
+        let (u, v) = frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
+        match table.slope_for_change(*c, u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS) {
+            Some((sx, sy)) => {
+                gx[i] = sx;
+                gy[i] = sy;
+            }
+            None => {
+                gx[i] = 0.0;
+                gy[i] = 0.0;
+                valid[i] = false;
+            }
+        }
+    }
 }
 
 fn lit_slope(

@@ -1,5 +1,6 @@
 //! What a vision-based tactile sensor is: image geometry, gel, optics and marker grid.
 
+use crate::tactile::gel_glow::GelGlow;
 use crate::tactile::photometric::PhotometricModel;
 use crate::tactile::shading_table::ShadingTable;
 use serde::{Deserialize, Serialize};
@@ -34,6 +35,10 @@ pub struct TactileSpec {
     /// are rendered and read through it instead of the lights.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub table: Option<ShadingTable>,
+    /// Light scattered in the gel round a contact (fitted by `calibrate`): frames are rendered
+    /// with it and read through it. None: no glow.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub glow: Option<GelGlow>,
     pub markers: MarkerGrid,
     pub frame_rate_hz: f64,
 }
@@ -54,6 +59,7 @@ impl TactileSpec {
             },
             photometric: PhotometricModel::default(),
             table: None,
+            glow: None,
             markers: MarkerGrid {
                 cols: 9,
                 rows: 7,

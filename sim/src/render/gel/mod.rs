@@ -148,7 +148,7 @@ impl SensorOptics {
             vignette: profile.vignette as f32,
             exposure: profile.exposure as f32,
             noise_sigma: profile.noise_sigma_grey as f32,
-            glow: profile.glow.clone(),
+            glow: profile.spec.glow.clone(),
         }
     }
 

@@ -1,0 +1,213 @@
+//! The glow read backwards. A calibrated profile's glow replaces the shading's colour change S
+//! by a sum of blurs of it mixed across channels (linear in S) plus terms of its magnitude and
+//! of the gel's indentation. Reading a frame's change per pixel through the table as if it
+//! were S takes the glow for slope (a wide bowl round every contact). The linear part is a
+//! 3x3 matrix per spatial frequency, A(f) = sum_k M_k g_k(f), so S is recovered by a
+//! regularised inverse per frequency (on the frame's mirror extension, so nothing wraps); the
+//! other terms are taken from the previous reading and subtracted.
+
+use crate::spectral::fft2;
+use crate::tactile::gel_glow::{GelGlow, GlowSource, gaussian_kernel};
+use rustfft::num_complex::Complex;
+
+/// Tikhonov weight, relative to the zero-frequency gain: how much of a frequency the glow
+/// nearly cancels is given up rather than amplified with the camera's noise.
+const RIDGE: f64 = 0.01;
+
+/// The linear part of a glow inverted for one frame size.
+pub struct GlowInverse {
+    width: usize,
+    height: usize,
+    /// Per frequency of the 2w x 2h extension, the 3x3 regularised inverse, row-major.
+    inverse: Vec<[f64; 9]>,
+    /// The glow's other terms (magnitude, indentation, indented change); None when it has none.
+    rest: Option<GelGlow>,
+}
+
+/// The DFT of a symmetric kernel at the frequencies of a length-n signal.
+fn kernel_response(kernel: &[f32], n: usize) -> Vec<f64> {
+    let r = (kernel.len() / 2) as f64;
+    (0..n)
+        .map(|u| {
+            let omega = 2.0 * std::f64::consts::PI * u as f64 / n as f64;
+            kernel
+                .iter()
+                .enumerate()
+                .map(|(i, k)| f64::from(*k) * (omega * (i as f64 - r)).cos())
+                .sum()
+        })
+        .collect()
+}
+
+fn invert3(m: [f64; 9]) -> Option<[f64; 9]> {
+    let [a, b, c, d, e, f, g, h, i] = m;
+    let det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let k = 1.0 / det;
+    Some([
+        (e * i - f * h) * k,
+        (c * h - b * i) * k,
+        (b * f - c * e) * k,
+        (f * g - d * i) * k,
+        (a * i - c * g) * k,
+        (c * d - a * f) * k,
+        (d * h - e * g) * k,
+        (b * g - a * h) * k,
+        (a * e - b * d) * k,
+    ])
+}
+
+impl GlowInverse {
+    pub fn new(glow: &GelGlow, width: usize, height: usize) -> Self {
+        let (n, m) = (2 * width, 2 * height);
+        let colour: Vec<_> = glow
+            .terms()
+            .into_iter()
+            .filter(|t| t.source == GlowSource::Change)
+            .map(|t| {
+                let k = gaussian_kernel(t.sigma_px);
+                (kernel_response(&k, n), kernel_response(&k, m), t.mix)
+            })
+            .collect();
+        let gain_at = |u: usize, v: usize| {
+            let mut a = [0.0f64; 9];
+            for (gx, gy, mix) in &colour {
+                let g = gx[u] * gy[v];
+                for (c, row) in mix.iter().enumerate() {
+                    for (k, w) in row.iter().enumerate() {
+                        a[3 * c + k] += g * f64::from(*w);
+                    }
+                }
+            }
+            a
+        };
+        let zero = gain_at(0, 0);
+        let ridge = RIDGE * zero.iter().map(|v| v * v).sum::<f64>() / 3.0;
+        let mut inverse = Vec::with_capacity(n * m);
+        for v in 0..m {
+            for u in 0..n {
+                let a = gain_at(u, v);
+                // (A^T A + ridge I)^-1 A^T
+                let mut ata = [0.0f64; 9];
+                for i in 0..3 {
+                    for j in 0..3 {
+                        ata[3 * i + j] = (0..3).map(|c| a[3 * c + i] * a[3 * c + j]).sum();
+                    }
+                    ata[4 * i] += ridge;
+                }
+                let inv = invert3(ata).unwrap_or([0.0; 9]);
+                let mut b = [0.0f64; 9];
+                for i in 0..3 {
+                    for c in 0..3 {
+                        b[3 * i + c] = (0..3).map(|j| inv[3 * i + j] * a[3 * c + j]).sum();
+                    }
+                }
+                inverse.push(b);
+            }
+        }
+        let rest = GelGlow {
+            colour: Vec::new(),
+            ..glow.clone()
+        };
+        Self {
+            width,
+            height,
+            inverse,
+            rest: (!rest.terms().is_empty()).then_some(rest),
+        }
+    }
+
+    /// Whether the glow has terms beyond the linear ones (they need the gel's indentation).
+    pub fn has_rest(&self) -> bool {
+        self.rest.is_some()
+    }
+
+    /// The glow's other terms for a shading change and indentation (mm).
+    pub fn rest(&self, change: &[[f32; 3]], indentation_mm: &[f32]) -> Vec<[f32; 3]> {
+        match &self.rest {
+            Some(g) => g.apply(change, indentation_mm, self.width, self.height),
+            None => vec![[0.0; 3]; change.len()],
+        }
+    }
+
+    /// The shading change whose linear glow is `observed` (row-major, width x height).
+    pub fn solve(&self, observed: &[[f32; 3]]) -> Vec<[f32; 3]> {
+        let (w, h) = (self.width, self.height);
+        let (n, m) = (2 * w, 2 * h);
+        let mut spectra: Vec<Vec<Complex<f64>>> = (0..3)
+            .map(|c| {
+                let mut data = vec![Complex::new(0.0, 0.0); n * m];
+                for y in 0..m {
+                    let yy = if y < h { y } else { m - 1 - y };
+                    for x in 0..n {
+                        let xx = if x < w { x } else { n - 1 - x };
+                        data[y * n + x].re = f64::from(observed[yy * w + xx][c]);
+                    }
+                }
+                fft2(&mut data, n, m, false);
+                data
+            })
+            .collect();
+        for (k, b) in self.inverse.iter().enumerate() {
+            let o = [spectra[0][k], spectra[1][k], spectra[2][k]];
+            for (i, s) in spectra.iter_mut().enumerate() {
+                s[k] = o[0] * b[3 * i] + o[1] * b[3 * i + 1] + o[2] * b[3 * i + 2];
+            }
+        }
+        let scale = 1.0 / (n * m) as f64;
+        let mut out = vec![[0.0f32; 3]; w * h];
+        for (c, s) in spectra.iter_mut().enumerate() {
+            fft2(s, n, m, true);
+            for y in 0..h {
+                for x in 0..w {
+                    out[y * w + x][c] = (s[y * n + x].re * scale) as f32;
+                }
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tactile::gel_glow::ColourGlow;
+
+    #[test]
+    fn a_colour_glow_is_undone() {
+        let (w, h) = (48, 36);
+        let glow = GelGlow {
+            colour: vec![
+                ColourGlow {
+                    sigma_px: 0.0,
+                    mix: [[0.8, 0.1, 0.0], [0.0, 0.7, 0.1], [0.1, 0.0, 0.9]],
+                },
+                ColourGlow {
+                    sigma_px: 4.0,
+                    mix: [[0.5, 0.0, 0.2], [0.1, 0.4, 0.0], [0.0, 0.3, 0.6]],
+                },
+            ],
+            magnitude: Vec::new(),
+            indentation: Vec::new(),
+            indented_colour: Vec::new(),
+        };
+        let change: Vec<[f32; 3]> = (0..w * h)
+            .map(|p| {
+                let (x, y) = ((p % w) as f32 - 24.0, (p / w) as f32 - 18.0);
+                let d = (-(x * x + y * y) / 40.0).exp();
+                [30.0 * d, -12.0 * d * x.signum(), 8.0 * d]
+            })
+            .collect();
+        let glowing = glow.apply(&change, &vec![0.0; w * h], w, h);
+        let back = GlowInverse::new(&glow, w, h).solve(&glowing);
+        let worst = change
+            .iter()
+            .zip(&back)
+            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+            .fold(0.0f32, f32::max);
+        // The ridge gives up a little of every frequency; 30 grey levels come back within 2.
+        assert!(worst < 2.0, "worst {worst} grey levels");
+    }
+}

@@ -1,0 +1,127 @@
+//! `tactex read`: what the twin reads from one tactile frame (real or rendered) through a
+//! sensor's optics: the gel's indentation map, the imprint's peak depth and the contact's
+//! size, as the indentation estimator reads every frame of a press; `--out` draws it.
+
+use crate::app::{load_rgb, load_sensor};
+use crate::report::indentation_view::indentation_view;
+use crate::report::output::write_png_atomic;
+use anyhow::{Result, bail};
+use clap::Args;
+use serde::Serialize;
+use std::path::PathBuf;
+use tactex_core::tactile::frame_reading::{FrameReading, read_frame};
+use tactex_core::tactile::sensor_profile::ProfileId;
+
+#[derive(Args, Debug)]
+pub struct ReadArgs {
+    /// The tactile frame.
+    pub image: PathBuf,
+    /// A no-contact frame of the same sensor; default the profile's background.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Sensor profile whose optics the frame is read through (TOML); default the built-in
+    /// GelSight Mini.
+    #[arg(long)]
+    pub sensor: Option<PathBuf>,
+    /// Write the frame beside its indentation map, the contact outlined (PNG).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Serialize)]
+pub struct ReadReport {
+    pub image: String,
+    pub reference: String,
+    pub sensor: ProfileId,
+    /// The imprint's depth into the gel (mean of the 20 deepest pixels).
+    pub peak_depth_mm: f64,
+    /// The contact's semi-axes, wide then narrow (mm), from the half-depth region.
+    pub contact_axes_mm: [f64; 2],
+    /// The radius of the circle of the contact's area.
+    pub contact_radius_mm: f64,
+    /// Whether the imprint lies within the frame (else its depth reads short).
+    pub within_frame: bool,
+    /// Share of the pixels whose shading could be read.
+    pub readable_share: f64,
+}
+
+/// Reads the frame as the estimators do.
+pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImage)> {
+    let profile = load_sensor(args.sensor.as_deref())?;
+    let image = load_rgb(&args.image)?;
+    let (reference, reference_name) = match (&args.reference, &profile.background) {
+        (Some(path), _) => (load_rgb(path)?, path.display().to_string()),
+        (None, Some(bg)) => (bg.clone(), format!("{} (background)", profile.id())),
+        (None, None) => bail!(
+            "--reference: needed, the sensor profile {} has no background frame",
+            profile.id()
+        ),
+    };
+    let spec = &profile.spec;
+    let size = (spec.width_px, spec.height_px);
+    for (what, img) in [(&args.image, &image)] {
+        if img.dimensions() != size {
+            bail!(
+                "{}: {} x {} px, the sensor {} has {} x {}",
+                what.display(),
+                img.width(),
+                img.height(),
+                profile.id(),
+                size.0,
+                size.1
+            );
+        }
+    }
+    if reference.dimensions() != size {
+        bail!(
+            "--reference {reference_name}: {} x {} px, the sensor {} has {} x {}",
+            reference.width(),
+            reference.height(),
+            profile.id(),
+            size.0,
+            size.1
+        );
+    }
+    let reading = read_frame(&image, &reference, spec).expect("sizes were checked");
+    let readable = reading.valid.iter().filter(|v| **v).count();
+    let report = ReadReport {
+        image: args.image.display().to_string(),
+        reference: reference_name,
+        sensor: profile.id(),
+        peak_depth_mm: reading.peak_mm,
+        contact_axes_mm: reading.contact_axes_mm,
+        contact_radius_mm: reading.contact_radius_mm(),
+        within_frame: reading.within_frame,
+        readable_share: readable as f64 / reading.valid.len() as f64,
+    };
+    Ok((report, reading, image))
+}
+
+pub fn run(args: &ReadArgs) -> Result<()> {
+    let (report, reading, image) = read(args)?;
+    if let Some(out) = &args.out {
+        write_png_atomic(out, &indentation_view(&image, &reading))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    println!(
+        "{}: peak depth {:.3} mm, contact radius {:.3} mm (semi-axes {:.3} x {:.3} mm){}; read through {}",
+        report.image,
+        report.peak_depth_mm,
+        report.contact_radius_mm,
+        report.contact_axes_mm[0],
+        report.contact_axes_mm[1],
+        if report.within_frame {
+            ""
+        } else {
+            ", the imprint reaches the frame's edge (its depth reads short)"
+        },
+        report.sensor
+    );
+    Ok(())
+}
