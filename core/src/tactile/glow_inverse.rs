@@ -9,6 +9,7 @@
 use crate::spectral::fft2;
 use crate::tactile::gel_glow::{GelGlow, GlowSource, gaussian_kernel};
 use rustfft::num_complex::Complex;
+use std::sync::{Arc, Mutex};
 
 /// Tikhonov weight, relative to the zero-frequency gain: how much of a frequency the glow
 /// nearly cancels is given up rather than amplified with the camera's noise.
@@ -59,7 +60,33 @@ fn invert3(m: [f64; 9]) -> Option<[f64; 9]> {
     ])
 }
 
+/// The inverses made last: a press reads every frame through one glow at one size.
+static MADE: Mutex<Vec<Made>> = Mutex::new(Vec::new());
+/// An inverse with the glow and frame size (width, height) it was made for.
+type Made = (GelGlow, usize, usize, Arc<GlowInverse>);
+const KEPT: usize = 4;
+
 impl GlowInverse {
+    /// The inverse for this glow and frame size, made once and shared.
+    pub fn shared(glow: &GelGlow, width: usize, height: usize) -> Arc<Self> {
+        let found = {
+            let made = MADE.lock().unwrap_or_else(|e| e.into_inner());
+            made.iter()
+                .find(|(g, w, h, _)| g == glow && *w == width && *h == height)
+                .map(|(.., inverse)| inverse.clone())
+        };
+        if let Some(inverse) = found {
+            return inverse;
+        }
+        let inverse = Arc::new(Self::new(glow, width, height));
+        let mut made = MADE.lock().unwrap_or_else(|e| e.into_inner());
+        if made.len() >= KEPT {
+            made.remove(0);
+        }
+        made.push((glow.clone(), width, height, inverse.clone()));
+        inverse
+    }
+
     pub fn new(glow: &GelGlow, width: usize, height: usize) -> Self {
         let (n, m) = (2 * width, 2 * height);
         let colour: Vec<_> = glow

@@ -4,6 +4,7 @@
 //! are left out.
 
 use crate::tactile::depth::integrate_slopes;
+use crate::tactile::gel_glow::blur;
 use crate::tactile::glow_inverse::GlowInverse;
 use crate::tactile::photometric::PhotometricModel;
 use crate::tactile::shading_table::{ShadingTable, frame_position};
@@ -75,7 +76,12 @@ pub fn recover_slopes(
                 })
                 .collect();
             let observed = without_drift(observed, &valid, w, h);
-            let inverse = GlowInverse::new(glow, w, h);
+            // The glow is read backwards over the whole frame, so the marker dots' holes are
+            // filled from the shading round them (zeros there would read as flat gel inside
+            // a contact) and read like the rest.
+            let hole_px = (spec.markers.radius_mm / spec.mm_per_px) as f32 + 2.0;
+            let observed = fill_holes(&observed, &mut valid, w, h, hole_px.max(1.0));
+            let inverse = GlowInverse::shared(glow, w, h);
             let mut change = inverse.solve(&observed);
             read_table(table, &change, w, h, &mut valid, &mut gx, &mut gy);
             if inverse.has_rest() {
@@ -169,6 +175,42 @@ fn without_drift(mut observed: Vec<[f32; 3]>, valid: &[bool], w: usize, h: usize
         }
     }
     observed
+}
+
+/// Pixels that carry no shading filled by normalised convolution (a Gaussian of `sigma_px`
+/// over the valid pixels, divided by the same blur of the mask); they become valid where
+/// enough valid pixels lie near.
+fn fill_holes(
+    observed: &[[f32; 3]],
+    valid: &mut [bool],
+    w: usize,
+    h: usize,
+    sigma_px: f32,
+) -> Vec<[f32; 3]> {
+    let weighted: Vec<[f32; 4]> = observed
+        .iter()
+        .zip(valid.iter())
+        .map(|(o, ok)| match ok {
+            true => [o[0], o[1], o[2], 1.0],
+            false => [0.0; 4],
+        })
+        .collect();
+    let spread = blur(&weighted, w, h, sigma_px);
+    observed
+        .iter()
+        .zip(valid.iter_mut())
+        .zip(&spread)
+        .map(|((o, ok), b)| {
+            if *ok {
+                *o
+            } else if b[3] > 0.05 {
+                *ok = true;
+                [b[0] / b[3], b[1] / b[3], b[2] / b[3]]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect()
 }
 
 /// A calibrated table read backwards at every valid pixel of a shading change.
