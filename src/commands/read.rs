@@ -5,7 +5,7 @@
 use crate::app::{load_rgb, load_sensor};
 use crate::report::indentation_view::indentation_view;
 use crate::report::output::write_png_atomic;
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -103,10 +103,19 @@ pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImag
 pub fn run(args: &ReadArgs) -> Result<()> {
     let (report, reading, image) = read(args)?;
     if let Some(out) = &args.out {
-        write_png_atomic(out, &indentation_view(&image, &reading))?;
+        write_png_atomic(out, &indentation_view(&image, &reading)).context("--out")?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    if report.peak_depth_mm <= 0.0 {
+        println!(
+            "{}: no imprint read ({:.0}% of the pixels readable); read through {}",
+            report.image,
+            100.0 * report.readable_share,
+            report.sensor
+        );
         return Ok(());
     }
     println!(
