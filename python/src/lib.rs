@@ -277,6 +277,31 @@ fn compare(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
     })
 }
 
+/// `tactex read` (flags in `argv`): one frame read through a sensor's optics. Returns the
+/// report (JSON text, what `read --json` prints) and the indentation map (mm into the gel,
+/// float32, H x W); `--out` writes the picture as the command does.
+#[pyfunction]
+fn read(py: Python<'_>, argv: Vec<String>) -> PyResult<Bound<'_, PyDict>> {
+    let Command::Read(args) = parse(std::iter::once("read".into()).chain(argv).collect())? else {
+        unreachable!("the argv starts with read")
+    };
+    let (report, map) = off_the_gil(py, || -> anyhow::Result<(String, Array2<f32>)> {
+        let (report, reading, image) = tactex::commands::read::read(&args)?;
+        if let Some(out) = &args.out {
+            tactex::commands::read::write_picture(out, &image, &reading)?;
+        }
+        let report = serde_json::to_string_pretty(&report).context("serialising the reading")?;
+        Ok((
+            report,
+            field_array(&reading.indentation_mm, reading.width, reading.height),
+        ))
+    })?;
+    let out = PyDict::new(py);
+    out.set_item("report", report)?;
+    out.set_item("indentation_mm", map.into_pyarray(py))?;
+    Ok(out)
+}
+
 /// A sensor profile's identity and geometry: the built-in GelSight Mini, or the profile
 /// file at `path`.
 #[pyfunction]
@@ -313,6 +338,7 @@ fn _tactex(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ask, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(sensor_info, m)?)?;
     m.add_function(wrap_pyfunction!(threads, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

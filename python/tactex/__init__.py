@@ -37,6 +37,7 @@ __all__ = [
     "ask",
     "calibrate",
     "compare",
+    "read",
     "SHAPE_FAMILIES",
     "FIDELITIES",
     "__version__",
@@ -524,3 +525,26 @@ def compare(
         json=True,
     )
     return json.loads(_tactex.compare(argv))
+
+
+def read(
+    image: PathLike,
+    reference: Optional[PathLike] = None,
+    sensor: Optional[PathLike] = None,
+    *,
+    out: Optional[PathLike] = None,
+) -> Dict[str, Any]:
+    """What the twin reads from one tactile frame, as ``tactex read``: the frame (a real or
+    rendered PNG of the ``sensor`` profile's size; default the built-in GelSight Mini) read
+    against the no-contact ``reference`` (default the profile's background) through the
+    profile's optics, as the estimators read every frame of a press. Returns what ``read
+    --json`` prints (``peak_depth_mm``, ``contact_radius_mm``, ``contact_axes_mm``,
+    ``within_frame``, ``readable_share``, the sensor's id) and ``indentation_mm``, the gel's
+    indentation map (H x W float32, mm into the gel). ``out`` writes the frame beside the map
+    as a PNG."""
+    argv = _flags(reference=reference, sensor=sensor, out=out) + ["--", os.fspath(image)]
+    native = _tactex.read(argv)
+    report = json.loads(native["report"])
+    report["indentation_mm"] = native["indentation_mm"]
+    return report
+

@@ -29,6 +29,10 @@ def calibrate(argv: List[str]) -> str:
 def compare(argv: List[str]) -> str:
     """``tactex compare --json`` from its flags: the comparison as JSON text."""
 
+def read(argv: List[str]) -> Dict[str, Any]:
+    """``tactex read`` from its flags: ``report`` (JSON text) and ``indentation_mm`` (H x W
+    float32)."""
+
 def sensor_info(path: Optional[str] = None) -> Dict[str, Any]:
     """A profile's id, name, width, height, mm_per_px, gel and markers."""
 

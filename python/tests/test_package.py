@@ -160,6 +160,22 @@ def test_compare_scores_held_out_real_presses_as_the_cli_does(cli):
     assert scored["mean"]["ssim_contact"] > scored["background_only_mean"]["ssim_contact"]
 
 
+def test_read_reads_a_real_press_as_the_cli_does(cli, tmp_path):
+    profile, frame = FOTS / "profile/fots-9.toml", FOTS / "ball-presses/0014.png"
+    read = tactex.read(frame, sensor=profile, out=tmp_path / "read.png")
+    printed = json.loads(cli("read", str(frame), "--sensor", str(profile), "--json").stdout)
+    depth = read.pop("indentation_mm")
+    assert read == printed
+    assert depth.shape == (320, 240) and depth.dtype == np.float32
+    # The map's deepest pixels are the peak; the marked contact is 39 px = 2.0 mm, the ball
+    # 2.35 mm.
+    assert abs(float(np.sort(depth.ravel())[-20:].mean()) - read["peak_depth_mm"]) < 1e-3
+    assert 1.5 < read["contact_radius_mm"] < 3.2
+    assert (tmp_path / "read.png").is_file()
+    with pytest.raises(ValueError, match="--reference"):
+        tactex.read(frame)
+
+
 def test_compare_rebuilds_a_recorded_session_as_the_cli_does(cli, tmp_path):
     session = tmp_path / "session"
     cli("ask", "--record", str(session), "--seed", "3", "Which fruit is the softest?")

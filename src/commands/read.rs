@@ -100,10 +100,19 @@ pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImag
     Ok((report, reading, image))
 }
 
+/// The frame beside its indentation map, written to `out` (`--out`).
+pub fn write_picture(
+    out: &std::path::Path,
+    image: &image::RgbImage,
+    reading: &FrameReading,
+) -> Result<()> {
+    write_png_atomic(out, &indentation_view(image, reading)).context("--out")
+}
+
 pub fn run(args: &ReadArgs) -> Result<()> {
     let (report, reading, image) = read(args)?;
     if let Some(out) = &args.out {
-        write_png_atomic(out, &indentation_view(&image, &reading)).context("--out")?;
+        write_picture(out, &image, &reading)?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
