@@ -31,19 +31,27 @@ pub struct ReadArgs {
     pub json: bool,
 }
 
+/// Shallower than this no imprint is reported: the reading of a frame against itself, or of
+/// noise, integrates to micrometres.
+pub const MIN_IMPRINT_MM: f64 = 0.01;
+
 #[derive(Serialize)]
 pub struct ReadReport {
     pub image: String,
-    pub reference: String,
+    /// The no-contact frame's file; null when it is the profile's background.
+    pub reference: Option<String>,
     pub sensor: ProfileId,
+    /// Whether an imprint was read (a peak of at least `MIN_IMPRINT_MM`); without one the
+    /// contact's figures are null.
+    pub imprint: bool,
     /// The imprint's depth into the gel (mean of the 20 deepest pixels).
     pub peak_depth_mm: f64,
     /// The contact's semi-axes, wide then narrow (mm), from the half-depth region.
-    pub contact_axes_mm: [f64; 2],
-    /// The radius of the circle of the contact's area.
-    pub contact_radius_mm: f64,
+    pub contact_axes_mm: Option<[f64; 2]>,
+    /// The radius of the circle of the contact's area (the semi-axes' geometric mean).
+    pub contact_radius_mm: Option<f64>,
     /// Whether the imprint lies within the frame (else its depth reads short).
-    pub within_frame: bool,
+    pub within_frame: Option<bool>,
     /// Share of the pixels whose shading could be read.
     pub readable_share: f64,
 }
@@ -53,8 +61,11 @@ pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImag
     let profile = load_sensor(args.sensor.as_deref())?;
     let image = load_rgb(&args.image)?;
     let (reference, reference_name) = match (&args.reference, &profile.background) {
-        (Some(path), _) => (load_rgb(path)?, path.display().to_string()),
-        (None, Some(bg)) => (bg.clone(), format!("{} (background)", profile.id())),
+        (Some(path), _) => (
+            load_rgb(path).context("--reference")?,
+            Some(path.display().to_string()),
+        ),
+        (None, Some(bg)) => (bg.clone(), None),
         (None, None) => bail!(
             "--reference: needed, the sensor profile {} has no background frame",
             profile.id()
@@ -77,7 +88,10 @@ pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImag
     }
     if reference.dimensions() != size {
         bail!(
-            "--reference {reference_name}: {} x {} px, the sensor {} has {} x {}",
+            "--reference {}: {} x {} px, the sensor {} has {} x {}",
+            reference_name
+                .as_deref()
+                .unwrap_or("(the profile's background)"),
             reference.width(),
             reference.height(),
             profile.id(),
@@ -85,16 +99,31 @@ pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImag
             size.1
         );
     }
+    if let Some(out) = &args.out {
+        let same = |p: &std::path::Path| {
+            std::fs::canonicalize(p)
+                .ok()
+                .is_some_and(|p| Some(p) == std::fs::canonicalize(out).ok())
+        };
+        if same(&args.image) || args.reference.as_deref().is_some_and(same) {
+            bail!(
+                "--out {}: is an input frame; name another file",
+                out.display()
+            );
+        }
+    }
     let reading = read_frame(&image, &reference, spec).expect("sizes were checked");
     let readable = reading.valid.iter().filter(|v| **v).count();
+    let imprint = reading.peak_mm >= MIN_IMPRINT_MM;
     let report = ReadReport {
         image: args.image.display().to_string(),
         reference: reference_name,
         sensor: profile.id(),
-        peak_depth_mm: reading.peak_mm,
-        contact_axes_mm: reading.contact_axes_mm,
-        contact_radius_mm: reading.contact_radius_mm(),
-        within_frame: reading.within_frame,
+        imprint,
+        peak_depth_mm: reading.peak_mm.max(0.0),
+        contact_axes_mm: imprint.then_some(reading.contact_axes_mm),
+        contact_radius_mm: imprint.then(|| reading.contact_radius_mm()),
+        within_frame: imprint.then_some(reading.within_frame),
         readable_share: readable as f64 / reading.valid.len() as f64,
     };
     Ok((report, reading, image))
@@ -118,23 +147,27 @@ pub fn run(args: &ReadArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    if report.peak_depth_mm <= 0.0 {
+    let (Some(axes), Some(radius), Some(within)) = (
+        report.contact_axes_mm,
+        report.contact_radius_mm,
+        report.within_frame,
+    ) else {
         println!(
-            "{}: no imprint read ({:.0}% of the pixels readable); read through {}",
+            "{}: no imprint read (none {MIN_IMPRINT_MM} mm deep or more; {:.0}% of the pixels readable); read through {}",
             report.image,
             100.0 * report.readable_share,
             report.sensor
         );
         return Ok(());
-    }
+    };
     println!(
         "{}: peak depth {:.3} mm, contact radius {:.3} mm (semi-axes {:.3} x {:.3} mm){}; read through {}",
         report.image,
         report.peak_depth_mm,
-        report.contact_radius_mm,
-        report.contact_axes_mm[0],
-        report.contact_axes_mm[1],
-        if report.within_frame {
+        radius,
+        axes[0],
+        axes[1],
+        if within {
             ""
         } else {
             ", the imprint reaches the frame's edge (its depth reads short)"

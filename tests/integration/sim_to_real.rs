@@ -407,8 +407,32 @@ fn read_draws_the_indentation_map_and_refuses_a_frame_of_another_size() {
     let depth = report["peak_depth_mm"].as_f64().unwrap();
     assert!((1.5..3.2).contains(&radius), "{report}");
     assert!(depth > 0.5 && depth < 2.35, "{report}");
+    assert_eq!(report["imprint"], true);
     let drawn = rgb(&png);
     assert_eq!(drawn.dimensions(), (2 * 240, 320));
+    // The no-contact frame read against itself: no imprint, and no contact made of noise.
+    let flat = json(&tactex(&[
+        "read",
+        f.join("profile/fots-9.background.png").to_str().unwrap(),
+        "--sensor",
+        profile.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(flat["imprint"], false, "{flat}");
+    assert!(flat["contact_radius_mm"].is_null(), "{flat}");
+    // The picture may not replace the frame it was read from.
+    let copy = dir.path().join("copy.png");
+    std::fs::copy(&frame, &copy).unwrap();
+    let out = tactex(&[
+        "read",
+        copy.to_str().unwrap(),
+        "--sensor",
+        profile.to_str().unwrap(),
+        "--out",
+        copy.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert_eq!(rgb(&copy), rgb(&frame));
     // A frame of the stock Mini's size through the FOTS profile: one line, nothing written.
     let small = dir.path().join("small.png");
     RgbImage::new(320, 240).save(&small).unwrap();
