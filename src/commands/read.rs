@@ -73,18 +73,16 @@ pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImag
     };
     let spec = &profile.spec;
     let size = (spec.width_px, spec.height_px);
-    for (what, img) in [(&args.image, &image)] {
-        if img.dimensions() != size {
-            bail!(
-                "{}: {} x {} px, the sensor {} has {} x {}",
-                what.display(),
-                img.width(),
-                img.height(),
-                profile.id(),
-                size.0,
-                size.1
-            );
-        }
+    if image.dimensions() != size {
+        bail!(
+            "{}: {} x {} px, the sensor {} has {} x {}",
+            args.image.display(),
+            image.width(),
+            image.height(),
+            profile.id(),
+            size.0,
+            size.1
+        );
     }
     if reference.dimensions() != size {
         bail!(

@@ -4,7 +4,7 @@
 //! are left out.
 
 use crate::tactile::depth::integrate_slopes;
-use crate::tactile::gel_glow::blur;
+use crate::tactile::gel_glow::{GelGlow, blur};
 use crate::tactile::glow_inverse::GlowInverse;
 use crate::tactile::photometric::PhotometricModel;
 use crate::tactile::shading_table::{ShadingTable, frame_position};
@@ -63,91 +63,84 @@ pub fn recover_slopes(
             }
         }
     }
-    let (mut gx, mut gy) = (vec![0.0f32; w * h], vec![0.0f32; w * h]);
-    match (&spec.table, &spec.glow) {
-        (Some(table), Some(glow)) => {
-            let observed: Vec<[f32; 3]> = frame
-                .pixels()
-                .zip(reference.pixels())
-                .zip(&valid)
-                .map(|((p, r), ok)| match ok {
-                    true => std::array::from_fn(|c| f32::from(p[c]) - f32::from(r[c])),
-                    false => [0.0; 3],
-                })
-                .collect();
-            let observed = without_drift(observed, &valid, w, h);
-            // The glow is read backwards over the whole frame, so the marker dots' holes are
-            // filled from the shading round them (zeros there would read as flat gel inside
-            // a contact) and read like the rest.
-            let hole_px = (spec.markers.radius_mm / spec.mm_per_px) as f32 + 2.0;
-            let observed = fill_holes(&observed, &mut valid, w, h, hole_px.max(1.0));
-            let inverse = GlowInverse::shared(glow, w, h);
-            let mut change = inverse.solve(&observed);
-            read_table(table, &change, w, h, &mut valid, &mut gx, &mut gy);
-            if inverse.has_rest() {
-                // The glow's indentation and magnitude terms from this first reading,
-                // subtracted, and the change read again.
-                let field = SlopeField {
-                    width: w,
-                    height: h,
-                    gx: gx.clone(),
-                    gy: gy.clone(),
-                    valid: valid.clone(),
-                };
-                let depth: Vec<f32> = integrate_slopes(&field, spec.mm_per_px)
-                    .into_iter()
-                    .map(|d| d as f32)
-                    .collect();
-                let modelled: Vec<[f32; 3]> = (0..w * h)
-                    .map(|i| {
-                        let (u, v) =
-                            frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
-                        table.change(gx[i], gy[i], u, v)
-                    })
-                    .collect();
-                let rest = inverse.rest(&modelled, &depth);
-                let linear: Vec<[f32; 3]> = observed
-                    .iter()
-                    .zip(&rest)
-                    .map(|(o, r)| std::array::from_fn(|c| o[c] - r[c]))
-                    .collect();
-                change = inverse.solve(&linear);
-                read_table(table, &change, w, h, &mut valid, &mut gx, &mut gy);
-            }
-        }
-        _ => {
-            for (i, (p, r)) in frame.pixels().zip(reference.pixels()).enumerate() {
-                if !valid[i] {
-                    continue;
-                }
-                let slope = match &spec.table {
-                    Some(table) => {
-                        let (u, v) =
-                            frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
-                        let change = std::array::from_fn(|c| f32::from(p[c]) - f32::from(r[c]));
-                        table
-                            .slope_for_change(change, u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS)
-                            .map(|(sx, sy)| (f64::from(sx), f64::from(sy)))
-                    }
-                    None => lit_slope(&spec.photometric, p, r),
-                };
-                match slope {
-                    Some((sx, sy)) => {
-                        gx[i] = sx as f32;
-                        gy[i] = sy as f32;
-                    }
-                    None => valid[i] = false,
-                }
-            }
-        }
-    }
-    Some(SlopeField {
+    let mut field = SlopeField {
         width: w,
         height: h,
-        gx,
-        gy,
+        gx: vec![0.0; w * h],
+        gy: vec![0.0; w * h],
         valid,
-    })
+    };
+    let Some(table) = &spec.table else {
+        for (i, (p, r)) in frame.pixels().zip(reference.pixels()).enumerate() {
+            if !field.valid[i] {
+                continue;
+            }
+            match lit_slope(&spec.photometric, p, r) {
+                Some((sx, sy)) => {
+                    field.gx[i] = sx as f32;
+                    field.gy[i] = sy as f32;
+                }
+                None => field.valid[i] = false,
+            }
+        }
+        return Some(field);
+    };
+    let observed: Vec<[f32; 3]> = frame
+        .pixels()
+        .zip(reference.pixels())
+        .zip(&field.valid)
+        .map(|((p, r), ok)| match ok {
+            true => std::array::from_fn(|c| f32::from(p[c]) - f32::from(r[c])),
+            false => [0.0; 3],
+        })
+        .collect();
+    match &spec.glow {
+        Some(glow) => read_through_glow(table, glow, spec, observed, &mut field),
+        None => read_table(table, &observed, &mut field),
+    }
+    Some(field)
+}
+
+/// A frame's change read through a table and its glow: the drift removed, the marker dots'
+/// holes filled, the glow's linear part inverted and the table read backwards; then the
+/// glow's indentation and magnitude terms from that first reading subtracted and the change
+/// read again.
+fn read_through_glow(
+    table: &ShadingTable,
+    glow: &GelGlow,
+    spec: &TactileSpec,
+    observed: Vec<[f32; 3]>,
+    field: &mut SlopeField,
+) {
+    let (w, h) = (field.width, field.height);
+    let observed = without_drift(observed, &field.valid, w, h);
+    // The glow is read backwards over the whole frame, so the marker dots' holes are filled
+    // from the shading round them (zeros there would read as flat gel inside a contact) and
+    // read like the rest.
+    let hole_px = (spec.markers.radius_mm / spec.mm_per_px) as f32 + 2.0;
+    let observed = fill_holes(&observed, &mut field.valid, w, h, hole_px.max(1.0));
+    let inverse = GlowInverse::shared(glow, w, h);
+    read_table(table, &inverse.solve(&observed), field);
+    if !inverse.has_rest() {
+        return;
+    }
+    let depth: Vec<f32> = integrate_slopes(field, spec.mm_per_px)
+        .into_iter()
+        .map(|d| d as f32)
+        .collect();
+    let modelled: Vec<[f32; 3]> = (0..w * h)
+        .map(|i| {
+            let (u, v) = frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
+            table.change(field.gx[i], field.gy[i], u, v)
+        })
+        .collect();
+    let rest = inverse.rest(&modelled, &depth);
+    let linear: Vec<[f32; 3]> = observed
+        .iter()
+        .zip(&rest)
+        .map(|(o, r)| std::array::from_fn(|c| o[c] - r[c]))
+        .collect();
+    read_table(table, &inverse.solve(&linear), field);
 }
 
 /// Real frames drift in colour from shot to shot far from any contact (FOTS: up to 30 grey
@@ -213,30 +206,24 @@ fn fill_holes(
         .collect()
 }
 
-/// A calibrated table read backwards at every valid pixel of a shading change.
-fn read_table(
-    table: &ShadingTable,
-    change: &[[f32; 3]],
-    w: usize,
-    h: usize,
-    valid: &mut [bool],
-    gx: &mut [f32],
-    gy: &mut [f32],
-) {
+/// A calibrated table read backwards at every valid pixel of a shading change; a pixel no
+/// slope explains becomes invalid.
+fn read_table(table: &ShadingTable, change: &[[f32; 3]], field: &mut SlopeField) {
+    let (w, h) = (field.width, field.height);
     for (i, c) in change.iter().enumerate() {
-        if !valid[i] {
+        if !field.valid[i] {
             continue;
         }
         let (u, v) = frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
         match table.slope_for_change(*c, u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS) {
             Some((sx, sy)) => {
-                gx[i] = sx;
-                gy[i] = sy;
+                field.gx[i] = sx;
+                field.gy[i] = sy;
             }
             None => {
-                gx[i] = 0.0;
-                gy[i] = 0.0;
-                valid[i] = false;
+                field.gx[i] = 0.0;
+                field.gy[i] = 0.0;
+                field.valid[i] = false;
             }
         }
     }
