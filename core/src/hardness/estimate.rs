@@ -148,6 +148,11 @@ pub enum EstimateError {
     NoImprint,
     #[error("hardness model {0}")]
     Model(String),
+    /// The press was read, but the reading lies where the estimator cannot resolve a
+    /// modulus (a fit that failed, a share of the travel at the model's ends): the object is
+    /// reported as not measured, with why, rather than as a number with a tight interval.
+    #[error("not measurable: {0}")]
+    OutsideCompetence(String),
 }
 
 /// Reads a modulus from a press. Shared across threads: the pipeline reads one object's

@@ -12,7 +12,7 @@ use crate::hardness::estimate::{
     EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval,
     OWN_FIT_INTERVAL, PhysicsEvidence, PressSequence, Z95,
 };
-use crate::hardness::gel_share_fit::{fit_gel_share, gel_share};
+use crate::hardness::gel_share_fit::{ShareFit, fit_gel_share, gel_share};
 use crate::hardness::layer_compliance::hertz_ellipse_centre_compliance_ratio;
 use crate::hardness::scale::Hardness;
 use crate::hertz::Elastic;
@@ -83,6 +83,13 @@ impl HardnessEstimator for IndentationEstimator {
             .collect();
         let fit = fit_gel_share(&pick(&peaks), &pick(&press.travel_mm), &pick(&layer))
             .ok_or(EstimateError::NoImprint)?;
+        let last = *used.last().expect("at least two frames used");
+        check_competence(
+            &fit,
+            gel_share(layer[last], fit.compliance_ratio),
+            peaks[last],
+            &press.travel_mm,
+        )?;
         let gel = Elastic {
             modulus_mpa: Some(spec.gel.modulus_mpa),
             poisson: spec.gel.poisson,
@@ -99,7 +106,6 @@ impl HardnessEstimator for IndentationEstimator {
         // The fit's interval is one standard error in ln rho; the 95% one widens it in ln.
         let rho = fit.compliance_ratio;
         let widen = |r: f64| rho * (r / rho).powf(Z95);
-        let last = *used.last().expect("at least two frames used");
         let share_at = |rho: f64| gel_share(layer[last], rho);
         let last_approach = fit.first_contact_approach_mm + press.travel_mm[last];
         // The circle of the contact's area.
@@ -131,5 +137,97 @@ impl HardnessEstimator for IndentationEstimator {
                 }),
             }),
         })
+    }
+}
+
+/// The least share of the travel the gel may take for the estimator to resolve the object.
+/// The modulus goes as (1 - s) / s, so d ln E / d s = -1 / (s (1 - s)): where s (1 - s) <
+/// 0.02, a reading error of 1% of the travel moves the modulus by more than half. Below it
+/// the object is far softer than the gel and the press cannot say by how much. (At the
+/// stiff end the same loss is a rigid object's bound, which the estimate already says.)
+const MIN_GEL_SHARE: f64 = 0.0205;
+
+/// A fit whose residual is more than this share of the last frame's depth does not describe
+/// the press: the depths do not grow with the travel as two elastic bodies' do.
+const MAX_FIT_RESIDUAL_SHARE: f64 = 0.25;
+
+/// Refuses a reading the model cannot stand behind, saying why in the user's terms.
+fn check_competence(
+    fit: &ShareFit,
+    share: f64,
+    last_depth_mm: f64,
+    travel_mm: &[f64],
+) -> Result<(), EstimateError> {
+    let outside = |why: String| Err(EstimateError::OutsideCompetence(why));
+    let travelled = travel_mm.iter().cloned().fold(0.0f64, f64::max);
+    if fit.first_contact_approach_mm > travelled.max(0.0) {
+        return outside(format!(
+            "the depth fit puts first contact {:.2} mm before the first frame, more than the \
+             press travelled ({travelled:.2} mm): the gel's depths do not follow the travel",
+            fit.first_contact_approach_mm
+        ));
+    }
+    if fit.residual_rms_mm > MAX_FIT_RESIDUAL_SHARE * last_depth_mm {
+        return outside(format!(
+            "the depth fit misses the gel's depths by {:.3} mm rms against a last depth of \
+             {last_depth_mm:.3} mm: the press does not read as two elastic bodies",
+            fit.residual_rms_mm
+        ));
+    }
+    if share < MIN_GEL_SHARE {
+        return outside(format!(
+            "the gel took {:.1}% of the travel: the object is too soft against the gel to \
+             resolve (below {:.1}%)",
+            100.0 * share,
+            100.0 * MIN_GEL_SHARE
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fit(rho: f64, a0: f64, residual: f64) -> ShareFit {
+        ShareFit {
+            compliance_ratio: rho,
+            compliance_ratio_interval: [rho * 0.9, rho * 1.1],
+            first_contact_approach_mm: a0,
+            residual_rms_mm: residual,
+        }
+    }
+
+    #[test]
+    fn a_press_read_as_two_elastic_bodies_is_measured() {
+        // A tomato on the stock Mini: a fifth of the travel in the gel, first contact a
+        // fifth of a millimetre in, the depths fitted to 2 microns.
+        let travel = [0.0, 0.25, 0.5, 0.75];
+        assert!(check_competence(&fit(1.0, 0.22, 0.002), 0.22, 0.16, &travel).is_ok());
+    }
+
+    #[test]
+    fn a_fit_that_puts_first_contact_beyond_the_whole_press_is_not_measured() {
+        let travel = [0.0, 0.25, 0.5, 0.75];
+        let err = check_competence(&fit(1.0, 505.0, 0.002), 0.22, 0.26, &travel).unwrap_err();
+        assert!(
+            matches!(&err, EstimateError::OutsideCompetence(why) if why.contains("first contact"))
+        );
+    }
+
+    #[test]
+    fn depths_the_fit_misses_by_a_quarter_are_not_measured() {
+        let travel = [0.0, 0.25, 0.5, 0.75];
+        let err = check_competence(&fit(1.0, 0.2, 0.18), 0.22, 0.26, &travel).unwrap_err();
+        assert!(matches!(&err, EstimateError::OutsideCompetence(why) if why.contains("misses")));
+    }
+
+    #[test]
+    fn an_object_too_soft_against_the_gel_to_resolve_is_not_measured() {
+        // At a share of 1% a reading error of 1% of the travel doubles the modulus.
+        let travel = [0.0, 0.25, 0.5, 0.75];
+        let err = check_competence(&fit(50.0, 0.2, 0.0001), 0.01, 0.01, &travel).unwrap_err();
+        assert!(matches!(&err, EstimateError::OutsideCompetence(why) if why.contains("too soft")));
+        assert!(check_competence(&fit(20.0, 0.2, 0.0001), 0.03, 0.02, &travel).is_ok());
     }
 }

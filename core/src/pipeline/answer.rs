@@ -51,6 +51,9 @@ pub enum NotMeasuredReason {
     ImprintCut,
     /// The estimator could not read the press.
     Estimator,
+    /// The press was read, but where the estimator cannot resolve a modulus (its fit failed,
+    /// or the object is too soft against the gel): no number is better than a wrong one.
+    OutsideCompetence,
 }
 
 /// The reason for machines, and the detail for people.

@@ -222,6 +222,12 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
                             .map(|f| f.stage_for_modulus(est.hardness.modulus_mpa()).name.clone());
                         report.evidence = Some(est.evidence);
                     }
+                    Err(EstimateError::OutsideCompetence(why)) => {
+                        report.not_measured = Some(NotMeasured {
+                            reason: NotMeasuredReason::OutsideCompetence,
+                            detail: why,
+                        })
+                    }
                     Err(e) => {
                         report.not_measured = Some(NotMeasured {
                             reason: NotMeasuredReason::Estimator,

@@ -156,6 +156,44 @@ impl ShadingTable {
         })
     }
 
+    /// `change` and its derivatives along gx and gy, from one lookup of the four nodes (the
+    /// inverse's Gauss-Newton needs all three at every step). Away from the flat gel only:
+    /// at gx = gy = 0 the direction, and so the derivative, is undefined.
+    pub fn change_with_derivatives(
+        &self,
+        gx: f32,
+        gy: f32,
+        u: f32,
+        v: f32,
+    ) -> ([f32; 3], [f32; 3], [f32; 3]) {
+        let b = bin_position(self.mag_bins, self.dir_bins, self.mag_max, gx, gy);
+        let at = |m: u32, d: u32| m * self.dir_bins + d;
+        let mag2 = gx * gx + gy * gy;
+        let mag = mag2.sqrt();
+        // d tm / d g and d td / d g: magnitude is clamped at mag_max, direction wraps.
+        let dtm = if mag < self.mag_max {
+            (self.mag_bins - 1) as f32 / self.mag_max / mag
+        } else {
+            0.0
+        };
+        let dtd = self.dir_bins as f32 / TAU / mag2;
+        let (mut c, mut jx, mut jy) = ([0.0f32; 3], [0.0f32; 3], [0.0f32; 3]);
+        for k in 0..3 {
+            let n00 = self.node_value(at(b.m0, b.d0), k, u, v);
+            let n01 = self.node_value(at(b.m0, b.d1), k, u, v);
+            let n10 = self.node_value(at(b.m0 + 1, b.d0), k, u, v);
+            let n11 = self.node_value(at(b.m0 + 1, b.d1), k, u, v);
+            let lo = n00 * (1.0 - b.td) + n01 * b.td;
+            let hi = n10 * (1.0 - b.td) + n11 * b.td;
+            c[k] = lo * (1.0 - b.tm) + hi * b.tm;
+            let by_tm = (hi - lo) * dtm;
+            let by_td = ((n01 - n00) * (1.0 - b.tm) + (n11 - n10) * b.tm) * dtd;
+            jx[k] = by_tm * gx - by_td * gy;
+            jy[k] = by_tm * gy + by_td * gx;
+        }
+        (c, jx, jy)
+    }
+
     /// The colour change of the flat gel at normalised position (u, v): zero for a sensor whose
     /// no-contact frame is its background. Calibration presses taken some time after the
     /// background show a smooth drift here, which `split_flat` moves into the background.
@@ -185,9 +223,11 @@ impl ShadingTable {
     /// table read backwards, as the estimators read a calibrated sensor's frames. A real
     /// table can colour a steep slope almost like the flat gel (its steep nodes are fitted
     /// from few pixels), so without the prior the camera's noise on a flat pixel can pick a
-    /// steep slope. The best of a coarse ring of slopes starts a damped Gauss-Newton descent.
-    /// None where no slope comes within `max_rms` grey levels (saturation, dust, a marker's
-    /// edge).
+    /// steep slope. A damped Gauss-Newton descent starts from the better of the flat gel and
+    /// `near` (a neighbouring pixel's slope: the gel's surface is continuous); only a change
+    /// that descent leaves unexplained, by more than a few grey levels, is searched again
+    /// from the best of a coarse ring of slopes. None where no slope comes within `max_rms`
+    /// grey levels (saturation, dust, a marker's edge).
     pub fn slope_for_change(
         &self,
         change: [f32; 3],
@@ -195,6 +235,7 @@ impl ShadingTable {
         v: f32,
         prior: f32,
         max_rms: f32,
+        near: Option<(f32, f32)>,
     ) -> Option<(f32, f32)> {
         let residual = |gx: f32, gy: f32| {
             let c = self.change(gx, gy, u, v);
@@ -202,65 +243,93 @@ impl ShadingTable {
         };
         let norm2 = |r: [f32; 3]| r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
         let cost = |gx: f32, gy: f32| norm2(residual(gx, gy)) + prior * (gx * gx + gy * gy);
-        let mut best = (0.0f32, 0.0f32, cost(0.0, 0.0));
-        // A flat gel shows no change: most of a press frame ends here.
-        if best.2 <= 3.0 * 0.25 {
+        let mut start = (0.0f32, 0.0f32, cost(0.0, 0.0));
+        // A flat gel shows no change: most of a stock-sensor press frame ends here.
+        if start.2 <= 3.0 * 0.25 {
             return Some((0.0, 0.0));
         }
-        // A change within a few grey levels is a gentle slope, found by descending from the
-        // flat gel; only a clear change needs the ring's global start (most of a press
-        // frame is the former, and the ring is most of the cost).
-        let ring = best.2 > 3.0 * 4.0 * 4.0;
-        for mag in [0.1f32, 0.3, 0.6, 1.0, 1.6].into_iter().filter(|_| ring) {
-            let mag = mag * self.mag_max / 2.5;
-            for k in 0..12 {
-                let a = k as f32 * TAU / 12.0;
-                let (gx, gy) = (mag * a.cos(), mag * a.sin());
-                let e = cost(gx, gy);
-                if e < best.2 {
-                    best = (gx, gy, e);
-                }
+        if let Some((nx, ny)) = near {
+            let e = cost(nx, ny);
+            if e < start.2 {
+                start = (nx, ny, e);
             }
         }
-        let (mut gx, mut gy, mut err) = best;
-        let mut damping = 1e-2f32;
-        let h = 1e-3f32 * self.mag_max;
-        for _ in 0..20 {
-            let r = residual(gx, gy);
-            let dx = residual(gx + h, gy);
-            let dxm = residual(gx - h, gy);
-            let dy = residual(gx, gy + h);
-            let dym = residual(gx, gy - h);
-            let jx: [f32; 3] = std::array::from_fn(|c| (dx[c] - dxm[c]) / (2.0 * h));
-            let jy: [f32; 3] = std::array::from_fn(|c| (dy[c] - dym[c]) / (2.0 * h));
-            let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-            let (a, b, d) = (dot(jx, jx) + prior, dot(jx, jy), dot(jy, jy) + prior);
-            let (ex, ey) = (-dot(jx, r) - prior * gx, -dot(jy, r) - prior * gy);
-            let mut stepped = false;
-            for _ in 0..6 {
-                let (a2, d2) = (a * (1.0 + damping) + 1e-6, d * (1.0 + damping) + 1e-6);
-                let det = a2 * d2 - b * b;
-                if det.abs() < 1e-12 {
+        let descend = |(mut gx, mut gy, mut err): (f32, f32, f32)| {
+            let mut damping = 1e-2f32;
+            let h = 1e-3f32 * self.mag_max;
+            for _ in 0..20 {
+                // Analytic derivatives of the bilinear lookup, except at the flat gel, where the
+                // table is a cone with no gradient: there central differences average the
+                // directions, which is what lets the descent leave the apex.
+                let (c, jx, jy) = if gx * gx + gy * gy > h * h {
+                    self.change_with_derivatives(gx, gy, u, v)
+                } else {
+                    let dx = residual(gx + h, gy);
+                    let dxm = residual(gx - h, gy);
+                    let dy = residual(gx, gy + h);
+                    let dym = residual(gx, gy - h);
+                    (
+                        self.change(gx, gy, u, v),
+                        std::array::from_fn(|c| (dx[c] - dxm[c]) / (2.0 * h)),
+                        std::array::from_fn(|c| (dy[c] - dym[c]) / (2.0 * h)),
+                    )
+                };
+                let r: [f32; 3] = std::array::from_fn(|k| c[k] - change[k]);
+                let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+                let (a, b, d) = (dot(jx, jx) + prior, dot(jx, jy), dot(jy, jy) + prior);
+                let (ex, ey) = (-dot(jx, r) - prior * gx, -dot(jy, r) - prior * gy);
+                let mut stepped = false;
+                for _ in 0..6 {
+                    let (a2, d2) = (a * (1.0 + damping) + 1e-6, d * (1.0 + damping) + 1e-6);
+                    let det = a2 * d2 - b * b;
+                    if det.abs() < 1e-12 {
+                        damping *= 4.0;
+                        continue;
+                    }
+                    let (sx, sy) = ((d2 * ex - b * ey) / det, (a2 * ey - b * ex) / det);
+                    let e = cost(gx + sx, gy + sy);
+                    if e < err {
+                        gx += sx;
+                        gy += sy;
+                        let converged = (sx * sx + sy * sy).sqrt() < 1e-4 || err - e < 1e-6 * err;
+                        err = e;
+                        damping = (damping / 3.0).max(1e-6);
+                        stepped = !converged;
+                        break;
+                    }
                     damping *= 4.0;
-                    continue;
                 }
-                let (sx, sy) = ((d2 * ex - b * ey) / det, (a2 * ey - b * ex) / det);
-                let e = cost(gx + sx, gy + sy);
-                if e < err {
-                    gx += sx;
-                    gy += sy;
-                    let converged = (sx * sx + sy * sy).sqrt() < 1e-4 || err - e < 1e-6 * err;
-                    err = e;
-                    damping = (damping / 3.0).max(1e-6);
-                    stepped = !converged;
+                if !stepped {
                     break;
                 }
-                damping *= 4.0;
             }
-            if !stepped {
-                break;
+            (gx, gy, err)
+        };
+        let mut best = descend(start);
+        // Left over after the descent: more than a camera's noise (4 grey levels a channel)
+        // may be a local minimum, so the ring's global start gets its chance.
+        if best.2 > 3.0 * 4.0 * 4.0 {
+            let mut ring = (0.0f32, 0.0f32, f32::INFINITY);
+            let directions: [(f32, f32); 12] =
+                std::array::from_fn(|k| (k as f32 * TAU / 12.0).sin_cos());
+            for mag in [0.1f32, 0.3, 0.6, 1.0, 1.6] {
+                let mag = mag * self.mag_max / 2.5;
+                for (sin, cos) in directions {
+                    let (gx, gy) = (mag * cos, mag * sin);
+                    let e = cost(gx, gy);
+                    if e < ring.2 {
+                        ring = (gx, gy, e);
+                    }
+                }
+            }
+            if ring.2 < best.2 {
+                let again = descend(ring);
+                if again.2 < best.2 {
+                    best = again;
+                }
             }
         }
+        let (gx, gy, _) = best;
         ((norm2(residual(gx, gy)) / 3.0).sqrt() <= max_rms).then_some((gx, gy))
     }
 
@@ -455,7 +524,9 @@ mod tests {
         ] {
             for (u, v) in [(0.0f32, 0.0f32), (0.5, -0.3)] {
                 let change = table.change(gx, gy, u, v);
-                let (rx, ry) = table.slope_for_change(change, u, v, 0.0, 1.0).unwrap();
+                let (rx, ry) = table
+                    .slope_for_change(change, u, v, 0.0, 1.0, None)
+                    .unwrap();
                 let tol = 0.02 + 0.03 * (gx * gx + gy * gy).sqrt();
                 assert!(
                     (rx - gx).abs() < tol && (ry - gy).abs() < tol,
@@ -466,9 +537,43 @@ mod tests {
         // No slope makes every channel 80 grey levels brighter.
         assert!(
             table
-                .slope_for_change([80.0; 3], 0.0, 0.0, 0.0, 6.0)
+                .slope_for_change([80.0; 3], 0.0, 0.0, 0.0, 6.0, None)
                 .is_none()
         );
+    }
+
+    #[test]
+    fn the_lookups_derivatives_are_its_slopes_between_nodes() {
+        let table = lights_table();
+        let h = 1e-3f32;
+        for (gx, gy) in [
+            (0.13f32, 0.07f32),
+            (-0.61, 0.42),
+            (1.17, -0.93),
+            (0.02, 1.71),
+        ] {
+            let (u, v) = (0.4f32, -0.2f32);
+            let (c, jx, jy) = table.change_with_derivatives(gx, gy, u, v);
+            assert_eq!(c, table.change(gx, gy, u, v));
+            let (px, mx) = (
+                table.change(gx + h, gy, u, v),
+                table.change(gx - h, gy, u, v),
+            );
+            let (py, my) = (
+                table.change(gx, gy + h, u, v),
+                table.change(gx, gy - h, u, v),
+            );
+            for k in 0..3 {
+                let (nx, ny) = ((px[k] - mx[k]) / (2.0 * h), (py[k] - my[k]) / (2.0 * h));
+                let tol = 0.02 * (nx.abs() + ny.abs()) + 0.5;
+                assert!(
+                    (jx[k] - nx).abs() < tol && (jy[k] - ny).abs() < tol,
+                    "({gx}, {gy}) channel {k}: analytic ({}, {}) numeric ({nx}, {ny})",
+                    jx[k],
+                    jy[k]
+                );
+            }
+        }
     }
 
     #[test]

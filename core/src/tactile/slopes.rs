@@ -209,24 +209,32 @@ fn fill_holes(
 /// A calibrated table read backwards at every valid pixel of a shading change; a pixel no
 /// slope explains becomes invalid.
 fn read_table(table: &ShadingTable, change: &[[f32; 3]], field: &mut SlopeField) {
+    use rayon::prelude::*;
     let (w, h) = (field.width, field.height);
-    for (i, c) in change.iter().enumerate() {
-        if !field.valid[i] {
-            continue;
-        }
-        let (u, v) = frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
-        match table.slope_for_change(*c, u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS) {
-            Some((sx, sy)) => {
-                field.gx[i] = sx;
-                field.gy[i] = sy;
+    // Rows are read in parallel, each left to right so that a pixel's descent can start from
+    // its left neighbour's slope.
+    field
+        .gx
+        .par_chunks_mut(w)
+        .zip(field.gy.par_chunks_mut(w))
+        .zip(field.valid.par_chunks_mut(w))
+        .zip(change.par_chunks(w))
+        .enumerate()
+        .for_each(|(y, (((gx, gy), valid), change))| {
+            let mut near = None;
+            for x in 0..w {
+                if !valid[x] {
+                    near = None;
+                    continue;
+                }
+                let (u, v) = frame_position(x as u32, y as u32, w as u32, h as u32);
+                let read =
+                    table.slope_for_change(change[x], u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS, near);
+                (gx[x], gy[x]) = read.unwrap_or((0.0, 0.0));
+                valid[x] = read.is_some();
+                near = read;
             }
-            None => {
-                field.gx[i] = 0.0;
-                field.gy[i] = 0.0;
-                field.valid[i] = false;
-            }
-        }
-    }
+        });
 }
 
 fn lit_slope(
