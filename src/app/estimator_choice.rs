@@ -8,6 +8,7 @@ use std::str::FromStr;
 use tactex_core::hardness::estimate::{HardnessEstimator, HertzSlopeEstimator};
 use tactex_core::hardness::indentation_estimator::IndentationEstimator;
 use tactex_core::hardness::interval_calibration::{Calibrated, IntervalCalibration};
+use tactex_core::tactile::sensor_profile::ProfileId;
 
 /// A hardness estimator by name, or a trained model file.
 #[derive(Clone, Debug, PartialEq)]
@@ -95,12 +96,15 @@ impl EstimatorChoice {
 
     /// Loads the estimator with calibrated intervals: from `intervals` (a file `eval fruits
     /// --calibrate` wrote) when given, else the calibration shipped for it at `fidelity`,
-    /// else its own intervals, which say that they are not calibrated.
+    /// else its own intervals, which say that they are not calibrated. A calibration applies
+    /// only to the `sensor` its presses were read through: the shipped ones were measured on
+    /// the built-in Mini, and a calibrated profile reads with errors of its own.
     pub fn open(
         &self,
         flag: &str,
         fidelity: &str,
         intervals: Option<&Path>,
+        sensor: &ProfileId,
     ) -> Result<BoxedEstimator> {
         let inner = self.open_uncalibrated(flag)?;
         let calibration = match intervals {
@@ -117,9 +121,17 @@ impl EstimatorChoice {
                         inner.name()
                     );
                 }
+                let through = c.measured_through();
+                if &through != sensor {
+                    bail!(
+                        "--intervals {}: measured through the sensor {through}, not {sensor} (the one in use); \
+                         make one with `tactex eval fruits --sensor PROFILE --calibrate FILE`",
+                        path.display(),
+                    );
+                }
                 Some(c)
             }
-            None => builtin_intervals(self, fidelity)?,
+            None => builtin_intervals(self, fidelity)?.filter(|c| &c.measured_through() == sensor),
         };
         Ok(match calibration {
             Some(calibration) => Box::new(Calibrated { inner, calibration }),

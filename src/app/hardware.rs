@@ -40,6 +40,7 @@ pub fn answer_on_hardware(
         "--estimator",
         Fidelity::Layer.name(),
         twin.intervals.as_deref(),
+        &sensor.id(),
     )?;
     // The sensors first, so that a missing camera never leaves the arm enabled.
     let mut camera = devices.open_camera()?;

@@ -76,6 +76,14 @@ pub struct OpenedTwin {
 
 impl TwinOptions {
     pub fn open(&self) -> Result<OpenedTwin> {
+        let sensor = load_sensor(self.sensor.as_deref())?;
+        if let (Some(path), None) = (&self.sensor, &self.intervals) {
+            eprintln!(
+                "note: --sensor {0}: the intervals are the estimator's own, not measured through this sensor; \
+                 measure them with `tactex eval fruits --sensor {0} --calibrate FILE` and pass `--intervals FILE`",
+                path.display()
+            );
+        }
         Ok(OpenedTwin {
             detector: DetectorChoice::parse(&self.detector)?,
             renderer: scene_renderer(self.device)?,
@@ -84,9 +92,10 @@ impl TwinOptions {
                 "--estimator",
                 self.fidelity.name(),
                 self.intervals.as_deref(),
+                &sensor.id(),
             )?,
             fidelity: self.fidelity,
-            sensor: load_sensor(self.sensor.as_deref())?,
+            sensor,
         })
     }
 }

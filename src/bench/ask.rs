@@ -104,7 +104,9 @@ pub fn run(args: &AskBenchArgs) -> Result<()> {
     let mut estimator_name = String::new();
     for &fidelity in &args.fidelity {
         bar.set_message(fidelity.name());
-        let estimator = args.estimator.open("--estimator", fidelity.name(), None)?;
+        let estimator = args
+            .estimator
+            .open("--estimator", fidelity.name(), None, &sensor.id())?;
         estimator_name = estimator.name().to_string();
         let twin = Twin {
             scene: &scene,

@@ -37,6 +37,7 @@ use tactex_core::hardness::interval_calibration::{
 use tactex_core::hardness::scale::Hardness;
 use tactex_core::pipeline::PipelineConfig;
 use tactex_core::scene::Scene;
+use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_sim::contact::Fidelity;
 use tactex_sim::datagen::scene_random::{RandomSceneError, Variation, random_scene};
 use tactex_sim::render::device::DeviceChoice;
@@ -547,12 +548,17 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
     );
     let catalog = FruitCatalog::builtin();
     let fidelity = args.fidelity.name();
+    let sensor = crate::app::load_sensor(args.sensor.as_deref())?;
+    let sensor_id = sensor.id();
     let estimator = match &args.calibrate {
         // The residuals do not depend on the intervals; the file is for new presses.
         Some(_) => args.estimator.open_uncalibrated("--estimator")?,
-        None => args
-            .estimator
-            .open("--estimator", fidelity, args.intervals.as_deref())?,
+        None => args.estimator.open(
+            "--estimator",
+            fidelity,
+            args.intervals.as_deref(),
+            &sensor_id,
+        )?,
     };
     if let Some(path) = &args.calibrate
         && path.is_dir()
@@ -567,7 +573,6 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
             .expect("a valid template"),
     );
     let config = PipelineConfig::default();
-    let sensor = crate::app::load_sensor(args.sensor.as_deref())?;
     let per_table: Vec<(Vec<FruitRow>, usize)> = tables
         .par_iter()
         .map(|t| -> Result<(Vec<FruitRow>, usize)> {
@@ -605,7 +610,6 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
         .sum();
     let rows: Vec<FruitRow> = per_table.into_iter().flat_map(|p| p.0).collect();
 
-    let sensor_id = sensor.id();
     let protocol = format!(
         "each catalog kind alone at {} random places and yaws (stages in turn, every other at a modulus between stages), and {} crowded tables of 10-12 fruits, {:.0}% of them put against a neighbour; prompt {PROMPT:?}; camera noise on, classical detector; located: a report of the kind touches the fruit; placed: its centre within {:.0} mm of the fruit's outline centre",
         args.placements,
@@ -626,14 +630,19 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
             })
             .collect();
         let command = format!(
-            "tactex eval fruits --placements {} --crowded {} --seed {} --fidelity {fidelity} --estimator {} --calibrate FILE",
+            "tactex eval fruits --placements {} --crowded {} --seed {} --fidelity {fidelity} --estimator {}{} --calibrate FILE",
             args.placements,
             args.crowded,
             args.seed,
-            args.estimator.flag_value()
+            args.estimator.flag_value(),
+            match &args.sensor {
+                Some(p) => format!(" --sensor {}", p.display()),
+                None => String::new(),
+            }
         );
-        let calibration =
+        let mut calibration =
             IntervalCalibration::fit(estimator.name(), fidelity, &command, &samples, 3)?;
+        calibration.sensor = Some(sensor_id.clone());
         write_json_atomic(path, &calibration)?;
         eprintln!(
             "wrote {} ({} presses, {} bins)",
@@ -652,8 +661,13 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
         protocol,
         estimator: estimator.name().into(),
         fidelity: fidelity.into(),
+        intervals: interval_source(
+            &args.estimator,
+            fidelity,
+            args.intervals.as_ref(),
+            &sensor_id,
+        )?,
         sensor: sensor_id,
-        intervals: interval_source(&args.estimator, fidelity, args.intervals.as_ref())?,
         seed: args.seed,
         kinds: names
             .iter()
@@ -702,9 +716,15 @@ fn interval_source(
     choice: &EstimatorChoice,
     fidelity: &str,
     file: Option<&PathBuf>,
+    sensor: &ProfileId,
 ) -> Result<String> {
+    let builtin_sensor = SensorProfile::gelsight_mini().id();
     Ok(match file {
         Some(p) => format!("--intervals {}", p.display()),
+        None if sensor != &builtin_sensor => format!(
+            "the estimator's own (the shipped calibrations were measured through the built-in {}, not {sensor})",
+            builtin_sensor.name
+        ),
         None => match crate::app::estimator_choice::builtin_interval_file(choice, fidelity) {
             Some(name) => format!("{name} (built in)"),
             None => "the estimator's own (no calibration shipped for it here)".into(),

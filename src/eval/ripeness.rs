@@ -145,12 +145,12 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         }
         fruits.push(spec.clone());
     }
-    let estimator = args.estimator.open("--estimator", fidelity.name(), None)?;
+    let profile = crate::app::load_sensor(args.sensor.as_deref())?;
+    let estimator = args
+        .estimator
+        .open("--estimator", fidelity.name(), None, &profile.id())?;
     // The sensor as it is, unrandomised: a lab's validation run on one sensor.
-    let sensor = match &args.sensor {
-        Some(path) => SensorDraw::of(std::sync::Arc::new(crate::app::load_sensor(Some(path))?)),
-        None => SensorDraw::nominal(),
-    };
+    let sensor = SensorDraw::of(std::sync::Arc::new(profile));
     let protocol = PressProtocol::default();
     let jobs: Vec<Job> = fruits
         .iter()

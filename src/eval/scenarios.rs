@@ -538,9 +538,10 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
         .map(|spec| DetectorChoice::parse(spec))
         .collect::<Result<Vec<_>>>()?;
     let renderer = crate::app::scene_renderer(args.device)?;
+    let sensor = crate::app::load_sensor(args.sensor.as_deref())?;
     let estimator = args
         .estimator
-        .open("--estimator", args.fidelity.name(), None)?;
+        .open("--estimator", args.fidelity.name(), None, &sensor.id())?;
     let scenarios = tiers
         .iter()
         .flat_map(|&t| (0..args.runs).map(move |r| (t, r)))
@@ -554,7 +555,6 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
             .expect("a valid template"),
     );
     let config = PipelineConfig::default();
-    let sensor = crate::app::load_sensor(args.sensor.as_deref())?;
     let scores: Vec<RunScore> = jobs
         .par_iter()
         .map(|&(s, d)| -> Result<RunScore> {

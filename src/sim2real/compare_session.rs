@@ -448,7 +448,7 @@ pub fn compare_session(args: &SessionCompare) -> Result<SessionComparison> {
     }
     let estimator = args
         .estimator
-        .open("--estimator", args.fidelity.name(), None)?;
+        .open("--estimator", args.fidelity.name(), None, &sensor.id())?;
     let mut sim = SimDevices::with_sensor(&scene, seed, sensor.clone(), args.fidelity)
         .with_context(|| format!("{scene_name}: the twin cannot stand it up"))?;
     let rebuilt = rebuild_frames(&mut sim, &manifest)?;

@@ -411,6 +411,21 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
         e.contains("--intervals models/hardness-small.json: "),
         "{e}"
     );
+    // The shipped intervals were measured through the built-in Mini: through another sensor
+    // they would claim a coverage nobody measured.
+    let e = fails(&[
+        "ask",
+        "--sensor",
+        "tests/fixtures/fots/profile/fots-9.toml",
+        "--intervals",
+        "models/intervals/indentation-layer.json",
+        softest,
+    ]);
+    assert!(
+        e.contains("--intervals models/intervals/indentation-layer.json: measured through the sensor GelSight Mini")
+            && e.contains("eval fruits --sensor"),
+        "{e}"
+    );
     let e = fails(&["ask", "How hard is the pineapple?"]);
     assert!(
         e.contains("prompt: 'pineapple' is not in the fruit catalog"),

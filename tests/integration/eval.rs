@@ -434,6 +434,47 @@ fn fruits_scores_each_kind_and_writes_tables_that_ask_answers_again() {
         "{a}"
     );
 
+    // Through a calibrated profile: tables are pressed in parallel while each press is read
+    // on a thread of its own (this once deadlocked), and the shipped intervals, measured
+    // through the built-in Mini, are not applied.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args([
+            "eval",
+            "fruits",
+            "--placements",
+            "1",
+            "--crowded",
+            "0",
+            "--kinds",
+            "strawberry,lime",
+            "--sensor",
+            "tests/fixtures/fots/profile/fots-9.toml",
+            "--json",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > std::time::Duration::from_secs(600) {
+            child.kill().unwrap();
+            panic!("eval fruits through a profile did not finish in 10 minutes");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(200));
+    }
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        v["intervals"]
+            .as_str()
+            .unwrap()
+            .contains("measured through the built-in GelSight Mini, not fots-9"),
+        "{v}"
+    );
+
     bad_arguments_are_named(
         "fruits",
         &[

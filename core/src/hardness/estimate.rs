@@ -104,6 +104,9 @@ pub struct ModulusInterval {
     pub p68_mpa: [Option<f64>; 2],
     pub p95_mpa: [Option<f64>; 2],
     pub source: String,
+    /// Whether the coverage was measured (on held-out presses through the sensor in use).
+    /// An estimator's own interval is not, and answers do not word it as "likely".
+    pub calibrated: bool,
 }
 
 /// Normal quantile of the two-sided 95% interval.
@@ -117,6 +120,7 @@ impl ModulusInterval {
             p68_mpa: [at(-1.0), at(1.0)],
             p95_mpa: [at(-Z95), at(Z95)],
             source: source.into(),
+            calibrated: false,
         }
     }
 
@@ -126,6 +130,7 @@ impl ModulusInterval {
             p68_mpa: [None, None],
             p95_mpa: [None, None],
             source: source.into(),
+            calibrated: false,
         }
     }
 
@@ -373,6 +378,7 @@ impl HardnessEstimator for HertzSlopeEstimator {
                     to_modulus(share + Z95 * share_se),
                 ],
                 source: OWN_FIT_INTERVAL.into(),
+                calibrated: false,
             },
             evidence: Evidence::Physics(PhysicsEvidence {
                 gel_share: share,

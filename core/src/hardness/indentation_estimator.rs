@@ -117,6 +117,7 @@ impl HardnessEstimator for IndentationEstimator {
                 p68_mpa: [to_modulus(rho_hi), to_modulus(rho_lo)],
                 p95_mpa: [to_modulus(widen(rho_hi)), to_modulus(widen(rho_lo))],
                 source: OWN_FIT_INTERVAL.into(),
+                calibrated: false,
             },
             evidence: Evidence::Physics(PhysicsEvidence {
                 gel_share: share_at(fit.compliance_ratio),

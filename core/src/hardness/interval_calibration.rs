@@ -21,6 +21,7 @@ use crate::hardness::estimate::{
 };
 use crate::hardness::scale::Hardness;
 use crate::stats::quantile;
+use crate::tactile::sensor_profile::{ProfileId, SensorProfile};
 use crate::tactile::spec::TactileSpec;
 use serde::{Deserialize, Serialize};
 
@@ -50,6 +51,10 @@ pub struct IntervalCalibration {
     /// The bins of presses whose first contact was elongated (`ELONGATED_ASPECT`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub elongated_contact: Option<ResidualGroup>,
+    /// The sensor the held-out presses were rendered with and read through; absent: the
+    /// built-in GelSight Mini. Residuals measured through one sensor say nothing of another's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<ProfileId>,
 }
 
 /// One group of held-out presses and its bins.
@@ -158,6 +163,7 @@ impl IntervalCalibration {
             protocol: protocol.into(),
             presses: main.len(),
             bins: fit_bins(main, max_bins),
+            sensor: None,
             elongated_contact,
         })
     }
@@ -177,6 +183,13 @@ impl IntervalCalibration {
             check_bins(&group.bins, "elongated_contact.bins").map_err(invalid)?;
         }
         Ok(c)
+    }
+
+    /// The sensor these residuals were measured through.
+    pub fn measured_through(&self) -> ProfileId {
+        self.sensor
+            .clone()
+            .unwrap_or_else(|| SensorProfile::gelsight_mini().id())
     }
 
     /// The bins for a press, with the presses they rest on and what sets them apart.
@@ -214,6 +227,7 @@ impl IntervalCalibration {
                 modulus_mpa,
                 100.0 * (e / modulus_mpa - 1.0)
             ),
+            calibrated: true,
         }
     }
 }

@@ -255,8 +255,17 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
             label: o.label.clone(),
             location: o.location.clone(),
             hardness: o.hardness,
-            interval_68_mpa: o.interval.as_ref().map_or([None, None], |i| i.p68_mpa),
-            interval_95_mpa: o.interval.as_ref().map_or([None, None], |i| i.p95_mpa),
+            // Only a measured coverage is worded as "likely".
+            interval_68_mpa: o
+                .interval
+                .as_ref()
+                .filter(|i| i.calibrated)
+                .map_or([None, None], |i| i.p68_mpa),
+            interval_95_mpa: o
+                .interval
+                .as_ref()
+                .filter(|i| i.calibrated)
+                .map_or([None, None], |i| i.p95_mpa),
             ripeness: o.ripeness.clone(),
             not_measured: o.not_measured.as_ref().map(|n| n.to_string()),
         })

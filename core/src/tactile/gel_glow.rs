@@ -337,17 +337,10 @@ impl GelGlow {
         width: usize,
         height: usize,
     ) -> Vec<[f32; 3]> {
-        use rayon::prelude::*;
-        // The terms' blurs are independent and most of the work: they run in parallel and are
-        // summed in `terms()` order, so the sum is the same bytes on any number of threads.
-        let terms = self.terms();
-        let blurred: Vec<Vec<[f32; 3]>> = terms
-            .par_iter()
-            .map(|term| blurred_source(term, change, indentation_mm, width, height))
-            .collect();
         let mut out = vec![[0.0f32; 3]; change.len()];
-        for (term, blurred) in terms.iter().zip(&blurred) {
-            for (o, b) in out.iter_mut().zip(blurred) {
+        for term in self.terms() {
+            let blurred = blurred_source(&term, change, indentation_mm, width, height);
+            for (o, b) in out.iter_mut().zip(&blurred) {
                 for (c, row) in term.mix.iter().enumerate() {
                     o[c] += row[0] * b[0] + row[1] * b[1] + row[2] * b[2];
                 }

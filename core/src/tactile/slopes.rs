@@ -209,32 +209,27 @@ fn fill_holes(
 /// A calibrated table read backwards at every valid pixel of a shading change; a pixel no
 /// slope explains becomes invalid.
 fn read_table(table: &ShadingTable, change: &[[f32; 3]], field: &mut SlopeField) {
-    use rayon::prelude::*;
+    // Sequential on purpose: the pipeline reads a press on a thread of its own while the arm
+    // presses the next, and a rayon pool those threads wait in would deadlock.
     let (w, h) = (field.width, field.height);
-    // Rows are read in parallel, each left to right so that a pixel's descent can start from
-    // its left neighbour's slope.
-    field
-        .gx
-        .par_chunks_mut(w)
-        .zip(field.gy.par_chunks_mut(w))
-        .zip(field.valid.par_chunks_mut(w))
-        .zip(change.par_chunks(w))
-        .enumerate()
-        .for_each(|(y, (((gx, gy), valid), change))| {
-            let mut near = None;
-            for x in 0..w {
-                if !valid[x] {
-                    near = None;
-                    continue;
-                }
-                let (u, v) = frame_position(x as u32, y as u32, w as u32, h as u32);
-                let read =
-                    table.slope_for_change(change[x], u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS, near);
-                (gx[x], gy[x]) = read.unwrap_or((0.0, 0.0));
-                valid[x] = read.is_some();
-                near = read;
+    for y in 0..h {
+        // Each row left to right, so that a pixel's descent can start from its left
+        // neighbour's slope.
+        let mut near = None;
+        for x in 0..w {
+            let i = y * w + x;
+            if !field.valid[i] {
+                near = None;
+                continue;
             }
-        });
+            let (u, v) = frame_position(x as u32, y as u32, w as u32, h as u32);
+            let read =
+                table.slope_for_change(change[i], u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS, near);
+            (field.gx[i], field.gy[i]) = read.unwrap_or((0.0, 0.0));
+            field.valid[i] = read.is_some();
+            near = read;
+        }
+    }
 }
 
 fn lit_slope(
