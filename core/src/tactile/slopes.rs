@@ -209,26 +209,64 @@ fn fill_holes(
 /// A calibrated table read backwards at every valid pixel of a shading change; a pixel no
 /// slope explains becomes invalid.
 fn read_table(table: &ShadingTable, change: &[[f32; 3]], field: &mut SlopeField) {
-    // Sequential on purpose: the pipeline reads a press on a thread of its own while the arm
-    // presses the next, and a rayon pool those threads wait in would deadlock.
     let (w, h) = (field.width, field.height);
-    for y in 0..h {
-        // Each row left to right, so that a pixel's descent can start from its left
-        // neighbour's slope.
-        let mut near = None;
-        for x in 0..w {
-            let i = y * w + x;
-            if !field.valid[i] {
-                near = None;
-                continue;
-            }
-            let (u, v) = frame_position(x as u32, y as u32, w as u32, h as u32);
-            let read =
-                table.slope_for_change(change[i], u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS, near);
-            (field.gx[i], field.gy[i]) = read.unwrap_or((0.0, 0.0));
-            field.valid[i] = read.is_some();
-            near = read;
+    // Bands of rows on scoped threads of their own, not a rayon pool's: the pipeline reads a
+    // press on its own thread while rayon's workers wait for it, and a job queued behind
+    // them would never run. Rows are independent, so the bytes do not depend on the bands.
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(h.max(1));
+    let rows_per_band = h.div_ceil(threads).max(1);
+    let band = rows_per_band * w;
+    std::thread::scope(|scope| {
+        let bands = field
+            .gx
+            .chunks_mut(band)
+            .zip(field.gy.chunks_mut(band))
+            .zip(field.valid.chunks_mut(band))
+            .zip(change.chunks(band))
+            .enumerate();
+        for (k, (((gx, gy), valid), change)) in bands {
+            scope.spawn(move || {
+                let first_row = k * rows_per_band;
+                for (r, (((gx, gy), valid), change)) in gx
+                    .chunks_mut(w)
+                    .zip(gy.chunks_mut(w))
+                    .zip(valid.chunks_mut(w))
+                    .zip(change.chunks(w))
+                    .enumerate()
+                {
+                    read_row(table, change, first_row + r, w, h, gx, gy, valid);
+                }
+            });
         }
+    });
+}
+
+/// One row, left to right, so that a pixel's descent can start from its left neighbour's
+/// slope.
+#[allow(clippy::too_many_arguments)]
+fn read_row(
+    table: &ShadingTable,
+    change: &[[f32; 3]],
+    y: usize,
+    w: usize,
+    h: usize,
+    gx: &mut [f32],
+    gy: &mut [f32],
+    valid: &mut [bool],
+) {
+    let mut near = None;
+    for x in 0..w {
+        if !valid[x] {
+            near = None;
+            continue;
+        }
+        let (u, v) = frame_position(x as u32, y as u32, w as u32, h as u32);
+        let read = table.slope_for_change(change[x], u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS, near);
+        (gx[x], gy[x]) = read.unwrap_or((0.0, 0.0));
+        valid[x] = read.is_some();
+        near = read;
     }
 }
 
