@@ -8,7 +8,7 @@ use std::str::FromStr;
 use tactex_core::hardness::estimate::{HardnessEstimator, HertzSlopeEstimator};
 use tactex_core::hardness::indentation_estimator::IndentationEstimator;
 use tactex_core::hardness::interval_calibration::{Calibrated, IntervalCalibration};
-use tactex_core::tactile::sensor_profile::ProfileId;
+use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 
 /// A hardness estimator by name, or a trained model file.
 #[derive(Clone, Debug, PartialEq)]
@@ -131,7 +131,7 @@ impl EstimatorChoice {
                 }
                 Some(c)
             }
-            None => builtin_intervals(self, fidelity)?.filter(|c| &c.measured_through() == sensor),
+            None => builtin_intervals(self, fidelity, sensor)?,
         };
         Ok(match calibration {
             Some(calibration) => Box::new(Calibrated { inner, calibration }),
@@ -140,10 +140,16 @@ impl EstimatorChoice {
     }
 }
 
-/// The calibration shipped for `choice` at `fidelity`: (file name, text). A model file given
-/// by path has none (its name may be the built-in's, its residuals are not).
-fn builtin_entry(choice: &EstimatorChoice, fidelity: &str) -> Option<(&'static str, &'static str)> {
-    if matches!(choice, EstimatorChoice::Model(_)) {
+/// The calibration shipped for `choice` at `fidelity` read through `sensor`: (file name,
+/// text). A model file given by path has none (its name may be the built-in's, its residuals
+/// are not), and every shipped one was measured through the built-in Mini.
+fn builtin_entry(
+    choice: &EstimatorChoice,
+    fidelity: &str,
+    sensor: &ProfileId,
+) -> Option<(&'static str, &'static str)> {
+    if matches!(choice, EstimatorChoice::Model(_)) || sensor != &SensorProfile::gelsight_mini().id()
+    {
         return None;
     }
     let flag = choice.flag_value();
@@ -153,16 +159,21 @@ fn builtin_entry(choice: &EstimatorChoice, fidelity: &str) -> Option<(&'static s
         .map(|(_, _, file, text)| (*file, *text))
 }
 
-/// The name of the calibration shipped for `choice` at `fidelity`, if one is.
-pub fn builtin_interval_file(choice: &EstimatorChoice, fidelity: &str) -> Option<&'static str> {
-    builtin_entry(choice, fidelity).map(|(file, _)| file)
+/// The name of the calibration shipped for `choice` at `fidelity` through `sensor`, if one is.
+pub fn builtin_interval_file(
+    choice: &EstimatorChoice,
+    fidelity: &str,
+    sensor: &ProfileId,
+) -> Option<&'static str> {
+    builtin_entry(choice, fidelity, sensor).map(|(file, _)| file)
 }
 
 fn builtin_intervals(
     choice: &EstimatorChoice,
     fidelity: &str,
+    sensor: &ProfileId,
 ) -> Result<Option<IntervalCalibration>> {
-    builtin_entry(choice, fidelity)
+    builtin_entry(choice, fidelity, sensor)
         .map(|(file, text)| {
             IntervalCalibration::parse(text, &format!("{file} (built in)")).map_err(Into::into)
         })

@@ -718,16 +718,15 @@ fn interval_source(
     file: Option<&PathBuf>,
     sensor: &ProfileId,
 ) -> Result<String> {
-    let builtin_sensor = SensorProfile::gelsight_mini().id();
     Ok(match file {
         Some(p) => format!("--intervals {}", p.display()),
-        None if sensor != &builtin_sensor => format!(
-            "the estimator's own (the shipped calibrations were measured through the built-in {}, not {sensor})",
-            builtin_sensor.name
-        ),
-        None => match crate::app::estimator_choice::builtin_interval_file(choice, fidelity) {
+        None => match crate::app::estimator_choice::builtin_interval_file(choice, fidelity, sensor)
+        {
             Some(name) => format!("{name} (built in)"),
-            None => "the estimator's own (no calibration shipped for it here)".into(),
+            None => format!(
+                "the estimator's own (none is shipped for it through {sensor}; the shipped ones were measured through the built-in {})",
+                SensorProfile::gelsight_mini().id().name
+            ),
         },
     })
 }

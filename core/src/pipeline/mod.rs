@@ -251,23 +251,18 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
     let t = start("explain", arm);
     let measured: Vec<Measured> = objects
         .iter()
-        .map(|o| Measured {
-            label: o.label.clone(),
-            location: o.location.clone(),
-            hardness: o.hardness,
+        .map(|o| {
             // Only a measured coverage is worded as "likely".
-            interval_68_mpa: o
-                .interval
-                .as_ref()
-                .filter(|i| i.calibrated)
-                .map_or([None, None], |i| i.p68_mpa),
-            interval_95_mpa: o
-                .interval
-                .as_ref()
-                .filter(|i| i.calibrated)
-                .map_or([None, None], |i| i.p95_mpa),
-            ripeness: o.ripeness.clone(),
-            not_measured: o.not_measured.as_ref().map(|n| n.to_string()),
+            let calibrated = o.interval.as_ref().filter(|i| i.calibrated);
+            Measured {
+                label: o.label.clone(),
+                location: o.location.clone(),
+                hardness: o.hardness,
+                interval_68_mpa: calibrated.map_or([None, None], |i| i.p68_mpa),
+                interval_95_mpa: calibrated.map_or([None, None], |i| i.p95_mpa),
+                ripeness: o.ripeness.clone(),
+                not_measured: o.not_measured.as_ref().map(|n| n.to_string()),
+            }
         })
         .collect();
     let selected = explain::select(&query, &measured, catalog);

@@ -207,7 +207,7 @@ impl ShadingTable {
     /// `change` and its derivatives along gx and gy, from one lookup of the four nodes (the
     /// inverse's Gauss-Newton needs all three at every step). Away from the flat gel only:
     /// at gx = gy = 0 the direction, and so the derivative, is undefined.
-    pub fn change_with_derivatives(
+    fn change_with_derivatives(
         &self,
         gx: f32,
         gy: f32,
