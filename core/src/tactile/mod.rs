@@ -1,7 +1,8 @@
 //! The tactile sensor and its frames: what a GelSight is (`spec`, `sensor_profile`, the
 //! shading models `photometric` and `shading_table`, the `gel_glow`), how a profile is fitted
 //! from ball presses (`ball_calibration`), and reading its frames: SSIM, markers and their
-//! grid, the contact criterion, the contact circle, surface slopes and the indentation map.
+//! grid, the contact criterion, the contact circle, surface slopes (a table read backwards in
+//! `shading_inverse`) and the indentation map.
 
 pub mod ball_calibration;
 pub mod circle_fit;
@@ -16,6 +17,7 @@ pub mod marker_grid;
 pub mod markers;
 pub mod photometric;
 pub mod sensor_profile;
+pub mod shading_inverse;
 pub mod shading_table;
 pub mod slopes;
 pub mod spec;

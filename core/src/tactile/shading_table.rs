@@ -59,45 +59,19 @@ fn invalid(field: &'static str, message: impl Into<String>) -> ShadingTableError
 /// Where a slope falls among the bin nodes: the lower magnitude node and the two direction
 /// nodes around it, with the interpolation fractions.
 #[derive(Clone, Copy, Debug)]
-struct BinPosition {
-    m0: u32,
-    d0: u32,
-    d1: u32,
-    tm: f32,
-    td: f32,
+pub(super) struct BinPosition {
+    pub(super) m0: u32,
+    pub(super) d0: u32,
+    pub(super) d1: u32,
+    pub(super) tm: f32,
+    pub(super) td: f32,
 }
 
 fn bin_position(mag_bins: u32, dir_bins: u32, mag_max: f32, gx: f32, gy: f32) -> BinPosition {
     bin_position_at(mag_bins, dir_bins, mag_max, gx, gy, gy.atan2(gx))
 }
 
-/// atan2 to within 1e-5 rad (a 5th-order minimax fit of atan on [0, 1], folded into the
-/// octants), for the table's inverse: libm's is a fifth of its time, and an error of 1e-5
-/// rad moves a lookup by 4e-5 of a 24-bin direction step, far below a grey level.
-fn direction(gy: f32, gx: f32) -> f32 {
-    use std::f32::consts::{FRAC_PI_2, PI};
-    let (ax, ay) = (gx.abs(), gy.abs());
-    let (num, den) = if ax >= ay { (ay, ax) } else { (ax, ay) };
-    if den == 0.0 {
-        return 0.0;
-    }
-    let z = num / den;
-    let z2 = z * z;
-    let mut a = z
-        * (0.999_977_3
-            + z2 * (-0.332_623_5
-                + z2 * (0.193_543_5
-                    + z2 * (-0.116_432_9 + z2 * (0.052_653_3 + z2 * -0.011_721_2)))));
-    if ay > ax {
-        a = FRAC_PI_2 - a;
-    }
-    if gx < 0.0 {
-        a = PI - a;
-    }
-    if gy < 0.0 { -a } else { a }
-}
-
-fn bin_position_at(
+pub(super) fn bin_position_at(
     mag_bins: u32,
     dir_bins: u32,
     mag_max: f32,
@@ -107,9 +81,11 @@ fn bin_position_at(
 ) -> BinPosition {
     let mag = (gx * gx + gy * gy).sqrt().min(mag_max);
     let fm = mag / mag_max * (mag_bins - 1) as f32;
-    let m0 = (fm.floor() as u32).min(mag_bins - 2);
+    // Truncation is floor for these non-negative positions, without libm's floorf call
+    // (a twentieth of a profile's read).
+    let m0 = (fm as u32).min(mag_bins - 2);
     let fd = (angle + TAU * 0.5) / TAU * dir_bins as f32;
-    let fd0 = fd.floor();
+    let fd0 = (fd as u32) as f32;
     let d0 = (fd0 as u32) % dir_bins;
     BinPosition {
         m0,
@@ -186,13 +162,6 @@ impl ShadingTable {
         self.lookup(b, u, v)
     }
 
-    /// `change` with the direction from `direction`: the inverse's own lookup.
-    fn change_for_inverse(&self, gx: f32, gy: f32, u: f32, v: f32) -> [f32; 3] {
-        let angle = direction(gy, gx);
-        let b = bin_position_at(self.mag_bins, self.dir_bins, self.mag_max, gx, gy, angle);
-        self.lookup(b, u, v)
-    }
-
     fn lookup(&self, b: BinPosition, u: f32, v: f32) -> [f32; 3] {
         let at = |m: u32, d: u32| m * self.dir_bins + d;
         std::array::from_fn(|c| {
@@ -202,45 +171,6 @@ impl ShadingTable {
                 + self.node_value(at(b.m0 + 1, b.d1), c, u, v) * b.td;
             lo * (1.0 - b.tm) + hi * b.tm
         })
-    }
-
-    /// `change` and its derivatives along gx and gy, from one lookup of the four nodes (the
-    /// inverse's Gauss-Newton needs all three at every step). Away from the flat gel only:
-    /// at gx = gy = 0 the direction, and so the derivative, is undefined.
-    fn change_with_derivatives(
-        &self,
-        gx: f32,
-        gy: f32,
-        u: f32,
-        v: f32,
-    ) -> ([f32; 3], [f32; 3], [f32; 3]) {
-        let angle = direction(gy, gx);
-        let b = bin_position_at(self.mag_bins, self.dir_bins, self.mag_max, gx, gy, angle);
-        let at = |m: u32, d: u32| m * self.dir_bins + d;
-        let mag2 = gx * gx + gy * gy;
-        let mag = mag2.sqrt();
-        // d tm / d g and d td / d g: magnitude is clamped at mag_max, direction wraps.
-        let dtm = if mag < self.mag_max {
-            (self.mag_bins - 1) as f32 / self.mag_max / mag
-        } else {
-            0.0
-        };
-        let dtd = self.dir_bins as f32 / TAU / mag2;
-        let (mut c, mut jx, mut jy) = ([0.0f32; 3], [0.0f32; 3], [0.0f32; 3]);
-        for k in 0..3 {
-            let n00 = self.node_value(at(b.m0, b.d0), k, u, v);
-            let n01 = self.node_value(at(b.m0, b.d1), k, u, v);
-            let n10 = self.node_value(at(b.m0 + 1, b.d0), k, u, v);
-            let n11 = self.node_value(at(b.m0 + 1, b.d1), k, u, v);
-            let lo = n00 * (1.0 - b.td) + n01 * b.td;
-            let hi = n10 * (1.0 - b.td) + n11 * b.td;
-            c[k] = lo * (1.0 - b.tm) + hi * b.tm;
-            let by_tm = (hi - lo) * dtm;
-            let by_td = ((n01 - n00) * (1.0 - b.tm) + (n11 - n10) * b.tm) * dtd;
-            jx[k] = by_tm * gx - by_td * gy;
-            jy[k] = by_tm * gy + by_td * gx;
-        }
-        (c, jx, jy)
     }
 
     /// The colour change of the flat gel at normalised position (u, v): zero for a sensor whose
@@ -265,121 +195,6 @@ impl ShadingTable {
             coefficients,
             ..self.clone()
         }
-    }
-
-    /// The slope (gx, gy) whose colour change at (u, v) is nearest `change` (least squares
-    /// over the three channels, plus `prior` grey levels^2 per unit slope^2 of |g|^2): the
-    /// table read backwards, as the estimators read a calibrated sensor's frames. A real
-    /// table can colour a steep slope almost like the flat gel (its steep nodes are fitted
-    /// from few pixels), so without the prior the camera's noise on a flat pixel can pick a
-    /// steep slope. A damped Gauss-Newton descent starts from the better of the flat gel and
-    /// `near` (a neighbouring pixel's slope: the gel's surface is continuous); only a change
-    /// that descent leaves unexplained, by more than a few grey levels, is searched again
-    /// from the best of a coarse ring of slopes. None where no slope comes within `max_rms`
-    /// grey levels (saturation, dust, a marker's edge).
-    pub fn slope_for_change(
-        &self,
-        change: [f32; 3],
-        u: f32,
-        v: f32,
-        prior: f32,
-        max_rms: f32,
-        near: Option<(f32, f32)>,
-    ) -> Option<(f32, f32)> {
-        let residual = |gx: f32, gy: f32| {
-            let c = self.change_for_inverse(gx, gy, u, v);
-            [c[0] - change[0], c[1] - change[1], c[2] - change[2]]
-        };
-        let norm2 = |r: [f32; 3]| r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        let cost = |gx: f32, gy: f32| norm2(residual(gx, gy)) + prior * (gx * gx + gy * gy);
-        let mut start = (0.0f32, 0.0f32, cost(0.0, 0.0));
-        // A flat gel shows no change: most of a stock-sensor press frame ends here.
-        if start.2 <= 3.0 * 0.25 {
-            return Some((0.0, 0.0));
-        }
-        if let Some((nx, ny)) = near {
-            let e = cost(nx, ny);
-            if e < start.2 {
-                start = (nx, ny, e);
-            }
-        }
-        let descend = |(mut gx, mut gy, mut err): (f32, f32, f32)| {
-            let mut damping = 1e-2f32;
-            let h = 1e-3f32 * self.mag_max;
-            for _ in 0..20 {
-                // Analytic derivatives of the bilinear lookup, except at the flat gel, where the
-                // table is a cone with no gradient: there central differences average the
-                // directions, which is what lets the descent leave the apex.
-                let (c, jx, jy) = if gx * gx + gy * gy > h * h {
-                    self.change_with_derivatives(gx, gy, u, v)
-                } else {
-                    let dx = residual(gx + h, gy);
-                    let dxm = residual(gx - h, gy);
-                    let dy = residual(gx, gy + h);
-                    let dym = residual(gx, gy - h);
-                    (
-                        self.change_for_inverse(gx, gy, u, v),
-                        std::array::from_fn(|c| (dx[c] - dxm[c]) / (2.0 * h)),
-                        std::array::from_fn(|c| (dy[c] - dym[c]) / (2.0 * h)),
-                    )
-                };
-                let r: [f32; 3] = std::array::from_fn(|k| c[k] - change[k]);
-                let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-                let (a, b, d) = (dot(jx, jx) + prior, dot(jx, jy), dot(jy, jy) + prior);
-                let (ex, ey) = (-dot(jx, r) - prior * gx, -dot(jy, r) - prior * gy);
-                let mut stepped = false;
-                for _ in 0..6 {
-                    let (a2, d2) = (a * (1.0 + damping) + 1e-6, d * (1.0 + damping) + 1e-6);
-                    let det = a2 * d2 - b * b;
-                    if det.abs() < 1e-12 {
-                        damping *= 4.0;
-                        continue;
-                    }
-                    let (sx, sy) = ((d2 * ex - b * ey) / det, (a2 * ey - b * ex) / det);
-                    let e = cost(gx + sx, gy + sy);
-                    if e < err {
-                        gx += sx;
-                        gy += sy;
-                        let converged = (sx * sx + sy * sy).sqrt() < 1e-4 || err - e < 1e-6 * err;
-                        err = e;
-                        damping = (damping / 3.0).max(1e-6);
-                        stepped = !converged;
-                        break;
-                    }
-                    damping *= 4.0;
-                }
-                if !stepped {
-                    break;
-                }
-            }
-            (gx, gy, err)
-        };
-        let mut best = descend(start);
-        // Left over after the descent: more than a camera's noise (4 grey levels a channel)
-        // may be a local minimum, so the ring's global start gets its chance.
-        if best.2 > 3.0 * 4.0 * 4.0 {
-            let mut ring = (0.0f32, 0.0f32, f32::INFINITY);
-            let directions: [(f32, f32); 12] =
-                std::array::from_fn(|k| (k as f32 * TAU / 12.0).sin_cos());
-            for mag in [0.1f32, 0.3, 0.6, 1.0, 1.6] {
-                let mag = mag * self.mag_max / 2.5;
-                for (sin, cos) in directions {
-                    let (gx, gy) = (mag * cos, mag * sin);
-                    let e = cost(gx, gy);
-                    if e < ring.2 {
-                        ring = (gx, gy, e);
-                    }
-                }
-            }
-            if ring.2 < best.2 {
-                let again = descend(ring);
-                if again.2 < best.2 {
-                    best = again;
-                }
-            }
-        }
-        let (gx, gy, _) = best;
-        ((norm2(residual(gx, gy)) / 3.0).sqrt() <= max_rms).then_some((gx, gy))
     }
 
     /// Least-squares fit of the table to `samples`. Each sample constrains the four nodes
@@ -533,12 +348,12 @@ pub(crate) fn solve_spd(a: &mut [f64], n: usize, b: &[[f64; 3]]) -> Option<Vec<[
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A table fitted to the analytic lights over a flat grey background: its changes are
     /// the lights' gains times the background, less the background.
-    fn lights_table() -> ShadingTable {
+    pub(crate) fn lights_table() -> ShadingTable {
         let lights = crate::tactile::photometric::PhotometricModel::default();
         let bg = 140.0f32;
         let mut samples = Vec::new();
@@ -558,89 +373,6 @@ mod tests {
             }
         }
         ShadingTable::fit(&samples, 12, 24, 2.5, 1.0).unwrap()
-    }
-
-    #[test]
-    fn read_backwards_the_table_gives_the_slope_that_made_the_colour() {
-        let table = lights_table();
-        for (gx, gy) in [
-            (0.0f32, 0.0f32),
-            (0.05, -0.02),
-            (0.3, 0.1),
-            (-0.6, 0.4),
-            (1.2, -0.9),
-            (0.0, 1.8),
-        ] {
-            for (u, v) in [(0.0f32, 0.0f32), (0.5, -0.3)] {
-                let change = table.change(gx, gy, u, v);
-                let (rx, ry) = table
-                    .slope_for_change(change, u, v, 0.0, 1.0, None)
-                    .unwrap();
-                let tol = 0.02 + 0.03 * (gx * gx + gy * gy).sqrt();
-                assert!(
-                    (rx - gx).abs() < tol && (ry - gy).abs() < tol,
-                    "({gx}, {gy}) at ({u}, {v}) read back as ({rx}, {ry})"
-                );
-            }
-        }
-        // No slope makes every channel 80 grey levels brighter.
-        assert!(
-            table
-                .slope_for_change([80.0; 3], 0.0, 0.0, 0.0, 6.0, None)
-                .is_none()
-        );
-    }
-
-    #[test]
-    fn the_lookups_derivatives_are_its_slopes_between_nodes() {
-        let table = lights_table();
-        let h = 1e-3f32;
-        for (gx, gy) in [
-            (0.13f32, 0.07f32),
-            (-0.61, 0.42),
-            (1.17, -0.93),
-            (0.02, 1.71),
-        ] {
-            let (u, v) = (0.4f32, -0.2f32);
-            let (c, jx, jy) = table.change_with_derivatives(gx, gy, u, v);
-            let exact = table.change(gx, gy, u, v);
-            assert!(
-                (0..3).all(|k| (c[k] - exact[k]).abs() < 1e-3),
-                "{c:?} {exact:?}"
-            );
-            let (px, mx) = (
-                table.change(gx + h, gy, u, v),
-                table.change(gx - h, gy, u, v),
-            );
-            let (py, my) = (
-                table.change(gx, gy + h, u, v),
-                table.change(gx, gy - h, u, v),
-            );
-            for k in 0..3 {
-                let (nx, ny) = ((px[k] - mx[k]) / (2.0 * h), (py[k] - my[k]) / (2.0 * h));
-                let tol = 0.02 * (nx.abs() + ny.abs()) + 0.5;
-                assert!(
-                    (jx[k] - nx).abs() < tol && (jy[k] - ny).abs() < tol,
-                    "({gx}, {gy}) channel {k}: analytic ({}, {}) numeric ({nx}, {ny})",
-                    jx[k],
-                    jy[k]
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn the_inverses_direction_is_atan2_within_1e_5_rad() {
-        let mut worst = 0.0f32;
-        for k in 0..20_000 {
-            let a = k as f32 / 20_000.0 * TAU - TAU / 2.0;
-            for r in [1e-4f32, 0.3, 2.5] {
-                let (gx, gy) = (r * a.cos(), r * a.sin());
-                worst = worst.max((direction(gy, gx) - gy.atan2(gx)).abs());
-            }
-        }
-        assert!(worst < 1e-5, "{worst}");
-        assert_eq!(direction(0.0, 0.0), 0.0);
     }
 
     #[test]

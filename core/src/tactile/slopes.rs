@@ -30,7 +30,7 @@ pub(crate) fn is_dark(p: &image::Rgb<u8>) -> bool {
 /// is not gel shading: a table fits real presses to about 5-9 grey levels.
 const TABLE_MAX_RMS: f32 = 25.0;
 /// How much a calibrated table's reading prefers gentle slopes (grey levels^2 per unit
-/// slope^2; see `ShadingTable::slope_for_change`): a unit of slope must buy back about 3.7
+/// slope^2; see `ShadingRow::slope_for_change`): a unit of slope must buy back about 3.7
 /// grey levels of residual in each channel. Chosen on the FOTS profile's read-back of
 /// rendered presses (tails of 1.5 slope units without it, 0.45 with it).
 const TABLE_SLOPE_PRIOR: f32 = 40.0;
@@ -257,13 +257,15 @@ fn read_row(
     valid: &mut [bool],
 ) {
     let mut near = None;
+    let (_, v) = frame_position(0, y as u32, w as u32, h as u32);
+    let row = table.row(v);
     for x in 0..w {
         if !valid[x] {
             near = None;
             continue;
         }
-        let (u, v) = frame_position(x as u32, y as u32, w as u32, h as u32);
-        let read = table.slope_for_change(change[x], u, v, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS, near);
+        let (u, _) = frame_position(x as u32, y as u32, w as u32, h as u32);
+        let read = row.slope_for_change(change[x], u, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS, near);
         (gx[x], gy[x]) = read.unwrap_or((0.0, 0.0));
         valid[x] = read.is_some();
         near = read;
