@@ -35,7 +35,22 @@ struct GlowTerm {
     // The source (GlowSource::code): 0 the change, 1 its magnitude (in channel 0), 2 the
     // gel's indentation in mm (in channel 0), 3 the change times the indentation.
     source: u32,
-    padding: u32,
+    // The spacing of the grid the blur is computed on (1: every pixel), as `blur_step`.
+    step: u32,
+}
+
+// Samples a blur with `step` takes along an axis of `len` pixels: every step-th and the last
+// (`blur_samples`).
+fn sample_count(len: u32, step: u32) -> u32 {
+    if ((len - 1u) % step == 0u) {
+        return (len - 1u) / step + 1u;
+    }
+    return (len - 1u) / step + 2u;
+}
+
+// The pixel sample j of an axis of `len` pixels lies at.
+fn sample_at(j: u32, len: u32, step: u32) -> u32 {
+    return min(j * step, len - 1u);
 }
 
 fn pixel_count() -> u32 {

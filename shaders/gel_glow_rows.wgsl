@@ -1,6 +1,7 @@
 // Glow, pass 1 of a term: the term's source (the shading's change from the flat gel's
 // shading, its magnitude, the gel's indentation, or the change times the indentation)
-// blurred along each row, edges extended.
+// blurred along each row, edges extended, at the term's sample columns: invocation x is
+// sample x, written at column x.
 
 @group(0) @binding(1) var<uniform> term: GlowTerm;
 @group(0) @binding(2) var<storage, read> kernel: array<f32>;
@@ -33,13 +34,14 @@ fn source(frame: u32, x: u32, y: u32) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (outside_frame(id)) {
+    if (outside_frame(id) || id.x >= sample_count(params.width, term.step)) {
         return;
     }
+    let at = i32(sample_at(id.x, params.width, term.step));
     let r = i32(term.radius);
     var sum = vec3<f32>(0.0);
     for (var i = -r; i <= r; i = i + 1) {
-        let x = u32(clamp(i32(id.x) + i, 0, i32(params.width) - 1));
+        let x = u32(clamp(at + i, 0, i32(params.width) - 1));
         sum = sum + kernel[term.offset + u32(i + r)] * source(id.z, x, id.y);
     }
     let out = (id.z * pixel_count() + id.y * params.width + id.x) * 3u;

@@ -166,11 +166,22 @@ fn gpu_and_cpu_paths_agree_on_a_set_of_presses() {
                 sigma_px: 3.0,
                 mix: [[0.5, 0.0, -0.1], [0.1, 0.4, 0.0], [0.0, 0.2, 0.6]],
             },
+            ColourGlow {
+                sigma_px: 27.0,
+                mix: [[0.6, 0.1, 0.0], [0.0, 0.5, 0.1], [0.1, 0.0, 0.7]],
+            },
         ],
-        magnitude: vec![ScalarGlow {
-            sigma_px: 9.0,
-            colour: [0.3, 0.1, -0.2],
-        }],
+        // 9 px at every pixel; 20 px computed on a grid of samples and interpolated.
+        magnitude: vec![
+            ScalarGlow {
+                sigma_px: 9.0,
+                colour: [0.3, 0.1, -0.2],
+            },
+            ScalarGlow {
+                sigma_px: 20.0,
+                colour: [0.4, -0.3, 0.2],
+            },
+        ],
         indentation: vec![ScalarGlow {
             sigma_px: 2.0,
             colour: [-23.5, -9.1, -6.5],
@@ -200,8 +211,10 @@ fn gpu_and_cpu_paths_agree_on_a_set_of_presses() {
                 "press {k}: mean |gpu - cpu| {mean:.4?}, max {max:?} ({})",
                 gpu.name()
             );
-            assert!(mean.iter().all(|m| *m <= 1.0), "press {k}: mean {mean:?}");
-            assert!(max.iter().all(|m| *m <= 4), "press {k}: max {max:?}");
+            // Both paths do the same arithmetic in f32; only the last rounding to a grey
+            // level may differ.
+            assert!(mean.iter().all(|m| *m <= 0.01), "press {k}: mean {mean:?}");
+            assert!(max.iter().all(|m| *m <= 1), "press {k}: max {max:?}");
         }
     }
 }

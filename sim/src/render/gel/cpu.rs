@@ -181,6 +181,11 @@ fn glowing(
     glow: &GelGlow,
     heights: &[f32],
 ) -> Vec<[f32; 3]> {
+    // Every source of the glow is zero on an untouched gel: its frame is the flat shading,
+    // bit for bit, without the blurs (the arm's search for contact renders many such).
+    if heights.iter().all(|&h| h == 0.0) {
+        return flat_shading(p, optics);
+    }
     let (flat, change) = shading_change(p, optics, heights);
     let mut out = glow.apply(&change, heights, p.width as usize, p.height as usize);
     for (o, f) in out.iter_mut().zip(&flat) {

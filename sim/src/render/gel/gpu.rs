@@ -1,4 +1,4 @@
-//! The WGSL compute renderer: the stages of `shaders/` (four, and three more for a glow) as
+//! The WGSL compute renderer: the stages of `shaders/` (four, and four more for a glow) as
 //! wgpu compute pipelines, a whole batch of presses per dispatch (the frame is the third
 //! dispatch dimension), read back as RGBA8 and unpacked.
 
@@ -9,13 +9,13 @@ use super::{
 };
 use crate::render::device::GpuDevice;
 use image::RgbImage;
-use tactex_core::tactile::gel_glow::gaussian_kernel;
+use tactex_core::tactile::gel_glow::{blur_step, gaussian_kernel};
 use wgpu::util::DeviceExt;
 
 const COMMON: &str = include_str!("../../../../shaders/common.wgsl");
 
 /// Each stage's own source; the shared prelude (`common.wgsl`) goes in front of it.
-pub const SHADER_SOURCES: [(&str, &str); 7] = [
+pub const SHADER_SOURCES: [(&str, &str); 8] = [
     (
         "gel_slopes",
         include_str!("../../../../shaders/gel_slopes.wgsl"),
@@ -41,6 +41,10 @@ pub const SHADER_SOURCES: [(&str, &str); 7] = [
         include_str!("../../../../shaders/gel_glow_columns.wgsl"),
     ),
     (
+        "gel_glow_spread",
+        include_str!("../../../../shaders/gel_glow_spread.wgsl"),
+    ),
+    (
         "gel_glow_apply",
         include_str!("../../../../shaders/gel_glow_apply.wgsl"),
     ),
@@ -53,7 +57,8 @@ const MARKERS: usize = 2;
 const EXPOSURE: usize = 3;
 const GLOW_ROWS: usize = 4;
 const GLOW_COLUMNS: usize = 5;
-const GLOW_APPLY: usize = 6;
+const GLOW_SPREAD: usize = 6;
+const GLOW_APPLY: usize = 7;
 
 /// The complete WGSL module of a stage, as the device compiles it.
 pub fn shader_source(stage: &str) -> Option<String> {
@@ -69,7 +74,7 @@ const MAX_FRAMES_PER_DISPATCH: usize = 64;
 pub struct GpuRenderer {
     gpu: GpuDevice,
     /// One per entry of SHADER_SOURCES.
-    pipelines: [wgpu::ComputePipeline; 7],
+    pipelines: [wgpu::ComputePipeline; 8],
 }
 
 impl GpuRenderer {
@@ -215,6 +220,7 @@ impl GpuRenderer {
                 frame_px * 12,
                 wgpu::BufferUsages::empty(),
             );
+            let blurred = self.scratch("glow blurred", frame_px * 12, wgpu::BufferUsages::empty());
             let sum = self.scratch("glow", frame_px * 12, wgpu::BufferUsages::COPY_DST);
             for term in &glow.terms {
                 steps.push((
@@ -237,8 +243,13 @@ impl GpuRenderer {
                     GLOW_COLUMNS,
                     self.bind(
                         GLOW_COLUMNS,
-                        &[&uniform, term, &glow.kernel, &along_rows, &sum],
+                        &[&uniform, term, &glow.kernel, &along_rows, &blurred],
                     ),
+                    tiles,
+                ));
+                steps.push((
+                    GLOW_SPREAD,
+                    self.bind(GLOW_SPREAD, &[&uniform, term, &blurred, &sum]),
                     tiles,
                 ));
             }
@@ -326,7 +337,7 @@ struct GlowTermBlock {
     offset: u32,
     radius: u32,
     source: u32,
-    padding: u32,
+    step: u32,
 }
 
 impl GpuRenderer {
@@ -342,7 +353,7 @@ impl GpuRenderer {
                 offset: kernel.len() as u32,
                 radius: (k.len() / 2) as u32,
                 source: term.source.code(),
-                padding: 0,
+                step: blur_step(term.sigma_px) as u32,
             };
             kernel.extend(k);
             terms.push(
