@@ -19,7 +19,7 @@
 //! (`tests/integration/sim_to_real.rs`; `tactex compare` reports it per image).
 
 use super::circle_fit::fit_circle;
-use super::slopes::is_dark;
+use super::slopes::{dark_level, is_dark};
 use image::{ImageBuffer, Luma, RgbImage};
 use imageproc::filter::{filter3x3, gaussian_blur_f32};
 use serde::Serialize;
@@ -91,9 +91,10 @@ pub fn estimate_contact_circle(frame: &RgbImage, reference: &RgbImage) -> Option
 /// (a deep press saturates red over thousands of pixels around the imprint on the FOTS frames).
 fn colour_change(frame: &RgbImage, reference: &RgbImage) -> [FloatImage; 3] {
     let (w, h) = frame.dimensions();
+    let level = dark_level(reference);
     let weight = FloatImage::from_fn(w, h, |x, y| {
         let (p, r) = (frame.get_pixel(x, y), reference.get_pixel(x, y));
-        let shaded = !(is_dark(p) || is_dark(r));
+        let shaded = !(is_dark(p, level) || is_dark(r, level));
         Luma([if shaded { 1.0 } else { 0.0 }])
     });
     let weight_blur = gaussian_blur_f32(&weight, CHANGE_SIGMA_PX);

@@ -21,9 +21,27 @@ pub struct SlopeField {
     pub valid: Vec<bool>,
 }
 
-/// A marker dot's pixel: it carries no shading.
-pub(crate) fn is_dark(p: &image::Rgb<u8>) -> bool {
-    (p[0] as u32 + p[1] as u32 + p[2] as u32) < 3 * 70
+/// Below this sum of the three channels a pixel is a marker dot's, and carries no shading:
+/// 210 (70 grey levels a channel), or 0.45 of the no-contact frame's median where that is
+/// dimmer, since a dim sensor's lit gel itself sits near 70 (a dot takes 60-85% of the light
+/// away, so its middle stays below 0.45 of the gel's).
+pub(crate) fn dark_level(reference: &RgbImage) -> u32 {
+    let mut sums: Vec<u32> = reference
+        .pixels()
+        .step_by(7)
+        .map(|p| p[0] as u32 + p[1] as u32 + p[2] as u32)
+        .collect();
+    if sums.is_empty() {
+        return 3 * 70;
+    }
+    let mid = sums.len() / 2;
+    let median = *sums.select_nth_unstable(mid).1;
+    (3 * 70).min(median * 45 / 100)
+}
+
+/// A marker dot's pixel, against a frame's `dark_level`.
+pub(crate) fn is_dark(p: &image::Rgb<u8>, level: u32) -> bool {
+    (p[0] as u32 + p[1] as u32 + p[2] as u32) < level
 }
 
 /// A calibrated table's colour change further than this (rms grey levels) from every slope's
@@ -47,9 +65,10 @@ pub fn recover_slopes(
         return None;
     }
     let (w, h) = (frame.width() as usize, frame.height() as usize);
+    let level = dark_level(reference);
     let mut dark = vec![false; w * h];
     for (i, (p, r)) in frame.pixels().zip(reference.pixels()).enumerate() {
-        dark[i] = is_dark(p) || is_dark(r) || p.0.contains(&255);
+        dark[i] = is_dark(p, level) || is_dark(r, level) || p.0.contains(&255);
     }
     let mut valid = vec![true; w * h];
     for y in 0..h {
@@ -307,5 +326,19 @@ mod tests {
             s.gx[i],
             s.gy[i]
         );
+    }
+
+    #[test]
+    fn a_dim_sensors_lit_gel_is_shading_and_its_dots_are_not() {
+        // Gel at 75 grey levels a channel (a dim sensor), dots taking 60% of its light.
+        let mut dim = RgbImage::from_pixel(20, 20, Rgb([80, 70, 75]));
+        dim.put_pixel(5, 5, Rgb([32, 28, 30]));
+        let level = dark_level(&dim);
+        assert!(!is_dark(dim.get_pixel(0, 0), level));
+        assert!(!is_dark(&Rgb([60, 55, 58]), level), "a shaded slope of the gel");
+        assert!(is_dark(dim.get_pixel(5, 5), level));
+        // A bright sensor keeps the fixed level: 70 grey levels a channel.
+        let bright = RgbImage::from_pixel(20, 20, Rgb([170, 160, 150]));
+        assert_eq!(dark_level(&bright), 210);
     }
 }
