@@ -186,6 +186,27 @@ impl<T: HardnessEstimator + ?Sized> HardnessEstimator for Box<T> {
     }
 }
 
+/// The least share of the travel the gel may take for an estimator to resolve the object.
+/// The modulus goes as (1 - s) / s, so d ln E / d s = -1 / (s (1 - s)): where s (1 - s) <
+/// 0.02, a reading error of 1% of the travel moves the modulus by more than half. Below it
+/// the object is far softer than the gel and the press cannot say by how much. (At the
+/// stiff end the same loss is a rigid object's bound, which the estimate already says.)
+pub(crate) const MIN_GEL_SHARE: f64 = 0.0205;
+
+/// Refuses a press in which the gel took too small a share of the travel to resolve the
+/// object, saying so in the user's terms (every physics estimator's rule).
+pub(crate) fn check_gel_share(share: f64) -> Result<(), EstimateError> {
+    if share < MIN_GEL_SHARE {
+        return Err(EstimateError::OutsideCompetence(format!(
+            "the gel took {:.1}% of the travel: the object is too soft against the gel to \
+             resolve (below {:.1}%)",
+            100.0 * share,
+            100.0 * MIN_GEL_SHARE
+        )));
+    }
+    Ok(())
+}
+
 /// Physics inversion of the Hertz compliance split from the slope field (see the module docs).
 #[derive(Clone, Debug)]
 pub struct HertzSlopeEstimator {
@@ -352,6 +373,10 @@ impl HardnessEstimator for HertzSlopeEstimator {
         if !(share.is_finite() && share > 0.0) {
             return Err(EstimateError::NoImprint);
         }
+        // The slope fit's first contact is loosely held (it trades off against the local
+        // radius), so unlike the depth fit's it is not a reason to refuse: through FOTS that
+        // rule refused three soft presses read better than the rest.
+        check_gel_share(share)?;
 
         let gel = Elastic {
             modulus_mpa: Some(spec.gel.modulus_mpa),

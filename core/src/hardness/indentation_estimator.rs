@@ -10,7 +10,7 @@
 
 use crate::hardness::estimate::{
     EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval,
-    OWN_FIT_INTERVAL, PhysicsEvidence, PressSequence, Z95,
+    OWN_FIT_INTERVAL, PhysicsEvidence, PressSequence, Z95, check_gel_share,
 };
 use crate::hardness::gel_share_fit::{ShareFit, fit_gel_share, gel_share};
 use crate::hardness::layer_compliance::hertz_ellipse_centre_compliance_ratio;
@@ -141,13 +141,6 @@ impl HardnessEstimator for IndentationEstimator {
     }
 }
 
-/// The least share of the travel the gel may take for the estimator to resolve the object.
-/// The modulus goes as (1 - s) / s, so d ln E / d s = -1 / (s (1 - s)): where s (1 - s) <
-/// 0.02, a reading error of 1% of the travel moves the modulus by more than half. Below it
-/// the object is far softer than the gel and the press cannot say by how much. (At the
-/// stiff end the same loss is a rigid object's bound, which the estimate already says.)
-const MIN_GEL_SHARE: f64 = 0.0205;
-
 /// A fit whose residual is more than this share of the last frame's depth does not describe
 /// the press: the depths do not grow with the travel as two elastic bodies' do.
 const MAX_FIT_RESIDUAL_SHARE: f64 = 0.25;
@@ -175,15 +168,7 @@ fn check_competence(
             fit.residual_rms_mm
         ));
     }
-    if share < MIN_GEL_SHARE {
-        return outside(format!(
-            "the gel took {:.1}% of the travel: the object is too soft against the gel to \
-             resolve (below {:.1}%)",
-            100.0 * share,
-            100.0 * MIN_GEL_SHARE
-        ));
-    }
-    Ok(())
+    check_gel_share(share)
 }
 
 #[cfg(test)]
