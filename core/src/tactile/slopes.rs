@@ -102,6 +102,7 @@ pub fn recover_slopes(
                 None => field.valid[i] = false,
             }
         }
+        fill_slope_holes(&mut field, spec);
         return Some(field);
     };
     let observed: Vec<[f32; 3]> = frame
@@ -115,7 +116,10 @@ pub fn recover_slopes(
         .collect();
     match &spec.glow {
         Some(glow) => read_through_glow(table, glow, spec, observed, &mut field),
-        None => read_table(table, &observed, &mut field),
+        None => {
+            read_table(table, &observed, &mut field);
+            fill_slope_holes(&mut field, spec);
+        }
     }
     Some(field)
 }
@@ -136,8 +140,7 @@ fn read_through_glow(
     // The glow is read backwards over the whole frame, so the marker dots' holes are filled
     // from the shading round them (zeros there would read as flat gel inside a contact) and
     // read like the rest.
-    let hole_px = (spec.markers.radius_mm / spec.mm_per_px) as f32 + 2.0;
-    let observed = fill_holes(&observed, &mut field.valid, w, h, hole_px.max(1.0));
+    let observed = fill_holes(&observed, &mut field.valid, w, h, hole_px(spec));
     let inverse = GlowInverse::shared(glow, w, h);
     read_table(table, &inverse.solve(&observed), field);
     if !inverse.has_rest() {
@@ -187,6 +190,30 @@ fn without_drift(mut observed: Vec<[f32; 3]>, valid: &[bool], w: usize, h: usize
         }
     }
     observed
+}
+
+/// A marker dot's hole in the shading, as a blur's sigma (px): the dot's radius and the ring
+/// of 2 px left out around it.
+fn hole_px(spec: &TactileSpec) -> f32 {
+    ((spec.markers.radius_mm / spec.mm_per_px) as f32 + 2.0).max(1.0)
+}
+
+/// The slopes under the marker dots (and saturated pixels), read as if flat they pull a
+/// press's integrated depth short by the dots' share of the imprint (the stock Mini read a
+/// steel ball 12% shallow), filled from the slopes round them as the glow's reading fills the
+/// colour change.
+fn fill_slope_holes(field: &mut SlopeField, spec: &TactileSpec) {
+    let (w, h) = (field.width, field.height);
+    let slopes: Vec<[f32; 3]> = field
+        .gx
+        .iter()
+        .zip(&field.gy)
+        .map(|(&gx, &gy)| [gx, gy, 0.0])
+        .collect();
+    let filled = fill_holes(&slopes, &mut field.valid, w, h, hole_px(spec));
+    for ((gx, gy), f) in field.gx.iter_mut().zip(field.gy.iter_mut()).zip(filled) {
+        (*gx, *gy) = (f[0], f[1]);
+    }
 }
 
 /// Pixels that carry no shading filled by normalised convolution (a Gaussian of `sigma_px`
@@ -335,7 +362,10 @@ mod tests {
         dim.put_pixel(5, 5, Rgb([32, 28, 30]));
         let level = dark_level(&dim);
         assert!(!is_dark(dim.get_pixel(0, 0), level));
-        assert!(!is_dark(&Rgb([60, 55, 58]), level), "a shaded slope of the gel");
+        assert!(
+            !is_dark(&Rgb([60, 55, 58]), level),
+            "a shaded slope of the gel"
+        );
         assert!(is_dark(dim.get_pixel(5, 5), level));
         // A bright sensor keeps the fixed level: 70 grey levels a channel.
         let bright = RgbImage::from_pixel(20, 20, Rgb([170, 160, 150]));
