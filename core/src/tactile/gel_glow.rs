@@ -194,7 +194,7 @@ pub fn blur<const N: usize>(
     sigma_px: f32,
 ) -> Vec<[f32; N]> {
     let k = gaussian_kernel(sigma_px);
-    if k.len() == 1 {
+    if k.len() == 1 || src.is_empty() {
         return src.to_vec();
     }
     let r = k.len() / 2;
