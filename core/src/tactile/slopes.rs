@@ -204,49 +204,47 @@ fn hole_px(spec: &TactileSpec) -> f32 {
 /// colour change.
 fn fill_slope_holes(field: &mut SlopeField, spec: &TactileSpec) {
     let (w, h) = (field.width, field.height);
-    let slopes: Vec<[f32; 3]> = field
+    let slopes: Vec<[f32; 2]> = field
         .gx
         .iter()
         .zip(&field.gy)
-        .map(|(&gx, &gy)| [gx, gy, 0.0])
+        .map(|(&gx, &gy)| [gx, gy])
         .collect();
     let filled = fill_holes(&slopes, &mut field.valid, w, h, hole_px(spec));
-    for ((gx, gy), f) in field.gx.iter_mut().zip(field.gy.iter_mut()).zip(filled) {
-        (*gx, *gy) = (f[0], f[1]);
+    for ((gx, gy), [fx, fy]) in field.gx.iter_mut().zip(field.gy.iter_mut()).zip(filled) {
+        (*gx, *gy) = (fx, fy);
     }
 }
 
 /// Pixels that carry no shading filled by normalised convolution (a Gaussian of `sigma_px`
 /// over the valid pixels, divided by the same blur of the mask); they become valid where
 /// enough valid pixels lie near.
-fn fill_holes(
-    observed: &[[f32; 3]],
+fn fill_holes<const N: usize>(
+    values: &[[f32; N]],
     valid: &mut [bool],
     w: usize,
     h: usize,
     sigma_px: f32,
-) -> Vec<[f32; 3]> {
-    let weighted: Vec<[f32; 4]> = observed
+) -> Vec<[f32; N]> {
+    let kept: Vec<[f32; N]> = values
         .iter()
         .zip(valid.iter())
-        .map(|(o, ok)| match ok {
-            true => [o[0], o[1], o[2], 1.0],
-            false => [0.0; 4],
-        })
+        .map(|(v, ok)| if *ok { *v } else { [0.0; N] })
         .collect();
-    let spread = blur(&weighted, w, h, sigma_px);
-    observed
+    let mask: Vec<[f32; 1]> = valid.iter().map(|ok| [f32::from(u8::from(*ok))]).collect();
+    let (spread, weight) = (blur(&kept, w, h, sigma_px), blur(&mask, w, h, sigma_px));
+    values
         .iter()
         .zip(valid.iter_mut())
-        .zip(&spread)
-        .map(|((o, ok), b)| {
+        .zip(spread.iter().zip(&weight))
+        .map(|((v, ok), (b, [weight]))| {
             if *ok {
-                *o
-            } else if b[3] > 0.05 {
+                *v
+            } else if *weight > 0.05 {
                 *ok = true;
-                [b[0] / b[3], b[1] / b[3], b[2] / b[3]]
+                b.map(|c| c / weight)
             } else {
-                [0.0; 3]
+                [0.0; N]
             }
         })
         .collect()
