@@ -60,34 +60,48 @@ fn invert3(m: [f64; 9]) -> Option<[f64; 9]> {
     ])
 }
 
+/// The response at frequency index `k` of a length-n signal of a Gaussian of `sigma_px`.
+fn smoothing_response(sigma_px: f64, k: usize, n: usize) -> f64 {
+    let signed = if k <= n / 2 {
+        k as f64
+    } else {
+        k as f64 - n as f64
+    };
+    let omega = 2.0 * std::f64::consts::PI * signed / n as f64;
+    (-0.5 * sigma_px * sigma_px * omega * omega).exp()
+}
+
 /// The inverses made last: a press reads every frame through one glow at one size.
 static MADE: Mutex<Vec<Made>> = Mutex::new(Vec::new());
-/// An inverse with the glow and frame size (width, height) it was made for.
-type Made = (GelGlow, usize, usize, Arc<GlowInverse>);
+/// An inverse with the glow, frame size (width, height) and smoothing it was made for.
+type Made = (GelGlow, usize, usize, u32, Arc<GlowInverse>);
 const KEPT: usize = 4;
 
 impl GlowInverse {
-    /// The inverse for this glow and frame size, made once and shared.
-    pub fn shared(glow: &GelGlow, width: usize, height: usize) -> Arc<Self> {
+    /// The inverse for this glow, frame size and smoothing, made once and shared.
+    pub fn shared(glow: &GelGlow, width: usize, height: usize, smoothing_px: f64) -> Arc<Self> {
+        let key = (smoothing_px as f32).to_bits();
         let found = {
             let made = MADE.lock().unwrap_or_else(|e| e.into_inner());
             made.iter()
-                .find(|(g, w, h, _)| g == glow && *w == width && *h == height)
+                .find(|(g, w, h, k, _)| g == glow && *w == width && *h == height && *k == key)
                 .map(|(.., inverse)| inverse.clone())
         };
         if let Some(inverse) = found {
             return inverse;
         }
-        let inverse = Arc::new(Self::new(glow, width, height));
+        let inverse = Arc::new(Self::new(glow, width, height, smoothing_px));
         let mut made = MADE.lock().unwrap_or_else(|e| e.into_inner());
         if made.len() >= KEPT {
             made.remove(0);
         }
-        made.push((glow.clone(), width, height, inverse.clone()));
+        made.push((glow.clone(), width, height, key, inverse.clone()));
         inverse
     }
 
-    pub fn new(glow: &GelGlow, width: usize, height: usize) -> Self {
+    /// The inverse followed by a Gaussian of `smoothing_px` (free here, as a product per
+    /// frequency), so that the camera's noise is not read backwards into slope.
+    pub fn new(glow: &GelGlow, width: usize, height: usize, smoothing_px: f64) -> Self {
         let (n, m) = (2 * width, 2 * height);
         let colour: Vec<_> = glow
             .terms()
@@ -131,6 +145,9 @@ impl GlowInverse {
                         b[3 * i + c] = (0..3).map(|j| inv[3 * i + j] * a[3 * c + j]).sum();
                     }
                 }
+                let smooth =
+                    smoothing_response(smoothing_px, u, n) * smoothing_response(smoothing_px, v, m);
+                b.iter_mut().for_each(|x| *x *= smooth);
                 inverse.push(b);
             }
         }
@@ -228,7 +245,7 @@ mod tests {
             })
             .collect();
         let glowing = glow.apply(&change, &vec![0.0; w * h], w, h);
-        let back = GlowInverse::new(&glow, w, h).solve(&glowing);
+        let back = GlowInverse::new(&glow, w, h, 0.0).solve(&glowing);
         let worst = change
             .iter()
             .zip(&back)

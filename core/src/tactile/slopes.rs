@@ -124,10 +124,10 @@ pub fn recover_slopes(
     Some(field)
 }
 
-/// A frame's change read through a table and its glow: the drift removed, the marker dots'
-/// holes filled, the glow's linear part inverted and the table read backwards; then the
-/// glow's indentation and magnitude terms from that first reading subtracted and the change
-/// read again.
+/// A frame's change read through a table and its glow: the marker dots' holes filled, the
+/// drift removed, the glow's linear part inverted and the table read backwards; then the
+/// drift measured again away from that first reading's imprint, the glow's indentation and
+/// magnitude terms from it subtracted and the change read again.
 fn read_through_glow(
     table: &ShadingTable,
     glow: &GelGlow,
@@ -136,20 +136,35 @@ fn read_through_glow(
     field: &mut SlopeField,
 ) {
     let (w, h) = (field.width, field.height);
-    let observed = without_drift(observed, &field.valid, w, h);
+    let band = outer_band(&field.valid, w, h);
     // The glow is read backwards over the whole frame, so the marker dots' holes are filled
     // from the shading round them (zeros there would read as flat gel inside a contact) and
     // read like the rest.
     let observed = fill_holes(&observed, &mut field.valid, w, h, hole_px(spec));
-    let inverse = GlowInverse::shared(glow, w, h);
-    read_table(table, &inverse.solve(&observed), field);
-    if !inverse.has_rest() {
-        return;
-    }
+    let first = without_drift(&observed, &field.valid, drift(&observed, &band));
+    let sm: f64 = std::env::var("TACTEX_SM")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(NOISE_SMOOTHING_MM);
+    let inverse = GlowInverse::shared(glow, w, h, sm / spec.mm_per_px);
+    read_table(table, &inverse.solve(&first), field);
     let depth: Vec<f32> = integrate_slopes(field, spec.mm_per_px)
         .into_iter()
         .map(|d| d as f32)
         .collect();
+    // A large press reaches the band (a fruit's contact spans most of the frame): its
+    // shading there is not drift, and taken for it the whole imprint reads shallow.
+    let peak = depth.iter().copied().fold(0.0f32, f32::max);
+    let untouched: Vec<usize> = band
+        .iter()
+        .copied()
+        .filter(|i| depth[*i] < UNTOUCHED_SHARE * peak)
+        .collect();
+    let observed = without_drift(&observed, &field.valid, drift(&observed, &untouched));
+    if !inverse.has_rest() {
+        read_table(table, &inverse.solve(&observed), field);
+        return;
+    }
     let modelled: Vec<[f32; 3]> = (0..w * h)
         .map(|i| {
             let (u, v) = frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
@@ -165,31 +180,51 @@ fn read_through_glow(
     read_table(table, &inverse.solve(&linear), field);
 }
 
-/// Real frames drift in colour from shot to shot far from any contact (FOTS: up to 30 grey
-/// levels in blue), which the table would read as a tilt of the whole gel: the change's
-/// median over the frame's outer band is taken as that drift and removed.
-fn without_drift(mut observed: Vec<[f32; 3]>, valid: &[bool], w: usize, h: usize) -> Vec<[f32; 3]> {
+/// The camera's noise read backwards through a table is not zero-mean in slope where the
+/// table is nearly flat: the R1.5 profile read a noise-only frame as a 0.1 mm imprint at the
+/// frame's edge. A Gaussian of this sigma (mm on the gel) over the change first takes most of
+/// the noise and leaves a contact's shading, millimetres wide, as it is.
+const NOISE_SMOOTHING_MM: f64 = 0.06;
+
+/// Where a first reading's indentation is below this share of its peak, the gel counts as
+/// untouched for measuring the drift.
+const UNTOUCHED_SHARE: f32 = 0.1;
+
+/// The valid pixels of the frame's outer band (a sixteenth of its shorter side).
+fn outer_band(valid: &[bool], w: usize, h: usize) -> Vec<usize> {
     let band = (w.min(h) / 16).max(2);
-    let edge: Vec<usize> = (0..w * h)
+    (0..w * h)
         .filter(|i| {
             let (x, y) = (i % w, i / w);
             valid[*i] && (x < band || y < band || x + band >= w || y + band >= h)
         })
-        .collect();
-    if edge.len() < 16 {
-        return observed;
+        .collect()
+}
+
+/// Real frames drift in colour from shot to shot far from any contact (FOTS: up to 30 grey
+/// levels in blue), which the table would read as a tilt of the whole gel: the change's
+/// median over untouched gel is taken as that drift; none where too little gel is untouched.
+fn drift(observed: &[[f32; 3]], untouched: &[usize]) -> [f32; 3] {
+    if untouched.len() < 16 {
+        return [0.0; 3];
     }
-    let drift: [f32; 3] = std::array::from_fn(|c| {
-        let mut v: Vec<f32> = edge.iter().map(|i| observed[*i][c]).collect();
+    std::array::from_fn(|c| {
+        let mut v: Vec<f32> = untouched.iter().map(|i| observed[*i][c]).collect();
         let k = v.len() / 2;
         *v.select_nth_unstable_by(k, f32::total_cmp).1
-    });
-    for (o, ok) in observed.iter_mut().zip(valid) {
-        if *ok {
-            *o = std::array::from_fn(|c| o[c] - drift[c]);
-        }
-    }
+    })
+}
+
+/// The drift taken from the pixels that carry shading; those that carry none stay zero.
+fn without_drift(observed: &[[f32; 3]], valid: &[bool], drift: [f32; 3]) -> Vec<[f32; 3]> {
     observed
+        .iter()
+        .zip(valid)
+        .map(|(o, ok)| match ok {
+            true => std::array::from_fn(|c| o[c] - drift[c]),
+            false => *o,
+        })
+        .collect()
 }
 
 /// A marker dot's hole in the shading, as a blur's sigma (px): the dot's radius and the ring
