@@ -22,7 +22,7 @@ pub mod tactile_samples;
 pub mod twin;
 pub mod twin_options;
 
-pub use image_input::load_rgb;
+pub use image_input::{load_rgb, load_tactile_frame};
 pub use scene::{default_scene, load_scene, scene_renderer};
 pub use sensor::{load_sensor, with_gel_modulus};
 pub use twin::{Twin, TwinAnswer};

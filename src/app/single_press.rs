@@ -12,8 +12,8 @@ use tactex_core::hertz::Elastic;
 use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_sim::contact::{
-    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, MAX_CELLS,
-    ObjectSurface, Rect, mesh_top,
+    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
+    field_pooling, mesh_top,
 };
 use tactex_sim::datagen::press_protocol::{PlannedPress, PressSetup, plan_press};
 use tactex_sim::render::gel::{
@@ -185,14 +185,17 @@ impl PressRequest {
         let mut solver = ContactSolver::new();
         solver.settings.tolerance = self.tolerance;
         let solution = solver.solve(&problem, self.fidelity)?;
-        // The gel's fields are rendered over the whole pad at the solver's cell: a contact
-        // far smaller than a pixel would ask for billions of cells (a 0.01 mm sphere: 7.8 GB).
-        let across = pad.size().max_element() / solution.grid.cell_mm;
-        if across > MAX_CELLS as f64 {
-            bail!(
-                "the object is too small to press: its {:.5} mm solver cells would need {across:.0} across the pad (at most {MAX_CELLS}); press a larger one (--radius-mm, --size-mm, --mesh-scale) or give --grid-mm",
+        // The gel's fields are drawn over the pad at the solver's cell; a contact far smaller
+        // than a pixel would need billions of them, so they are pooled into coarser cells
+        // (the solve's force and contact are its own), and the report says so.
+        let mut warnings = solution.warnings.clone();
+        let pool = field_pooling(solution.grid.cell_mm, &pad);
+        if pool > 1 {
+            warnings.push(format!(
+                "the contact is finer than the frame can show: the gel's fields are drawn at {:.4} mm cells, {pool} x {pool} of the solver's {:.5} mm (force and contact are the solver's)",
+                solution.grid.cell_mm * pool as f64,
                 solution.grid.cell_mm
-            );
+            ));
         }
         let shown = HardnessReport::from(self.hardness);
         let report = PressReport {
@@ -218,7 +221,7 @@ impl PressRequest {
             grid: (&solution.grid).into(),
             iterations: solution.iterations,
             residual: solution.residual,
-            warnings: solution.warnings.clone(),
+            warnings,
         };
         Ok(SolvedPress {
             report,
@@ -305,15 +308,32 @@ impl SolvedPress {
     }
 }
 
-/// A marker grid given as COLSxROWS ("9x7"), checked: 1 to 10000 markers.
+/// A marker grid given as COLSxROWS ("9x7"), checked: 1 to 10000 markers, or 0x0 for a gel
+/// without markers (as a profile calibrated from an unmarked gel has).
 pub fn parse_marker_grid(text: &str) -> Result<(u32, u32)> {
     let (cols, rows) = text
         .split_once(['x', 'X'])
         .and_then(|(c, r)| Some((c.trim().parse::<u32>().ok()?, r.trim().parse::<u32>().ok()?)))
         .with_context(|| format!("'{text}' is not COLSxROWS (e.g. 9x7, 11x9)"))?;
     let markers = u64::from(cols) * u64::from(rows);
-    if markers == 0 || markers > 10_000 {
-        bail!("{cols}x{rows} is {markers} markers; a gel has 1 to 10000 (e.g. 9x7, 11x9)");
+    if (cols, rows) != (0, 0) && (markers == 0 || markers > 10_000) {
+        bail!(
+            "{cols}x{rows} is {markers} markers; a gel has 1 to 10000 (e.g. 9x7, 11x9), or 0x0 for none"
+        );
     }
     Ok((cols, rows))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_marker_grid;
+
+    #[test]
+    fn a_marker_grid_of_0x0_is_a_gel_without_markers_and_a_half_empty_one_is_refused() {
+        assert_eq!(parse_marker_grid("0x0").unwrap(), (0, 0));
+        assert_eq!(parse_marker_grid("11X9").unwrap(), (11, 9));
+        for bad in ["0x7", "9x0", "1000x1000", "9by7"] {
+            assert!(parse_marker_grid(bad).is_err(), "{bad}");
+        }
+    }
 }

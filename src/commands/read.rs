@@ -2,7 +2,7 @@
 //! sensor's optics: the gel's indentation map, the imprint's peak depth and the contact's
 //! size, as the indentation estimator reads every frame of a press; `--out` draws it.
 
-use crate::app::{load_rgb, load_sensor};
+use crate::app::{load_sensor, load_tactile_frame};
 use crate::report::indentation_view::indentation_view;
 use crate::report::output::write_png_atomic;
 use anyhow::{Context, Result, bail};
@@ -58,11 +58,14 @@ pub struct ReadReport {
 
 /// Reads the frame as the estimators do.
 pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImage)> {
+    if let Some(out) = &args.out {
+        crate::report::output::check_png_path(out).context("--out")?;
+    }
     let profile = load_sensor(args.sensor.as_deref())?;
-    let image = load_rgb(&args.image)?;
+    let image = load_tactile_frame(&args.image)?;
     let (reference, reference_name) = match (&args.reference, &profile.background) {
         (Some(path), _) => (
-            load_rgb(path).context("--reference")?,
+            load_tactile_frame(path).context("--reference")?,
             Some(path.display().to_string()),
         ),
         (None, Some(bg)) => (bg.clone(), None),

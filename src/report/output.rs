@@ -60,7 +60,20 @@ pub fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>> {
 
 /// An 8-bit RGB PNG.
 pub fn write_png_atomic(path: &Path, image: &image::RgbImage) -> Result<()> {
+    check_png_path(path)?;
     write_bytes_atomic(path, &png_bytes(image)?)
+}
+
+/// A PNG goes only to a file named .png: `--out view.jpg` would hold PNG bytes under a name
+/// that says otherwise.
+pub fn check_png_path(path: &Path) -> Result<()> {
+    let png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !png {
+        bail!("{}: writes a PNG image; name the file .png", path.display());
+    }
+    Ok(())
 }
 
 /// A sensor profile: its background PNG beside it first, then the TOML, so that a profile
@@ -75,10 +88,19 @@ pub fn write_profile_atomic(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
+    // A profile path that cannot take the file must fail before its background is written.
+    if path.is_dir() {
+        bail!("{}: is a directory, not a profile file", path.display());
+    }
     if let Some(img) = &profile.background {
         write_png_atomic(&bg, img)?;
     }
-    write_bytes_atomic(path, profile.to_toml(&bg_name).as_bytes())
+    let written = write_bytes_atomic(path, profile.to_toml(&bg_name).as_bytes());
+    if written.is_err() && profile.background.is_some() {
+        // Not half a profile: a background without its TOML is no profile at all.
+        let _ = std::fs::remove_file(&bg);
+    }
+    written
 }
 
 /// A directory of outputs written whole or not at all: files go into `DIR.partial`, claimed

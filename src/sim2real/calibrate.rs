@@ -61,11 +61,11 @@ pub struct CalibrateArgs {
     /// Which presses to fit: calib (all but every third), eval, or all.
     #[arg(long, value_enum, default_value_t = Split::Calib)]
     pub split: Split,
-    /// Table nodes over slope magnitude; 2 to 100.
+    /// Table nodes over slope magnitude; 2 to 100, and at most 1536 nodes with --dir-bins.
     #[arg(long, value_parser = crate::app::flag_range::count::<u32>(2, 100), default_value_t = 12)]
     pub mag_bins: u32,
-    /// Table nodes over slope direction; 4 to 360.
-    #[arg(long, value_parser = crate::app::flag_range::count::<u32>(4, 360), default_value_t = 24)]
+    /// Table nodes over slope direction; 4 to 256, and at most 1536 nodes with --mag-bins.
+    #[arg(long, value_parser = crate::app::flag_range::count::<u32>(4, 256), default_value_t = 24)]
     pub dir_bins: u32,
     /// Largest slope (dw/dr) the table covers (above 0 up to 100).
     #[arg(long, default_value_t = 2.5, value_parser = above(0.0, 100.0))]
@@ -215,8 +215,26 @@ fn read_markers(
 }
 
 /// Fits the profile the flags describe and writes it to `--out`.
+/// The most table nodes (--mag-bins x --dir-bins) a fit may have: its normal equations are
+/// dense, so its time grows with the cube of the nodes (48 x 24 took 10 s, 96 x 24 72 s).
+pub const MAX_TABLE_NODES: u32 = 1536;
+
 pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
     let (radius, scale) = (args.ball_radius_mm, args.mm_per_px);
+    let nodes = args.mag_bins * args.dir_bins;
+    if nodes > MAX_TABLE_NODES {
+        bail!(
+            "--mag-bins {} x --dir-bins {} is {nodes} table nodes; at most {MAX_TABLE_NODES} (the fit's time grows with the cube of the nodes)",
+            args.mag_bins,
+            args.dir_bins
+        );
+    }
+    if args.out.is_dir() {
+        bail!(
+            "--out {}: is a directory, not a profile file",
+            args.out.display()
+        );
+    }
     let background = crate::app::load_rgb(&args.background)?;
     // Before the fit: a marker frame that cannot be read fails first.
     let markers = match &args.markers {
@@ -353,7 +371,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
     profile
         .validate()
         .map_err(|(field, message)| anyhow::anyhow!("the fitted profile: {field}: {message}"))?;
-    write_profile_atomic(&args.out, &profile)?;
+    write_profile_atomic(&args.out, &profile).context("--out")?;
     Ok(Calibration {
         profile: args.out.clone(),
         sensor: profile.id(),

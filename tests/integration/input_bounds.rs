@@ -194,27 +194,40 @@ fn ball_presses_too_small_or_too_large_for_the_frame_are_refused() {
 }
 
 #[test]
-fn an_object_too_small_for_the_pad_is_refused_not_rendered_out_of_memory() {
-    // A 0.01 mm sphere's solver cells are 0.5 um: rendered over the pad they asked for 7.8 GB.
+fn an_object_far_smaller_than_a_pixel_is_pressed_with_its_fields_pooled_not_out_of_memory() {
+    // A 0.01 mm sphere's solver cells are 0.5 um: rendered over the pad at that cell they
+    // asked for 7.8 GB; a shallow press of a large sphere (8 mm, 1 um in) was refused as "too
+    // small to press". Both are pressed, the pooling said in a warning.
     let dir = tempfile::tempdir().unwrap();
-    let out_dir = dir.path().join("speck");
-    let out = tactex(&[
-        "press",
-        "--shape",
-        "sphere",
-        "--radius-mm",
-        "0.01",
-        "--hardness",
-        "40A",
-        "--depth-mm",
-        "0.6",
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
-    let err = one_line_error(&out);
-    assert!(
-        err.contains("too small") && err.contains("--radius-mm"),
-        "{err}"
-    );
-    assert!(!out_dir.exists());
+    for (radius, depth) in [("0.01", "0.6"), ("8", "0.001")] {
+        let out_dir = dir.path().join(format!("r{radius}"));
+        let out = tactex(&[
+            "press",
+            "--shape",
+            "sphere",
+            "--radius-mm",
+            radius,
+            "--hardness",
+            "40A",
+            "--depth-mm",
+            depth,
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert!(report["force_n"].as_f64().unwrap() > 0.0, "{report}");
+        let warned = report["warnings"].as_array().unwrap().iter().any(|w| {
+            w.as_str()
+                .unwrap()
+                .contains("finer than the frame can show")
+        });
+        assert!(warned, "{report}");
+        assert!(out_dir.join("tactile.png").exists());
+    }
 }

@@ -324,30 +324,50 @@ fn calibrate_rejects_bad_input_in_one_line_and_writes_nothing() {
     )
     .unwrap();
     let good_csv = f.join("ball-presses/annotations.csv");
-    for (annotations, radius, expect) in [
-        (&good_csv, "-1", "--ball-radius-mm"),
-        (&bad_csv, "2.35", "bad.csv:2"),
+    let out_dir = dir.path().join("d");
+    std::fs::create_dir(&out_dir).unwrap();
+    let background_of_dir = dir.path().join("d.background.png");
+    let (images, background) = (f.join("ball-presses"), f.join("background.png"));
+    for (annotations, radius, extra, expect) in [
+        (&good_csv, "-1", vec![], "--ball-radius-mm"),
+        (&bad_csv, "2.35", vec![], "bad.csv:2"),
+        // Table sizes whose fit would run for minutes (it grows with the cube of the nodes).
+        (
+            &good_csv,
+            "2.35",
+            vec!["--mag-bins", "100"],
+            "--mag-bins 100 x --dir-bins 24",
+        ),
+        (&good_csv, "2.35", vec!["--dir-bins", "300"], "--dir-bins"),
+        (&good_csv, "2.35", vec![], "is a directory"),
     ] {
-        let run = tactex(&[
+        let target = match expect {
+            "is a directory" => &out_dir,
+            _ => &out,
+        };
+        let mut argv = vec![
             "calibrate",
             "--images",
-            f.join("ball-presses").to_str().unwrap(),
+            images.to_str().unwrap(),
             "--annotations",
             annotations.to_str().unwrap(),
             "--background",
-            f.join("background.png").to_str().unwrap(),
+            background.to_str().unwrap(),
             "--ball-radius-mm",
             radius,
             "--mm-per-px",
             MM_PER_PX,
             "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_eq!(run.status.code(), Some(1));
+            target.to_str().unwrap(),
+        ];
+        argv.extend(extra);
+        let run = tactex(&argv);
+        assert!(!run.status.success());
         let err = String::from_utf8_lossy(&run.stderr);
         assert_eq!(err.trim().lines().count(), 1, "{err}");
         assert!(err.contains(expect), "{err}");
         assert!(!out.exists());
+        assert!(!background_of_dir.exists(), "{err}");
     }
 }
 
@@ -422,6 +442,52 @@ fn the_stock_mini_reads_a_steel_balls_depth_within_five_percent() {
     assert!((depth - 0.6).abs() < 0.05 * 0.6, "{report}");
 }
 
+/// A rigid sphere pressed through the fixture profile, and the `read` report of its frame.
+fn press_and_read_through_fots_9(radius_mm: &str, depth_mm: &str) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let press = dir.path().join("press");
+    let profile = fixtures().join("profile/fots-9.toml");
+    let profile = profile.to_str().unwrap();
+    let made = tactex(&[
+        "press",
+        "--shape",
+        "sphere",
+        "--radius-mm",
+        radius_mm,
+        "--hardness",
+        "rigid",
+        "--depth-mm",
+        depth_mm,
+        "--sensor",
+        profile,
+        "--out",
+        press.to_str().unwrap(),
+    ]);
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    json(&tactex(&[
+        "read",
+        press.join("tactile.png").to_str().unwrap(),
+        "--reference",
+        press.join("reference.png").to_str().unwrap(),
+        "--sensor",
+        profile,
+        "--json",
+    ]))
+}
+
+/// The camera's noise alone, read backwards through a profile's table and glow, was read as
+/// a broad imprint (fots-9: 0.05 mm deep, 6.7 mm wide; the R1.5 profile: 0.1 mm), a floor
+/// under every shallow press; the reading smooths the change by 0.06 mm first.
+#[test]
+fn a_frame_of_camera_noise_alone_reads_no_imprint_through_a_profile() {
+    let report = press_and_read_through_fots_9("20", "0.001");
+    assert!(report["peak_depth_mm"].as_f64().unwrap() < 0.02, "{report}");
+}
+
 #[test]
 fn read_draws_the_indentation_map_and_refuses_a_frame_of_another_size() {
     let f = fixtures();
@@ -489,4 +555,55 @@ fn read_draws_the_indentation_map_and_refuses_a_frame_of_another_size() {
     );
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(!out_png.exists());
+}
+
+/// Frames `read` cannot read are refused in one line naming the file or flag, and nothing is
+/// written: a greyscale frame (the shading is read from three channels), a blown-out
+/// reference, and a picture asked for under another format's name.
+#[test]
+fn read_refuses_a_greyscale_frame_a_blown_out_reference_and_a_jpg_name() {
+    let f = fixtures();
+    let dir = tempfile::tempdir().unwrap();
+    let profile = f.join("profile/fots-9.toml");
+    let frame = f.join("profile/fots-9.background.png");
+    let grey = dir.path().join("grey.png");
+    image::imageops::grayscale(&rgb(&frame))
+        .save(&grey)
+        .unwrap();
+    let white = dir.path().join("white.png");
+    let (w, h) = rgb(&frame).dimensions();
+    RgbImage::from_pixel(w, h, image::Rgb([255, 255, 255]))
+        .save(&white)
+        .unwrap();
+    let out_png = dir.path().join("view.png");
+    let out_jpg = dir.path().join("view.jpg");
+    let frame = frame.to_str().unwrap();
+    for (argv, expect, out) in [
+        (
+            vec![grey.to_str().unwrap()],
+            "grey.png: a greyscale image",
+            &out_png,
+        ),
+        (
+            vec![frame, "--reference", white.to_str().unwrap()],
+            "--reference",
+            &out_png,
+        ),
+        (vec![frame], "--out", &out_jpg),
+    ] {
+        let mut full = vec!["read"];
+        full.extend(argv);
+        full.extend([
+            "--sensor",
+            profile.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let run = tactex(&full);
+        assert!(!run.status.success());
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(expect), "{err}");
+        assert!(!out.exists(), "{err}");
+    }
 }

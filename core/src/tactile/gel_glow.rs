@@ -37,6 +37,7 @@ pub struct ColourGlow {
     /// Blur (pixels, 1 sigma; 0: none).
     pub sigma_px: f32,
     /// Output channel c gains `mix[c][k]` times the blurred source's channel k.
+    #[serde(deserialize_with = "crate::serde_exact::matrix")]
     pub mix: [[f32; 3]; 3],
 }
 
@@ -46,6 +47,7 @@ pub struct ColourGlow {
 pub struct ScalarGlow {
     pub sigma_px: f32,
     /// Grey levels added per channel per unit of the blurred source.
+    #[serde(deserialize_with = "crate::serde_exact::array")]
     pub colour: [f32; 3],
 }
 

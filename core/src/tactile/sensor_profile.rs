@@ -18,6 +18,12 @@ use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 pub const PROFILE_FORMAT: &str = "tactex-sensor-profile/1";
+/// A profile's name is shown in every report: one short line.
+pub const MAX_NAME_CHARS: usize = 100;
+/// Its `source` note, free text of a few paragraphs at most.
+pub const MAX_SOURCE_CHARS: usize = 10_000;
+/// The finest pixel a profile may have: a micrometre on the gel (GelSight sensors: 0.02-0.1 mm).
+pub const MIN_MM_PER_PX: f64 = 0.001;
 
 /// How gel surface slopes become colour.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,6 +42,7 @@ pub struct CalibrationFit {
     pub images: Vec<String>,
     pub samples: usize,
     /// Root mean square residual of the fit per channel (grey levels).
+    #[serde(deserialize_with = "crate::serde_exact::array")]
     pub rms_grey: [f64; 3],
     pub ball_radius_mm: f64,
 }
@@ -158,6 +165,7 @@ struct OpticsSection {
 struct LightsSection {
     /// Unit directions from the surface towards the red, green and blue light (x along the
     /// frame's columns, y along its rows, z towards the camera).
+    #[serde(deserialize_with = "crate::serde_exact::matrix")]
     directions: [[f64; 3]; 3],
     ambient: f64,
     gain: f64,
@@ -317,6 +325,31 @@ impl SensorProfile {
         if self.name().trim().is_empty() {
             return bad("name", "must not be empty".into());
         }
+        // Both are printed in every report and answer: a line of plain text, and a note.
+        let name = self.name();
+        if name.chars().count() > MAX_NAME_CHARS || name.chars().any(char::is_control) {
+            return bad(
+                "name",
+                format!(
+                    "'{}', expected one line of at most {MAX_NAME_CHARS} characters without control characters",
+                    crate::printable::printable(&name.chars().take(40).collect::<String>())
+                ),
+            );
+        }
+        if self.source.chars().count() > MAX_SOURCE_CHARS
+            || self
+                .source
+                .chars()
+                .any(|c| c.is_control() && c != '\n' && c != '\t')
+        {
+            return bad(
+                "source",
+                format!(
+                    "{} characters, expected at most {MAX_SOURCE_CHARS} of text without control characters",
+                    self.source.chars().count()
+                ),
+            );
+        }
         let s = &self.spec;
         for (field, v) in [
             ("camera.width_px", s.width_px),
@@ -326,10 +359,13 @@ impl SensorProfile {
                 return bad(field, format!("{v} px, expected 8..=4096"));
             }
         }
-        if !(positive(s.mm_per_px) && s.mm_per_px <= 1.0) {
+        if !(s.mm_per_px.is_finite() && (MIN_MM_PER_PX..=1.0).contains(&s.mm_per_px)) {
             return bad(
                 "camera.mm_per_px",
-                format!("{}, expected a scale in (0, 1] mm per pixel", s.mm_per_px),
+                format!(
+                    "{}, expected a scale in [{MIN_MM_PER_PX}, 1] mm per pixel",
+                    crate::printable::short_number(s.mm_per_px)
+                ),
             );
         }
         if !(positive(s.frame_rate_hz) && s.frame_rate_hz <= 10_000.0) {
@@ -348,6 +384,15 @@ impl SensorProfile {
             return bad(
                 "camera.vignette",
                 format!("{}, expected 0..=1", self.vignette),
+            );
+        }
+        if self.background.is_some() && self.vignette != 0.0 {
+            return bad(
+                "camera.vignette",
+                format!(
+                    "{}, but the background is a real frame, which holds its own vignetting: expected 0",
+                    self.vignette
+                ),
             );
         }
         if !(self.exposure.is_finite() && self.exposure > 0.0 && self.exposure <= 4.0) {
@@ -591,6 +636,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let mut p = SensorProfile::gelsight_mini();
         p.spec.model = "bench sensor".into();
+        // A real background holds the sensor's vignetting already.
+        p.vignette = 0.0;
         p.spec.table = Some(ShadingTable {
             mag_bins: 2,
             dir_bins: 3,
@@ -626,6 +673,11 @@ mod tests {
         assert_eq!(back, p);
         assert_eq!(back.id(), p.id());
         assert_ne!(back.id(), SensorProfile::gelsight_mini().id());
+        // Vignetting laid over a real background again is refused.
+        p.vignette = 1.0;
+        std::fs::write(&path, p.to_toml("bench.background.png")).unwrap();
+        let e = SensorProfile::load(&path).unwrap_err();
+        assert_eq!(e.field, "camera.vignette", "{e}");
     }
 
     #[test]
@@ -699,6 +751,38 @@ mod tests {
         assert_eq!(e.field, "optics.glow.magnitude[0].sigma_px", "{e}");
         let e = parse("format = 3").unwrap_err();
         assert_eq!(e.field, "toml");
+        // Text that reaches every report: one short printable line of a name, a bounded note.
+        for (to, field) in [
+            ("name = \"Mini\\u001b[31m\"", "name"),
+            (
+                &*format!("name = \"{}\"", "x".repeat(MAX_NAME_CHARS + 1)),
+                "name",
+            ),
+            (
+                &*format!(
+                    "name = \"m\"\nsource = \"{}\"",
+                    "x".repeat(MAX_SOURCE_CHARS + 1)
+                ),
+                "source",
+            ),
+        ] {
+            let text = stock.replacen("name = \"GelSight Mini\"\nsource = \"\"", to, 1);
+            assert_ne!(text, stock);
+            let e = parse(&text).unwrap_err();
+            assert_eq!(e.field, field, "{e}");
+            assert!(
+                e.to_string().len() < 400 && !e.to_string().contains('\u{1b}'),
+                "{e}"
+            );
+        }
+        // A scale no sensor has (1e-9 mm a pixel).
+        let e = parse(&stock.replacen("mm_per_px = 0.0634", "mm_per_px = 1e-9", 1)).unwrap_err();
+        assert_eq!(e.field, "camera.mm_per_px", "{e}");
+        // Extra elements in a fixed-size list are refused, not dropped.
+        let lights = stock.lines().find(|l| l.starts_with("directions")).unwrap();
+        let longer = lights.replacen("]]", "], [0.0, 0.0, 1.0]]", 1);
+        let e = parse(&stock.replacen(lights, &longer, 1)).unwrap_err();
+        assert!(e.message.contains("exactly"), "{e}");
         let e = parse(&stock.replacen("[gel]", "[gel]\nshore = 3", 1)).unwrap_err();
         assert!(e.message.contains("shore"), "{e}");
     }

@@ -39,5 +39,7 @@ pub use grid::{Grid, Rect};
 pub use problem::{ContactError, ContactProblem};
 pub use rigid::RIGID_SMOOTHING_MM;
 pub use solution::{ContactSolution, GelFields};
-pub use solver::{ContactSolver, DEFAULT_CELLS_ACROSS, DEFAULT_MAX_CELLS, MAX_CELLS};
+pub use solver::{
+    ContactSolver, DEFAULT_CELLS_ACROSS, DEFAULT_MAX_CELLS, MAX_CELLS, field_pooling,
+};
 pub use surface::{ObjectSurface, mesh_top};

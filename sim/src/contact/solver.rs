@@ -235,19 +235,40 @@ impl ContactSolver {
     }
 
     /// The gel's displacement over `region` at the solution's cell size: beyond the solver
-    /// grid the gel still moves (the layer's bulge, the markers around the contact).
+    /// grid the gel still moves (the layer's bulge, the markers around the contact). A tiny
+    /// contact's cell over a whole pad would need billions of cells (a 1 um sphere: 780 GB),
+    /// so past `MAX_CELLS` a side the fields are made at a whole multiple of the cell, the
+    /// pressure pooled into it (force kept); see `field_pooling`.
     pub fn fields_over(&mut self, solution: &ContactSolution, region: &Rect) -> GelFields {
         let rect = Rect {
             min: region.min.min(solution.grid.rect().min),
             max: region.max.max(solution.grid.rect().max),
         };
-        let grid = Grid::covering(&rect, solution.grid.cell_mm);
+        let pool = field_pooling(solution.grid.cell_mm, &rect);
+        let grid = Grid::covering(&rect, solution.grid.cell_mm * pool as f64);
         let embed = |src: &[f64]| {
             let mut out = vec![0.0; grid.len()];
-            if let Some((oi, oj)) = solution.grid.offset_in(&grid) {
-                for j in 0..solution.grid.ny {
-                    for i in 0..solution.grid.nx {
-                        out[(j + oj) * grid.nx + i + oi] = src[j * solution.grid.nx + i];
+            if pool == 1 {
+                if let Some((oi, oj)) = solution.grid.offset_in(&grid) {
+                    for j in 0..solution.grid.ny {
+                        for i in 0..solution.grid.nx {
+                            out[(j + oj) * grid.nx + i + oi] = src[j * solution.grid.nx + i];
+                        }
+                    }
+                }
+                return out;
+            }
+            // Each fine cell lies wholly inside one coarse cell (both lattices run through
+            // the pad centre); the coarse cell holds the mean over its area.
+            let share = 1.0 / (pool * pool) as f64;
+            let coarse = |p: f64, origin: f64| ((p - origin) / grid.cell_mm + 0.5).floor();
+            for j in 0..solution.grid.ny {
+                for i in 0..solution.grid.nx {
+                    let c = solution.grid.centre(i, j);
+                    let (x, y) = (coarse(c.x, grid.origin_mm.x), coarse(c.y, grid.origin_mm.y));
+                    if x >= 0.0 && y >= 0.0 && (x as usize) < grid.nx && (y as usize) < grid.ny {
+                        out[y as usize * grid.nx + x as usize] +=
+                            share * src[j * solution.grid.nx + i];
                     }
                 }
             }
@@ -280,3 +301,18 @@ impl ContactSolver {
         }
     }
 }
+
+/// How many solver cells a side one cell of the gel's fields over `rect` pools: 1 unless the
+/// solver's cell would need more than `MAX_CELLS` a side, and then enough for at most
+/// `POOLED_CELLS` (a pad of 20 mm at 0.02 mm, finer than any sensor's pixels).
+pub fn field_pooling(cell_mm: f64, rect: &Rect) -> usize {
+    let across = rect.size().max_element() / cell_mm;
+    if across.is_finite() && across > MAX_CELLS as f64 {
+        (across / POOLED_CELLS as f64).ceil() as usize
+    } else {
+        1
+    }
+}
+
+/// Cells a side of pooled fields (see `field_pooling`).
+const POOLED_CELLS: usize = 1024;
