@@ -7,8 +7,13 @@ use super::slopes::SlopeField;
 use crate::spectral::fft2;
 use rustfft::num_complex::Complex;
 
+/// Sides of the border whose medians differ by more than this share of the imprint's depth
+/// are not level: the imprint presses one of them in.
+const UNLEVEL_SHARE: f64 = 0.6;
+
 /// Indentation (mm, into the gel) per pixel, row-major, zero where the gel is undisturbed
-/// (the median of the frame's border). Slopes of invalid pixels (markers) count as zero.
+/// (the median of the frame's border, or of its lowest side where the border is far from
+/// level). Slopes of invalid pixels (markers) count as zero.
 pub fn integrate_slopes(field: &SlopeField, mm_per_px: f64) -> Vec<f64> {
     let (w, h) = (field.width, field.height);
     let (w2, h2) = (2 * w, 2 * h);
@@ -62,7 +67,30 @@ pub fn integrate_slopes(field: &SlopeField, mm_per_px: f64) -> Vec<f64> {
         .chain((0..h).flat_map(|y| [depth[y * w], depth[y * w + w - 1]]))
         .collect();
     border.sort_by(f64::total_cmp);
-    let zero = border[border.len() / 2];
+    let mut zero = border[border.len() / 2];
+    // An imprint that runs off the frame along one side (a banana lying along the rows,
+    // pressed off its ridge) presses that side in, and the border's median with it: the
+    // imprint read 0.38 mm for 0.51. A border that is far from level is zeroed on its
+    // lowest side instead, the gel furthest from the contact.
+    let side_median = |mut v: Vec<f64>| {
+        let k = v.len() / 2;
+        *v.select_nth_unstable_by(k, f64::total_cmp).1
+    };
+    let sides = [
+        side_median((0..w).map(|x| depth[x]).collect()),
+        side_median((0..w).map(|x| depth[(h - 1) * w + x]).collect()),
+        side_median((0..h).map(|y| depth[y * w]).collect()),
+        side_median((0..h).map(|y| depth[y * w + w - 1]).collect()),
+    ];
+    let (lowest, highest) = sides
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(*s), hi.max(*s))
+        });
+    let peak = depth.iter().copied().fold(f64::NEG_INFINITY, f64::max) - zero;
+    if peak > 0.0 && highest - lowest > UNLEVEL_SHARE * peak {
+        zero = lowest;
+    }
     depth.iter_mut().for_each(|d| *d -= zero);
     depth
 }

@@ -142,11 +142,7 @@ fn read_through_glow(
     // read like the rest.
     let observed = fill_holes(&observed, &mut field.valid, w, h, hole_px(spec));
     let first = without_drift(&observed, &field.valid, drift(&observed, &band));
-    let sm: f64 = std::env::var("TACTEX_SM")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(NOISE_SMOOTHING_MM);
-    let inverse = GlowInverse::shared(glow, w, h, sm / spec.mm_per_px);
+    let inverse = GlowInverse::shared(glow, w, h, NOISE_SMOOTHING_MM / spec.mm_per_px);
     read_table(table, &inverse.solve(&first), field);
     let depth: Vec<f32> = integrate_slopes(field, spec.mm_per_px)
         .into_iter()
