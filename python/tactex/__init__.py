@@ -371,12 +371,13 @@ def generate(
     """
     shape_list = list(SHAPE_FAMILIES if shapes is None else shapes)
     profile = None if sensor is None else os.fspath(sensor)
-    indices = list(shard_indices(count, shard, start))
+    # A range, not a list: a data set of 10**9 samples is drawn without an index of them all.
+    indices = shard_indices(count, shard, start)
     step = batch if batch is not None else 4 * _tactex.threads()
     if step < 1:
         raise ValueError(f"batch: must be at least 1, got {step}")
     for k in range(0, len(indices), step):
-        chunk = indices[k : k + step]
+        chunk = list(indices[k : k + step])
         drawn = _tactex.generate_samples(fidelity, shape_list, profile, seed, chunk)
         for index, (labels, frames) in zip(chunk, drawn):
             yield Sample(index=index, frames=frames, labels=json.loads(labels))

@@ -81,6 +81,20 @@ impl SimWorld {
                     })?;
                     let (lo, hi) = m.bounds();
                     let centre = (lo + hi) / 2.0;
+                    // The same sizes as a scene's shapes may have, the mesh's units applied.
+                    let size_m = (hi - lo).max_element() * *scale;
+                    let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
+                    if !(size_m.is_finite() && (least..=most).contains(&size_m)) {
+                        return Err(WorldError::Object {
+                            scene: shown.clone(),
+                            index,
+                            message: format!(
+                                "the mesh is {} m across at scale {}: not a size an object on a table has ({least} to {most} m); set objects[{index}].scale to the mesh's unit in metres",
+                                tactex_core::printable::short_number(size_m),
+                                tactex_core::printable::short_number(*scale)
+                            ),
+                        });
+                    }
                     TriMesh {
                         vertices: m.vertices.iter().map(|v| (*v - centre) * *scale).collect(),
                         triangles: m.triangles,

@@ -7,14 +7,15 @@ use tactex_core::tactile::sensor_profile::SensorProfile;
 /// The profile at `path` (`--sensor`), or the built-in GelSight Mini.
 pub fn load_sensor(path: Option<&Path>) -> Result<SensorProfile> {
     match path {
-        Some(p) => {
-            super::file_input::present(p, "file: cannot read").context("--sensor")?;
-            SensorProfile::load(p)
-                .map_err(anyhow::Error::new)
-                .context("--sensor")
-        }
+        Some(p) => load_profile(p).context("--sensor"),
         None => Ok(SensorProfile::gelsight_mini()),
     }
+}
+
+/// A profile file named without a flag (`sensor check FILE`): its errors name the file alone.
+pub fn load_profile(path: &Path) -> Result<SensorProfile> {
+    super::file_input::present(path, "file: cannot read")?;
+    SensorProfile::load(path).map_err(anyhow::Error::new)
 }
 
 /// `sensor` with its gel's modulus replaced when one is given (`--gel-modulus-mpa`).

@@ -139,7 +139,10 @@ fn summary(p: &SensorProfile) -> Summary {
 }
 
 fn show(args: &ShowArgs) -> Result<()> {
-    let profile = crate::app::load_sensor(args.file.as_deref())?;
+    let profile = match &args.file {
+        Some(file) => crate::app::sensor::load_profile(file)?,
+        None => tactex_core::tactile::sensor_profile::SensorProfile::gelsight_mini(),
+    };
     if args.toml {
         let name = args
             .file
@@ -199,7 +202,7 @@ struct CheckReport {
 }
 
 fn check(args: &CheckArgs) -> Result<()> {
-    let profile = crate::app::load_sensor(Some(&args.file))?;
+    let profile = crate::app::sensor::load_profile(&args.file)?;
     let optics = SensorOptics::for_profile(&profile);
     let (w, h) = (optics.width, optics.height);
     let flat = GelImageFields::flat(w, h);

@@ -294,11 +294,14 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
         .map_err(|e| anyhow::anyhow!("--out {}: {e}", args.out.display()))?;
     let manifest_path = shard_manifest(&args.out, shard);
     let done = resume(&manifest_path)?;
-    let todo: Vec<u64> = (shard.0..args.count)
+    // Drawn chunk by chunk from the index range: 10^8 samples need no list of their indices.
+    let mut todo = (shard.0..args.count)
         .step_by(shard.1 as usize)
-        .filter(|i| !done.contains(i))
-        .collect();
-    let total = (shard.0..args.count).step_by(shard.1 as usize).count() as u64;
+        .filter(|i| !done.contains(i));
+    let total = args.count.saturating_sub(shard.0).div_ceil(shard.1);
+    let in_shard =
+        |i: &&u64| **i < args.count && **i >= shard.0 && (**i - shard.0).is_multiple_of(shard.1);
+    let new_samples = total - done.iter().filter(in_shard).count() as u64;
     let bar = ProgressBar::new(total).with_style(
         ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} samples, {per_sec}, eta {eta}")
             .expect("a valid template")
@@ -309,7 +312,7 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
     }
     bar.set_message(format!("shard {}/{}", shard.0, shard.1));
     let (mut redraws, mut search_steps) = (0u64, 0u64);
-    bar.set_position(total - todo.len() as u64);
+    bar.set_position(total - new_samples);
     let mut manifest = std::fs::OpenOptions::new()
         .create(true)
         .append(true)
@@ -317,7 +320,11 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
         .with_context(|| format!("{}: cannot open", manifest_path.display()))?;
     let chunk = 4 * rayon::current_num_threads().max(1);
     let render_here = renderer.is_none();
-    for indices in todo.chunks(chunk) {
+    loop {
+        let indices: Vec<u64> = todo.by_ref().take(chunk).collect();
+        if indices.is_empty() {
+            break;
+        }
         let mut samples: Vec<TactileSample> = indices
             .par_iter()
             .map_init(ContactSolver::new, |solver, &i| {
@@ -353,14 +360,14 @@ pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<Datage
             shard.0,
             shard.1,
             total,
-            todo.len(),
+            new_samples,
             manifest_path.display()
         );
     }
     Ok(DatagenSummary {
-        new: todo.len() as u64,
+        new: new_samples,
         redraws,
-        mean_search_steps: search_steps as f64 / todo.len().max(1) as f64,
+        mean_search_steps: search_steps as f64 / new_samples.max(1) as f64,
     })
 }
 

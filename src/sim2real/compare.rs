@@ -53,11 +53,11 @@ pub struct CompareArgs {
     /// With --session: the twin's gel modulus (MPa) instead of the stock 0.3.
     #[arg(long, conflicts_with_all = ["images", "annotations"])]
     pub gel_modulus_mpa: Option<f64>,
-    /// Which presses to score: eval (every third, held out of calibration), calib, or all.
     /// With --session: the hardness estimator that reads both presses (learned,
     /// indentation, hertz or FILE.onnx).
     #[arg(long, conflicts_with_all = ["images", "annotations"], default_value = crate::app::DEFAULT_ESTIMATOR)]
     pub estimator: crate::app::estimator_choice::EstimatorChoice,
+    /// Which presses to score: eval (every third, held out of calibration), calib, or all.
     #[arg(long, value_enum, default_value_t = Split::Eval)]
     pub split: Split,
     /// Contact model that rebuilds each press.

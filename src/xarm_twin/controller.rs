@@ -45,11 +45,16 @@ pub mod reg {
 pub mod mode {
     pub const POSITION: u8 = 0;
     pub const SERVO: u8 = 1;
+    /// The highest mode uFactory's manual lists (7, Cartesian online trajectory planning).
+    pub const LAST: u8 = 7;
 }
 
 /// A servo target further than this from the pad is not executed (uFactory's servo mode
 /// guide: steps of at most 10 mm).
 pub const SERVO_STEP_MAX_MM: f64 = 10.0;
+/// A move slower than this that would last longer than `SLOW_MOVE_S` is noted.
+const SLOW_SPEED_MM_S: f64 = 1.0;
+const SLOW_MOVE_S: f64 = 30.0;
 /// Servo targets run at the TCP's top speed.
 pub const SERVO_SPEED_MM_S: f64 = 1000.0;
 
@@ -360,8 +365,18 @@ impl Controller {
                 Answer::Params(vec![])
             }
             reg::SET_MODE => match params.len() {
-                1 | 2 => {
+                1 | 2 if params[0] <= mode::LAST => {
                     self.mode = params[0];
+                    Answer::Params(vec![])
+                }
+                1 | 2 => {
+                    self.warning = warn_code::PARAMETER;
+                    self.notice(format!(
+                        "set_mode({}) was not executed: the controller's modes are 0-{} (0 position, 1 servo, 2 joint teaching, 4-7 velocity and online modes); the mode stays {}",
+                        params[0],
+                        mode::LAST,
+                        self.mode
+                    ));
                     Answer::Params(vec![])
                 }
                 _ => Answer::Invalid,
@@ -471,6 +486,10 @@ impl Controller {
     fn move_to(&mut self, target: TcpPoseMm, speed_mm_s: f64, now: Instant) {
         if !(target.iter().all(|v| v.is_finite()) && speed_mm_s.is_finite() && speed_mm_s > 0.0) {
             self.warning = warn_code::PARAMETER;
+            self.notice(format!(
+                "a move to {target:?} at {speed_mm_s} mm/s was not executed: warning {}, a pose or speed that is not a finite positive number",
+                warn_code::PARAMETER
+            ));
             return;
         }
         let pose = world_pose(&self.mount, &target);
@@ -524,6 +543,13 @@ impl Controller {
             Err(e) => return self.fault(error_code::COLLISION, e.to_string(), now),
         }
         let seconds = (clock_after - clock_before).max(0.0) / self.mount.time_scale;
+        // The SDK raises a speed of zero or below to the controller's slowest, 0.1 mm/s, as a
+        // real controller then crawls: say so rather than leave a client waiting unexplained.
+        if speed_mm_s < SLOW_SPEED_MM_S && seconds > SLOW_MOVE_S {
+            self.notice(format!(
+                "a move at {speed_mm_s} mm/s takes {seconds:.0} s (the SDK raises a speed of zero or below to 0.1 mm/s)"
+            ));
+        }
         self.queue.push_back(Moving {
             from,
             to: target,

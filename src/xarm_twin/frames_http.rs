@@ -42,8 +42,17 @@ pub(super) fn serve(listener: TcpListener, twin: Shared) -> Result<()> {
     })
 }
 
+/// Set once Ctrl-C or SIGTERM came: open MJPEG streams end at their next part, so that the
+/// graceful shutdown, which waits for every response to finish, is not held by a viewer.
+static STOPPING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 /// Ctrl-C or SIGTERM: the server stops and the twin writes its session.
 async fn shutdown() {
+    wait_for_signal().await;
+    STOPPING.store(true, std::sync::atomic::Ordering::SeqCst);
+}
+
+async fn wait_for_signal() {
     #[cfg(unix)]
     {
         use tokio::signal::unix::{SignalKind, signal};
@@ -165,6 +174,9 @@ async fn gelsight_stream(State(twin): State<Shared>) -> Response {
         (twin, tokio::time::Instant::now()),
         move |(twin, next)| async move {
             tokio::time::sleep_until(next).await;
+            if STOPPING.load(std::sync::atomic::Ordering::SeqCst) {
+                return None;
+            }
             let shared = twin.clone();
             let part = tokio::task::spawn_blocking(move || -> Result<Vec<u8>> {
                 let frame = gelsight_capture(&shared)?;

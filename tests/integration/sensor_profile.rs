@@ -192,11 +192,16 @@ fn bad_profiles_fail_in_one_line_naming_the_field() {
                 err.contains("bad.toml") && err.contains(field),
                 "{to}: {err}"
             );
+            // A flag is named only where one gave the file: `sensor check FILE` has none.
+            assert_eq!(err.contains("--sensor"), args[0] == "press", "{err}");
         }
     }
     let missing = dir.path().join("missing.toml");
     let err = one_line_error(&tactex(&["sensor", "check", missing.to_str().unwrap()]));
-    assert!(err.contains("missing.toml"), "{err}");
+    assert!(
+        err.contains("missing.toml") && !err.contains("--sensor"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -607,3 +607,58 @@ fn read_refuses_a_greyscale_frame_a_blown_out_reference_and_a_jpg_name() {
         assert!(!out.exists(), "{err}");
     }
 }
+
+/// Each of compare's flags carries its own help: the split's text once sat under --estimator.
+#[test]
+fn compare_help_puts_the_splits_text_under_split() {
+    let out = tactex(&["compare", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    let estimator = help.find("--estimator").unwrap();
+    let split = help.find("--split").unwrap();
+    let text = help.find("Which presses to score").unwrap();
+    assert!(estimator < split && split < text, "{help}");
+}
+
+/// A long ellipsoid (a banana's body, 180 x 36 mm) lying along the frame's rows makes a strip
+/// that runs off both sides; pressed 3.8 mm off its ridge the strip nears one long edge and
+/// presses it in. Zeroed on the border's median that edge pulled the imprint to 0.38 mm
+/// against 0.57 on the ridge; zeroed on the lowest side of an unlevel border, 0.55 and 0.60.
+#[test]
+fn a_strip_running_off_the_frame_reads_as_deep_off_its_ridge_as_on_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let depth_at = |at: &str| {
+        let press = dir.path().join(format!("strip{at}"));
+        let made = tactex(&[
+            "press",
+            "--shape",
+            "ellipsoid",
+            "--size-mm",
+            "180,36,36",
+            "--modulus-mpa",
+            "0.8",
+            "--depth-mm",
+            "1.5",
+            &format!("--at-mm={at}"),
+            "--out",
+            press.to_str().unwrap(),
+        ]);
+        assert!(
+            made.status.success(),
+            "{}",
+            String::from_utf8_lossy(&made.stderr)
+        );
+        let report = json(&tactex(&[
+            "read",
+            press.join("tactile.png").to_str().unwrap(),
+            "--reference",
+            press.join("reference.png").to_str().unwrap(),
+            "--json",
+        ]));
+        report["peak_depth_mm"].as_f64().unwrap()
+    };
+    let (ridge, off) = (depth_at("0,0"), depth_at("0,-3.8"));
+    assert!(
+        (off / ridge - 1.0).abs() < 0.15,
+        "{off} mm off the ridge, {ridge} mm on it"
+    );
+}

@@ -365,4 +365,42 @@ fn the_gelsight_images_the_pad_mid_move_and_streams_as_mjpeg() {
         assert_eq!((frame.width(), frame.height()), (320, 240));
         assert_eq!(&jpeg[length..], b"\r\n");
     }
+
+    // SIGTERM with the stream still open: the stream ends and the twin exits (it was alive
+    // 45 s later, a viewer holding its graceful shutdown; now about 1.3 s).
+    let mut twin = twin;
+    let killed = Command::new("kill")
+        .args(["-TERM", &twin.child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let deadline = std::time::Instant::now() + Duration::from_secs(20);
+    let exited = loop {
+        if let Some(status) = twin.child.try_wait().unwrap() {
+            break Some(status);
+        }
+        if std::time::Instant::now() > deadline {
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    assert!(
+        exited.is_some(),
+        "the twin is still running 20 s after SIGTERM"
+    );
+    drop(body);
+}
+
+#[test]
+fn a_mode_the_controller_lacks_is_refused_with_a_warning_and_a_notice() {
+    let twin = Twin::start();
+    let arm = twin.arm();
+    arm.prepare().unwrap();
+    // The reply carries warning 12; the client may report it or not.
+    let _ = arm.set_mode(99);
+    assert_eq!(arm.error_warning().unwrap().1, 12);
+    let state: serde_json::Value = serde_json::from_slice(&twin.get("/state")).unwrap();
+    assert_eq!(state["mode"], 0, "{state}");
+    let notice = state["last_notice"].as_str().unwrap_or_default();
+    assert!(notice.contains("set_mode(99)"), "{state}");
 }
