@@ -71,8 +71,8 @@ pub struct PressArgs {
     /// (relative, 1e-12 to 0.5); `bench contact` measures what looser values trade.
     #[arg(long, default_value_t = 1e-6, value_parser = within(1e-12, 0.5))]
     tolerance: f64,
-    /// Gel thickness (mm, above 0 up to 50); GelSight Mini ~4.
-    #[arg(long, value_parser = above(0.0, 50.0))]
+    /// Gel thickness (mm, 0.5 to 50); GelSight Mini ~4.
+    #[arg(long, value_parser = within(tactex_core::tactile::sensor_profile::MIN_GEL_THICKNESS_MM, 50.0))]
     gel_thickness_mm: Option<f64>,
     /// Gel Young's modulus (MPa, above 0 up to 1000); GelSight Mini ~0.15-0.45.
     #[arg(long, value_parser = above(0.0, 1000.0))]

@@ -101,14 +101,22 @@ pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImag
         );
     }
     if let Some(out) = &args.out {
-        let same = |p: &std::path::Path| {
-            std::fs::canonicalize(p)
-                .ok()
-                .is_some_and(|p| Some(p) == std::fs::canonicalize(out).ok())
-        };
-        if same(&args.image) || args.reference.as_deref().is_some_and(same) {
+        use crate::report::output::same_file;
+        // The profile's own files too: its background is the default reference.
+        let sensor_files = args.sensor.iter().flat_map(|s| {
+            [
+                s.clone(),
+                tactex_core::tactile::sensor_profile::SensorProfile::background_path(s),
+            ]
+        });
+        let inputs: Vec<PathBuf> = [args.image.clone()]
+            .into_iter()
+            .chain(args.reference.clone())
+            .chain(sensor_files)
+            .collect();
+        if inputs.iter().any(|p| same_file(p, out)) {
             bail!(
-                "--out {}: is an input frame; name another file",
+                "--out {}: is an input (a frame or the sensor profile's file); name another file",
                 out.display()
             );
         }

@@ -64,6 +64,14 @@ pub fn write_png_atomic(path: &Path, image: &image::RgbImage) -> Result<()> {
     write_bytes_atomic(path, &png_bytes(image)?)
 }
 
+/// Whether two paths name one existing file (a path that does not exist is no input).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
 /// A PNG goes only to a file named .png: `--out view.jpg` would hold PNG bytes under a name
 /// that says otherwise.
 pub fn check_png_path(path: &Path) -> Result<()> {

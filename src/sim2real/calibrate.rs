@@ -49,8 +49,8 @@ pub struct CalibrateArgs {
     /// The gel's Young's modulus (MPa, above 0 up to 1000); default the GelSight Mini's.
     #[arg(long, value_parser = above(0.0, 1000.0))]
     pub gel_modulus_mpa: Option<f64>,
-    /// The gel's thickness (mm, above 0 up to 50); default the GelSight Mini's.
-    #[arg(long, value_parser = above(0.0, 50.0))]
+    /// The gel's thickness (mm, 0.5 to 50); default the GelSight Mini's.
+    #[arg(long, value_parser = crate::app::flag_range::within(tactex_core::tactile::sensor_profile::MIN_GEL_THICKNESS_MM, 50.0))]
     pub gel_thickness_mm: Option<f64>,
     /// The gel's Poisson ratio (0 to 0.5); default the GelSight Mini's.
     #[arg(long, value_parser = within(0.0, 0.5))]
@@ -61,10 +61,10 @@ pub struct CalibrateArgs {
     /// Which presses to fit: calib (all but every third), eval, or all.
     #[arg(long, value_enum, default_value_t = Split::Calib)]
     pub split: Split,
-    /// Table nodes over slope magnitude; 2 to 100, and at most 1536 nodes with --dir-bins.
+    /// Table nodes over slope magnitude; 2 to 100, and at most 768 nodes with --dir-bins.
     #[arg(long, value_parser = crate::app::flag_range::count::<u32>(2, 100), default_value_t = 12)]
     pub mag_bins: u32,
-    /// Table nodes over slope direction; 4 to 256, and at most 1536 nodes with --mag-bins.
+    /// Table nodes over slope direction; 4 to 256, and at most 768 nodes with --mag-bins.
     #[arg(long, value_parser = crate::app::flag_range::count::<u32>(4, 256), default_value_t = 24)]
     pub dir_bins: u32,
     /// Largest slope (dw/dr) the table covers (above 0 up to 100).
@@ -216,8 +216,8 @@ fn read_markers(
 
 /// Fits the profile the flags describe and writes it to `--out`.
 /// The most table nodes (--mag-bins x --dir-bins) a fit may have: its normal equations are
-/// dense, so its time grows with the cube of the nodes (48 x 24 took 10 s, 96 x 24 72 s).
-pub const MAX_TABLE_NODES: u32 = 1536;
+/// dense, so its time grows with the cube of the nodes (12 x 48 took 10 s, 12 x 64 23 s).
+pub const MAX_TABLE_NODES: u32 = 768;
 
 pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
     let (radius, scale) = (args.ball_radius_mm, args.mm_per_px);
@@ -247,6 +247,29 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
         args.split,
         background.dimensions(),
     )?;
+    // The profile and its background may not be written over the inputs they are made from.
+    let written = [
+        args.out.clone(),
+        tactex_core::tactile::sensor_profile::SensorProfile::background_path(&args.out),
+    ];
+    let inputs: Vec<std::path::PathBuf> = [args.background.clone(), args.annotations.clone()]
+        .into_iter()
+        .chain(args.markers.clone())
+        .chain(presses.iter().map(|(p, _)| args.images.join(&p.image)))
+        .collect();
+    for w in &written {
+        if let Some(input) = inputs
+            .iter()
+            .find(|i| crate::report::output::same_file(i, w))
+        {
+            bail!(
+                "--out {}: would write {} over the input {}; name another file",
+                args.out.display(),
+                w.display(),
+                input.display()
+            );
+        }
+    }
     let rule = SampleRule::default();
     let mut samples = Vec::new();
     let mut noise = Vec::new();

@@ -323,11 +323,18 @@ fn calibrate_rejects_bad_input_in_one_line_and_writes_nothing() {
         "image,center_x_px,center_y_px,contact_radius_px\n0001.png,76,182\n",
     )
     .unwrap();
-    let good_csv = f.join("ball-presses/annotations.csv");
+    let good_csv = dir.path().join("presses/annotations.csv");
     let out_dir = dir.path().join("d");
     std::fs::create_dir(&out_dir).unwrap();
     let background_of_dir = dir.path().join("d.background.png");
-    let (images, background) = (f.join("ball-presses"), f.join("background.png"));
+    // A copy of the presses: one case asks to write over one of them.
+    let images = dir.path().join("presses");
+    std::fs::create_dir(&images).unwrap();
+    for entry in std::fs::read_dir(f.join("ball-presses")).unwrap() {
+        let entry = entry.unwrap().path();
+        std::fs::copy(&entry, images.join(entry.file_name().unwrap())).unwrap();
+    }
+    let background = f.join("background.png");
     for (annotations, radius, extra, expect) in [
         (&good_csv, "-1", vec![], "--ball-radius-mm"),
         (&bad_csv, "2.35", vec![], "bad.csv:2"),
@@ -340,9 +347,12 @@ fn calibrate_rejects_bad_input_in_one_line_and_writes_nothing() {
         ),
         (&good_csv, "2.35", vec!["--dir-bins", "300"], "--dir-bins"),
         (&good_csv, "2.35", vec![], "is a directory"),
+        (&good_csv, "2.35", vec![], "over the input"),
     ] {
+        let over_input = images.join("0001.png");
         let target = match expect {
             "is a directory" => &out_dir,
+            "over the input" => &over_input,
             _ => &out,
         };
         let mut argv = vec![
@@ -564,7 +574,12 @@ fn read_draws_the_indentation_map_and_refuses_a_frame_of_another_size() {
 fn read_refuses_a_greyscale_frame_a_blown_out_reference_and_a_jpg_name() {
     let f = fixtures();
     let dir = tempfile::tempdir().unwrap();
-    let profile = f.join("profile/fots-9.toml");
+    // A copy of the profile: one case asks to draw over its background.
+    for name in ["fots-9.toml", "fots-9.background.png"] {
+        std::fs::copy(f.join("profile").join(name), dir.path().join(name)).unwrap();
+    }
+    let profile = dir.path().join("fots-9.toml");
+    let background = dir.path().join("fots-9.background.png");
     let frame = f.join("profile/fots-9.background.png");
     let grey = dir.path().join("grey.png");
     image::imageops::grayscale(&rgb(&frame))
@@ -590,6 +605,8 @@ fn read_refuses_a_greyscale_frame_a_blown_out_reference_and_a_jpg_name() {
             &out_png,
         ),
         (vec![frame], "--out", &out_jpg),
+        // The profile's background is the default reference: not to be drawn over.
+        (vec![frame], "is an input", &background),
     ] {
         let mut full = vec!["read"];
         full.extend(argv);
@@ -604,7 +621,14 @@ fn read_refuses_a_greyscale_frame_a_blown_out_reference_and_a_jpg_name() {
         let err = String::from_utf8_lossy(&run.stderr);
         assert_eq!(err.trim().lines().count(), 1, "{err}");
         assert!(err.contains(expect), "{err}");
-        assert!(!out.exists(), "{err}");
+        if out == &background {
+            assert_eq!(
+                rgb(&background),
+                rgb(&f.join("profile/fots-9.background.png"))
+            );
+        } else {
+            assert!(!out.exists(), "{err}");
+        }
     }
 }
 

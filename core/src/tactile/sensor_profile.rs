@@ -22,6 +22,10 @@ pub const PROFILE_FORMAT: &str = "tactex-sensor-profile/1";
 pub const MAX_NAME_CHARS: usize = 100;
 /// Its `source` note, free text of a few paragraphs at most.
 pub const MAX_SOURCE_CHARS: usize = 10_000;
+/// The thinnest gel a profile or `--gel-thickness-mm` may give: vision-based tactile gels are
+/// 0.5-5 mm, and a layer far thinner than its contact makes the layer solve stall (1e-9 mm
+/// ran past a minute).
+pub const MIN_GEL_THICKNESS_MM: f64 = 0.5;
 /// The finest pixel a profile may have: a micrometre on the gel (GelSight sensors: 0.02-0.1 mm).
 pub const MIN_MM_PER_PX: f64 = 0.001;
 
@@ -414,10 +418,14 @@ impl SensorProfile {
         if !(g.poisson.is_finite() && (0.0..=0.5).contains(&g.poisson)) {
             return bad("gel.poisson", format!("{}, expected 0..=0.5", g.poisson));
         }
-        if !(positive(g.thickness_mm) && g.thickness_mm <= 50.0) {
+        if !(g.thickness_mm.is_finite() && (MIN_GEL_THICKNESS_MM..=50.0).contains(&g.thickness_mm))
+        {
             return bad(
                 "gel.thickness_mm",
-                format!("{}, expected (0, 50] mm", g.thickness_mm),
+                format!(
+                    "{}, expected {MIN_GEL_THICKNESS_MM} to 50 mm",
+                    crate::printable::short_number(g.thickness_mm)
+                ),
             );
         }
         match &s.table {
@@ -715,6 +723,12 @@ mod tests {
             (
                 "thickness_mm = 4.0",
                 "thickness_mm = nan",
+                "gel.thickness_mm",
+            ),
+            // A gel far thinner than its contact stalls the layer solve.
+            (
+                "thickness_mm = 4.0",
+                "thickness_mm = 0.01",
                 "gel.thickness_mm",
             ),
             ("vignette = 0.55", "vignette = 2.0", "camera.vignette"),

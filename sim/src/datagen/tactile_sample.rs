@@ -340,7 +340,7 @@ impl SampleSpace {
             // On a 0.05 mm ladder: the layer model's tables are cached per thickness.
             thickness_mm: (rng.random_range(g.thickness_mm - 0.5..g.thickness_mm + 0.5) / 0.05)
                 .round()
-                .max(1.0)
+                .max(tactex_core::tactile::sensor_profile::MIN_GEL_THICKNESS_MM / 0.05)
                 * 0.05,
         };
         // The lights turned together and raised or lowered together.
