@@ -6,18 +6,20 @@ use std::path::Path;
 
 /// The image at `path` as 8-bit RGB, with the path named in any error.
 pub fn load_rgb(path: &Path) -> Result<RgbImage> {
+    Ok(decode(path)?.to_rgb8())
+}
+
+/// The image at `path` as decoded, with the path named in any error.
+fn decode(path: &Path) -> Result<image::DynamicImage> {
     super::file_input::present(path, "cannot read the image")?;
-    Ok(tactex_core::image_file::open(path)
-        .map_err(|e| anyhow::anyhow!("{}: cannot read the image: {e}", path.display()))?
-        .to_rgb8())
+    tactex_core::image_file::open(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot read the image: {e}", path.display()))
 }
 
 /// A tactile sensor's frame: colour (the shading is read from three channels) and not mostly
 /// saturated (a blown-out or blank frame carries no shading to read).
 pub fn load_tactile_frame(path: &Path) -> Result<RgbImage> {
-    super::file_input::present(path, "cannot read the image")?;
-    let decoded = tactex_core::image_file::open(path)
-        .map_err(|e| anyhow::anyhow!("{}: cannot read the image: {e}", path.display()))?;
+    let decoded = decode(path)?;
     if !decoded.color().has_color() {
         anyhow::bail!(
             "{}: a greyscale image; a tactile frame is colour (its shading is read from three channels)",

@@ -421,10 +421,7 @@ fn real_presses_read_through_the_glow_give_the_balls_depth() {
 /// read as flat gel) it read 0.548 mm, 9% short.
 #[test]
 fn the_stock_mini_reads_a_steel_balls_depth_within_five_percent() {
-    let dir = tempfile::tempdir().unwrap();
-    let press = dir.path().join("press");
-    let made = tactex(&[
-        "press",
+    let flags = [
         "--shape",
         "sphere",
         "--radius-mm",
@@ -433,33 +430,46 @@ fn the_stock_mini_reads_a_steel_balls_depth_within_five_percent() {
         "rigid",
         "--depth-mm",
         "0.6",
-        "--out",
-        press.to_str().unwrap(),
-    ]);
+    ];
+    let report = press_and_read(&flags, None);
+    let depth = report["peak_depth_mm"].as_f64().unwrap();
+    assert!((depth - 0.6).abs() < 0.05 * 0.6, "{report}");
+}
+
+/// `press` with these flags (through `sensor` when given), and the `read` report of its frame
+/// against its no-contact frame, read through the same sensor.
+fn press_and_read(press_flags: &[&str], sensor: Option<&Path>) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let press = dir.path().join("press");
+    let sensor_flags: Vec<&str> = match sensor {
+        Some(p) => vec!["--sensor", p.to_str().unwrap()],
+        None => vec![],
+    };
+    let mut argv = vec!["press"];
+    argv.extend(press_flags);
+    argv.extend(&sensor_flags);
+    argv.extend(["--out", press.to_str().unwrap()]);
+    let made = tactex(&argv);
     assert!(
         made.status.success(),
         "{}",
         String::from_utf8_lossy(&made.stderr)
     );
-    let report = json(&tactex(&[
+    let (frame, reference) = (press.join("tactile.png"), press.join("reference.png"));
+    let mut argv = vec![
         "read",
-        press.join("tactile.png").to_str().unwrap(),
+        frame.to_str().unwrap(),
         "--reference",
-        press.join("reference.png").to_str().unwrap(),
+        reference.to_str().unwrap(),
         "--json",
-    ]));
-    let depth = report["peak_depth_mm"].as_f64().unwrap();
-    assert!((depth - 0.6).abs() < 0.05 * 0.6, "{report}");
+    ];
+    argv.extend(&sensor_flags);
+    json(&tactex(&argv))
 }
 
 /// A rigid sphere pressed through the fixture profile, and the `read` report of its frame.
 fn press_and_read_through_fots_9(radius_mm: &str, depth_mm: &str) -> serde_json::Value {
-    let dir = tempfile::tempdir().unwrap();
-    let press = dir.path().join("press");
-    let profile = fixtures().join("profile/fots-9.toml");
-    let profile = profile.to_str().unwrap();
-    let made = tactex(&[
-        "press",
+    let flags = [
         "--shape",
         "sphere",
         "--radius-mm",
@@ -468,25 +478,8 @@ fn press_and_read_through_fots_9(radius_mm: &str, depth_mm: &str) -> serde_json:
         "rigid",
         "--depth-mm",
         depth_mm,
-        "--sensor",
-        profile,
-        "--out",
-        press.to_str().unwrap(),
-    ]);
-    assert!(
-        made.status.success(),
-        "{}",
-        String::from_utf8_lossy(&made.stderr)
-    );
-    json(&tactex(&[
-        "read",
-        press.join("tactile.png").to_str().unwrap(),
-        "--reference",
-        press.join("reference.png").to_str().unwrap(),
-        "--sensor",
-        profile,
-        "--json",
-    ]))
+    ];
+    press_and_read(&flags, Some(&fixtures().join("profile/fots-9.toml")))
 }
 
 /// The camera's noise alone, read backwards through a profile's table and glow, was read as
@@ -649,11 +642,9 @@ fn compare_help_puts_the_splits_text_under_split() {
 /// against 0.57 on the ridge; zeroed on the lowest side of an unlevel border, 0.55 and 0.60.
 #[test]
 fn a_strip_running_off_the_frame_reads_as_deep_off_its_ridge_as_on_it() {
-    let dir = tempfile::tempdir().unwrap();
     let depth_at = |at: &str| {
-        let press = dir.path().join(format!("strip{at}"));
-        let made = tactex(&[
-            "press",
+        let at = format!("--at-mm={at}");
+        let flags = [
             "--shape",
             "ellipsoid",
             "--size-mm",
@@ -662,23 +653,11 @@ fn a_strip_running_off_the_frame_reads_as_deep_off_its_ridge_as_on_it() {
             "0.8",
             "--depth-mm",
             "1.5",
-            &format!("--at-mm={at}"),
-            "--out",
-            press.to_str().unwrap(),
-        ]);
-        assert!(
-            made.status.success(),
-            "{}",
-            String::from_utf8_lossy(&made.stderr)
-        );
-        let report = json(&tactex(&[
-            "read",
-            press.join("tactile.png").to_str().unwrap(),
-            "--reference",
-            press.join("reference.png").to_str().unwrap(),
-            "--json",
-        ]));
-        report["peak_depth_mm"].as_f64().unwrap()
+            &at,
+        ];
+        press_and_read(&flags, None)["peak_depth_mm"]
+            .as_f64()
+            .unwrap()
     };
     let (ridge, off) = (depth_at("0,0"), depth_at("0,-3.8"));
     assert!(
