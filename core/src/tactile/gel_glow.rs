@@ -389,6 +389,24 @@ impl GelGlow {
         .concat()
     }
 
+    /// The same glow on a frame of half the resolution: every blur half as wide in pixels.
+    pub fn at_half_resolution(&self) -> GelGlow {
+        let colour = |t: &ColourGlow| ColourGlow {
+            sigma_px: 0.5 * t.sigma_px,
+            ..*t
+        };
+        let scalar = |t: &ScalarGlow| ScalarGlow {
+            sigma_px: 0.5 * t.sigma_px,
+            ..*t
+        };
+        GelGlow {
+            colour: self.colour.iter().map(colour).collect(),
+            magnitude: self.magnitude.iter().map(scalar).collect(),
+            indentation: self.indentation.iter().map(scalar).collect(),
+            indented_colour: self.indented_colour.iter().map(colour).collect(),
+        }
+    }
+
     /// Checks every term; Err is the field (under `optics.glow`) and what is wrong with it.
     pub fn validate(&self) -> Result<(), (String, String)> {
         let count = self.terms().len();

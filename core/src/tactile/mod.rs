@@ -13,6 +13,7 @@ pub mod depth;
 pub mod frame_reading;
 pub mod gel_glow;
 pub mod glow_inverse;
+pub mod half_resolution;
 pub mod marker_grid;
 pub mod markers;
 pub mod photometric;

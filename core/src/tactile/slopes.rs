@@ -6,6 +6,7 @@
 use crate::tactile::depth::integrate_slopes;
 use crate::tactile::gel_glow::{GelGlow, blur};
 use crate::tactile::glow_inverse::GlowInverse;
+use crate::tactile::half_resolution::HalfResolution;
 use crate::tactile::photometric::PhotometricModel;
 use crate::tactile::shading_table::{ShadingTable, frame_position};
 use crate::tactile::spec::TactileSpec;
@@ -125,9 +126,10 @@ pub fn recover_slopes(
 }
 
 /// A frame's change read through a table and its glow: the marker dots' holes filled, the
-/// drift removed, the glow's linear part inverted and the table read backwards; then the
-/// drift measured again away from that first reading's imprint, the glow's indentation and
-/// magnitude terms from it subtracted and the change read again.
+/// drift removed; a first reading at half the resolution (the glow's linear part inverted,
+/// the table read backwards, integrated) places the imprint, so the drift is measured again
+/// away from it, and gives the indentation the glow's other terms are computed from; those
+/// terms subtracted, the change is read at full resolution.
 fn read_through_glow(
     table: &ShadingTable,
     glow: &GelGlow,
@@ -142,14 +144,15 @@ fn read_through_glow(
     // read like the rest.
     let observed = fill_holes(&observed, &mut field.valid, w, h, hole_px(spec));
     let first = without_drift(&observed, &field.valid, drift(&observed, &band));
-    let inverse = GlowInverse::shared(glow, w, h, NOISE_SMOOTHING_MM / spec.mm_per_px);
-    read_table(table, &inverse.solve(&first), field);
-    let depth: Vec<f32> = integrate_slopes(field, spec.mm_per_px)
-        .into_iter()
-        .map(|d| d as f32)
-        .collect();
+    let smoothing_px = NOISE_SMOOTHING_MM / spec.mm_per_px;
+    let inverse = GlowInverse::shared(glow, w, h, smoothing_px);
+    let first_reading = match HalfResolution::of(w, h) {
+        Some(half) => FirstReading::at_half(table, glow, spec, &half, &first, &field.valid),
+        None => FirstReading::at_full(table, &inverse, spec, &first, field),
+    };
     // A large press reaches the band (a fruit's contact spans most of the frame): its
     // shading there is not drift, and taken for it the whole imprint reads shallow.
+    let depth = &first_reading.indentation_mm;
     let peak = depth.iter().copied().fold(0.0f32, f32::max);
     let untouched: Vec<usize> = band
         .iter()
@@ -157,23 +160,100 @@ fn read_through_glow(
         .filter(|i| depth[*i] < UNTOUCHED_SHARE * peak)
         .collect();
     let observed = without_drift(&observed, &field.valid, drift(&observed, &untouched));
-    if !inverse.has_rest() {
-        read_table(table, &inverse.solve(&observed), field);
-        return;
+    let linear: Vec<[f32; 3]> = match &first_reading.rest {
+        Some(rest) => observed
+            .iter()
+            .zip(rest)
+            .map(|(o, r)| std::array::from_fn(|c| o[c] - r[c]))
+            .collect(),
+        None => observed,
+    };
+    read_table(table, &inverse.solve(&linear), field);
+}
+
+/// The reading's first pass, on every pixel of the frame: its indentation (mm) and the
+/// glow's terms beyond the linear ones (None when the glow has none).
+struct FirstReading {
+    indentation_mm: Vec<f32>,
+    rest: Option<Vec<[f32; 3]>>,
+}
+
+impl FirstReading {
+    /// Read on the frame's half and interpolated back.
+    fn at_half(
+        table: &ShadingTable,
+        glow: &GelGlow,
+        spec: &TactileSpec,
+        half: &HalfResolution,
+        change: &[[f32; 3]],
+        valid: &[bool],
+    ) -> Self {
+        let (cw, ch) = (half.coarse_width(), half.coarse_height());
+        let mm_per_px = 2.0 * spec.mm_per_px;
+        let inverse = GlowInverse::shared(
+            &glow.at_half_resolution(),
+            cw,
+            ch,
+            NOISE_SMOOTHING_MM / mm_per_px,
+        );
+        let mut field = SlopeField {
+            width: cw,
+            height: ch,
+            gx: vec![0.0; cw * ch],
+            gy: vec![0.0; cw * ch],
+            valid: half.down_valid(valid),
+        };
+        read_table(table, &inverse.solve(&half.down(change)), &mut field);
+        let depth: Vec<f32> = integrate_slopes(&field, mm_per_px)
+            .into_iter()
+            .map(|d| d as f32)
+            .collect();
+        let rest = inverse.has_rest().then(|| {
+            let rest = inverse.rest(&modelled_change(table, &field), &depth);
+            let channels: [Vec<f64>; 3] =
+                std::array::from_fn(|c| half.up(&rest.iter().map(|r| r[c]).collect::<Vec<_>>()));
+            (0..half.width * half.height)
+                .map(|i| std::array::from_fn(|c| channels[c][i] as f32))
+                .collect()
+        });
+        Self {
+            indentation_mm: half.up(&depth).into_iter().map(|d| d as f32).collect(),
+            rest,
+        }
     }
-    let modelled: Vec<[f32; 3]> = (0..w * h)
+
+    /// Read on every pixel (a frame too small to halve); `field` keeps this reading.
+    fn at_full(
+        table: &ShadingTable,
+        inverse: &GlowInverse,
+        spec: &TactileSpec,
+        change: &[[f32; 3]],
+        field: &mut SlopeField,
+    ) -> Self {
+        read_table(table, &inverse.solve(change), field);
+        let depth: Vec<f32> = integrate_slopes(field, spec.mm_per_px)
+            .into_iter()
+            .map(|d| d as f32)
+            .collect();
+        let rest = inverse
+            .has_rest()
+            .then(|| inverse.rest(&modelled_change(table, field), &depth));
+        Self {
+            indentation_mm: depth,
+            rest,
+        }
+    }
+}
+
+/// The shading change the table gives for a field's slopes.
+fn modelled_change(table: &ShadingTable, field: &SlopeField) -> Vec<[f32; 3]> {
+    let (w, h) = (field.width, field.height);
+    (0..w * h)
         .map(|i| {
             let (u, v) = frame_position((i % w) as u32, (i / w) as u32, w as u32, h as u32);
             table.change(field.gx[i], field.gy[i], u, v)
         })
-        .collect();
-    let rest = inverse.rest(&modelled, &depth);
-    let linear: Vec<[f32; 3]> = observed
-        .iter()
-        .zip(&rest)
-        .map(|(o, r)| std::array::from_fn(|c| o[c] - r[c]))
-        .collect();
-    read_table(table, &inverse.solve(&linear), field);
+        .collect()
 }
 
 /// The camera's noise read backwards through a table is not zero-mean in slope where the
