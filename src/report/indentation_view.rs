@@ -29,24 +29,32 @@ fn viridis(t: f64) -> Rgb<u8> {
     }))
 }
 
-/// frame | indentation map, side by side, the contact outlined in red on both.
+/// frame | indentation map, side by side, the contact outlined in red on both. A reading
+/// made at a coarser resolution than the frame's (a fine sensor read on 2 x 2 blocks) is
+/// shown at the frame's, each of its pixels as a block.
 pub fn indentation_view(frame: &RgbImage, reading: &FrameReading) -> RgbImage {
+    let (fw, fh) = (frame.width() as usize, frame.height() as usize);
     let (w, h) = (reading.width, reading.height);
+    // The reading's pixel under a frame pixel.
+    let at = |x: usize, y: usize| ((y * h / fh).min(h - 1), (x * w / fw).min(w - 1));
+    let inside = |x: usize, y: usize| {
+        let (ry, rx) = at(x, y);
+        reading.in_contact(ry * w + rx)
+    };
     let top = reading.peak_mm.max(1e-9);
     let edge = |x: usize, y: usize| {
-        let i = y * w + x;
-        reading.in_contact(i)
+        inside(x, y)
             && [(0, -1), (0, 1), (-1, 0), (1, 0)].iter().any(|(dx, dy)| {
                 let (xx, yy) = (x as i64 + dx, y as i64 + dy);
                 xx < 0
                     || yy < 0
-                    || xx >= w as i64
-                    || yy >= h as i64
-                    || !reading.in_contact(yy as usize * w + xx as usize)
+                    || xx >= fw as i64
+                    || yy >= fh as i64
+                    || !inside(xx as usize, yy as usize)
             })
     };
-    RgbImage::from_fn(2 * w as u32, h as u32, |x, y| {
-        let (i, left) = ((x as usize) % w, (x as usize) < w);
+    RgbImage::from_fn(2 * fw as u32, fh as u32, |x, y| {
+        let (i, left) = ((x as usize) % fw, (x as usize) < fw);
         let y = y as usize;
         if edge(i, y) {
             return OUTLINE;
@@ -54,7 +62,7 @@ pub fn indentation_view(frame: &RgbImage, reading: &FrameReading) -> RgbImage {
         if left {
             return *frame.get_pixel(i as u32, y as u32);
         }
-        let d = reading.indentation_mm[y * w + i];
-        viridis(d / top)
+        let (ry, rx) = at(i, y);
+        viridis(reading.indentation_mm[ry * w + rx] / top)
     })
 }

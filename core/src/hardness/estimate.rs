@@ -259,7 +259,7 @@ impl HardnessEstimator for HertzSlopeEstimator {
             .ok_or_else(|| EstimateError::BadSequence("frame and reference sizes differ".into()))?;
         let last = fields.last().expect("at least two frames");
         let centre = radial_centre(last).ok_or(EstimateError::NoImprint)?;
-        let px = spec.mm_per_px;
+        let px = last.mm_per_px;
 
         let mut samples = Vec::new();
         for (i, f) in fields.iter().enumerate() {

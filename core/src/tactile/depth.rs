@@ -14,7 +14,8 @@ const UNLEVEL_SHARE: f64 = 0.6;
 /// Indentation (mm, into the gel) per pixel, row-major, zero where the gel is undisturbed
 /// (the median of the frame's border, or of its lowest side where the border is far from
 /// level). Slopes of invalid pixels (markers) count as zero.
-pub fn integrate_slopes(field: &SlopeField, mm_per_px: f64) -> Vec<f64> {
+pub fn integrate_slopes(field: &SlopeField) -> Vec<f64> {
+    let mm_per_px = field.mm_per_px;
     let (w, h) = (field.width, field.height);
     let (w2, h2) = (2 * w, 2 * h);
     // Mirror extension: gx is odd across vertical edges and even across horizontal ones,
@@ -105,6 +106,7 @@ mod tests {
         let mut field = SlopeField {
             width: w,
             height: h,
+            mm_per_px,
             gx: vec![0.0; w * h],
             gy: vec![0.0; w * h],
             valid: vec![true; w * h],
@@ -116,7 +118,7 @@ mod tests {
                 field.gy[y * w + x] = ((at(xf, yf + 0.5) - at(xf, yf - 0.5)) / mm_per_px) as f32;
             }
         }
-        let depth = integrate_slopes(&field, mm_per_px);
+        let depth = integrate_slopes(&field);
         let mut worst: f64 = 0.0;
         for y in 0..h {
             for x in 0..w {

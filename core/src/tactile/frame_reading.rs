@@ -47,10 +47,10 @@ pub fn read_frame(
     spec: &TactileSpec,
 ) -> Option<FrameReading> {
     let slopes = recover_slopes(frame, reference, spec)?;
-    let depth = integrate_slopes(&slopes, spec.mm_per_px);
+    let depth = integrate_slopes(&slopes);
     let p = peak(&depth);
     let deep = |d: f64| d > 0.5 * p;
-    let contact_axes_mm = contact_ellipse(&depth, slopes.width, deep, spec.mm_per_px);
+    let contact_axes_mm = contact_ellipse(&depth, slopes.width, deep, slopes.mm_per_px);
     let within_frame = imprint_within_frame(&depth, &slopes.valid, slopes.width, slopes.height, p);
     Some(FrameReading {
         width: slopes.width,

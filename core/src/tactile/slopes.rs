@@ -17,6 +17,9 @@ use image::RgbImage;
 pub struct SlopeField {
     pub width: usize,
     pub height: usize,
+    /// The gel's size of one of its pixels: the frame's, or twice it where the frame was
+    /// read at half its resolution.
+    pub mm_per_px: f64,
     pub gx: Vec<f32>,
     pub gy: Vec<f32>,
     pub valid: Vec<bool>,
@@ -86,6 +89,7 @@ pub fn recover_slopes(
     let mut field = SlopeField {
         width: w,
         height: h,
+        mm_per_px: spec.mm_per_px,
         gx: vec![0.0; w * h],
         gy: vec![0.0; w * h],
         valid,
@@ -115,7 +119,25 @@ pub fn recover_slopes(
             false => [0.0; 3],
         })
         .collect();
-    match &spec.glow {
+    // Pixels finer than the noise smoothing carry nothing it leaves: such a frame (R1.5's
+    // 640 x 480) is read on 2 x 2 blocks, a quarter of the work.
+    let half = HalfResolution::of(w, h).filter(|_| 2.0 * spec.mm_per_px <= NOISE_SMOOTHING_MM);
+    let (mut field, observed, glow) = match half {
+        Some(half) => (
+            SlopeField {
+                width: half.coarse_width(),
+                height: half.coarse_height(),
+                mm_per_px: 2.0 * spec.mm_per_px,
+                gx: vec![0.0; half.coarse_width() * half.coarse_height()],
+                gy: vec![0.0; half.coarse_width() * half.coarse_height()],
+                valid: half.down_valid(&field.valid),
+            },
+            half.down(&observed),
+            spec.glow.as_ref().map(GelGlow::at_half_resolution),
+        ),
+        None => (field, observed, spec.glow.clone()),
+    };
+    match &glow {
         Some(glow) => read_through_glow(table, glow, spec, observed, &mut field),
         None => {
             read_table(table, &observed, &mut field);
@@ -142,13 +164,14 @@ fn read_through_glow(
     // The glow is read backwards over the whole frame, so the marker dots' holes are filled
     // from the shading round them (zeros there would read as flat gel inside a contact) and
     // read like the rest.
-    let observed = fill_holes(&observed, &mut field.valid, w, h, hole_px(spec));
+    let hole = hole_px(spec, field);
+    let observed = fill_holes(&observed, &mut field.valid, w, h, hole);
     let first = without_drift(&observed, &field.valid, drift(&observed, &band));
-    let smoothing_px = NOISE_SMOOTHING_MM / spec.mm_per_px;
+    let smoothing_px = NOISE_SMOOTHING_MM / field.mm_per_px;
     let inverse = GlowInverse::shared(glow, w, h, smoothing_px);
     let first_reading = match HalfResolution::of(w, h) {
-        Some(half) => FirstReading::at_half(table, glow, spec, &half, &first, &field.valid),
-        None => FirstReading::at_full(table, &inverse, spec, &first, field),
+        Some(half) => FirstReading::at_half(table, glow, &half, &first, field),
+        None => FirstReading::at_full(table, &inverse, &first, field),
     };
     // A large press reaches the band (a fruit's contact spans most of the frame): its
     // shading there is not drift, and taken for it the whole imprint reads shallow.
@@ -183,13 +206,12 @@ impl FirstReading {
     fn at_half(
         table: &ShadingTable,
         glow: &GelGlow,
-        spec: &TactileSpec,
         half: &HalfResolution,
         change: &[[f32; 3]],
-        valid: &[bool],
+        full: &SlopeField,
     ) -> Self {
         let (cw, ch) = (half.coarse_width(), half.coarse_height());
-        let mm_per_px = 2.0 * spec.mm_per_px;
+        let mm_per_px = 2.0 * full.mm_per_px;
         let inverse = GlowInverse::shared(
             &glow.at_half_resolution(),
             cw,
@@ -199,12 +221,13 @@ impl FirstReading {
         let mut field = SlopeField {
             width: cw,
             height: ch,
+            mm_per_px,
             gx: vec![0.0; cw * ch],
             gy: vec![0.0; cw * ch],
-            valid: half.down_valid(valid),
+            valid: half.down_valid(&full.valid),
         };
         read_table(table, &inverse.solve(&half.down(change)), &mut field);
-        let depth: Vec<f32> = integrate_slopes(&field, mm_per_px)
+        let depth: Vec<f32> = integrate_slopes(&field)
             .into_iter()
             .map(|d| d as f32)
             .collect();
@@ -226,12 +249,11 @@ impl FirstReading {
     fn at_full(
         table: &ShadingTable,
         inverse: &GlowInverse,
-        spec: &TactileSpec,
         change: &[[f32; 3]],
         field: &mut SlopeField,
     ) -> Self {
         read_table(table, &inverse.solve(change), field);
-        let depth: Vec<f32> = integrate_slopes(field, spec.mm_per_px)
+        let depth: Vec<f32> = integrate_slopes(field)
             .into_iter()
             .map(|d| d as f32)
             .collect();
@@ -305,8 +327,8 @@ fn without_drift(observed: &[[f32; 3]], valid: &[bool], drift: [f32; 3]) -> Vec<
 
 /// A marker dot's hole in the shading, as a blur's sigma (px): the dot's radius and the ring
 /// of 2 px left out around it.
-fn hole_px(spec: &TactileSpec) -> f32 {
-    ((spec.markers.radius_mm / spec.mm_per_px) as f32 + 2.0).max(1.0)
+fn hole_px(spec: &TactileSpec, field: &SlopeField) -> f32 {
+    ((spec.markers.radius_mm / field.mm_per_px) as f32 + 2.0).max(1.0)
 }
 
 /// The slopes under the marker dots (and saturated pixels), read as if flat they pull a
@@ -321,7 +343,8 @@ fn fill_slope_holes(field: &mut SlopeField, spec: &TactileSpec) {
         .zip(&field.gy)
         .map(|(&gx, &gy)| [gx, gy])
         .collect();
-    let filled = fill_holes(&slopes, &mut field.valid, w, h, hole_px(spec));
+    let hole = hole_px(spec, field);
+    let filled = fill_holes(&slopes, &mut field.valid, w, h, hole);
     for ((gx, gy), [fx, fy]) in field.gx.iter_mut().zip(field.gy.iter_mut()).zip(filled) {
         (*gx, *gy) = (fx, fy);
     }
@@ -479,5 +502,44 @@ mod tests {
         // A bright sensor keeps the fixed level: 70 grey levels a channel.
         let bright = RgbImage::from_pixel(20, 20, Rgb([170, 160, 150]));
         assert_eq!(dark_level(&bright), 210);
+    }
+
+    #[test]
+    fn a_frame_finer_than_the_noise_smoothing_is_read_on_blocks_at_their_size() {
+        // A spherical cap (radius 4 mm, 0.3 mm deep) shaded through a table on a 240 x 180
+        // frame of 0.025 mm pixels: read on 2 x 2 blocks of 0.05 mm, and integrated at that
+        // size it gives the cap's depth.
+        let table = crate::tactile::shading_table::tests::lights_table();
+        let (w, h, px) = (240u32, 180u32, 0.025f64);
+        let mut spec = TactileSpec::gelsight_mini();
+        (spec.width_px, spec.height_px, spec.mm_per_px) = (w, h, px);
+        spec.table = Some(table.clone());
+        spec.glow = None;
+        let (radius, depth) = (4.0f64, 0.3f64);
+        let reference = RgbImage::from_pixel(w, h, Rgb([140, 140, 140]));
+        let frame = RgbImage::from_fn(w, h, |x, y| {
+            let (dx, dy) = (
+                (x as f64 + 0.5 - w as f64 / 2.0) * px,
+                (y as f64 + 0.5 - h as f64 / 2.0) * px,
+            );
+            let r2 = dx * dx + dy * dy;
+            // Slopes of the indentation depth - r^2 / 2R inside the contact, flat outside.
+            let (gx, gy) = match r2 < 2.0 * radius * depth {
+                true => (-dx / radius, -dy / radius),
+                false => (0.0, 0.0),
+            };
+            let (u, v) = frame_position(x, y, w, h);
+            let change = table.change(gx as f32, gy as f32, u, v);
+            Rgb(change.map(|c| (140.0 + c).round().clamp(0.0, 255.0) as u8))
+        });
+        let field = recover_slopes(&frame, &reference, &spec).expect("same sizes");
+        assert_eq!((field.width, field.height), (120, 90));
+        assert_eq!(field.mm_per_px, 2.0 * px);
+        let read = integrate_slopes(&field);
+        let peak = read.iter().copied().fold(0.0f64, f64::max);
+        assert!(
+            (peak / depth - 1.0).abs() < 0.1,
+            "peak {peak} mm for {depth}"
+        );
     }
 }
