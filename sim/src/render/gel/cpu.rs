@@ -7,6 +7,7 @@ use super::noise::gaussian3_row;
 use super::{GelGlow, GelRenderer, PressFrame, RenderError, RenderParams, SensorOptics, Shading};
 use image::RgbImage;
 use rayon::prelude::*;
+use std::sync::{Arc, Mutex};
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct CpuRenderer;
@@ -105,7 +106,7 @@ fn shade(p: &RenderParams, optics: &SensorOptics, slopes: &[[f32; 2]]) -> Vec<[f
     let frame = ShadedFrame::new(p, optics);
     out.par_chunks_mut(w).enumerate().for_each_init(
         || vec![0.0f32; w],
-        |fade, (y, row)| frame.shade_row(y, &slopes[y * w..][..w], fade, row),
+        |fade, (y, row)| frame.shade_row(y, &slopes[y * w..][..w], None, fade, row),
     );
     out
 }
@@ -131,7 +132,17 @@ impl<'a> ShadedFrame<'a> {
     }
 
     /// Row `y` of the shading from that row's slopes; `fade` is scratch of the row's width.
-    fn shade_row(&self, y: usize, g: &[[f32; 2]], fade: &mut [f32], row: &mut [[f32; 3]]) {
+    /// Where `flat` (the flat gel's shading of the row) is given, a table's untouched pixels
+    /// take it rather than look the table up again: the same operations made it, so the
+    /// bytes are the same.
+    fn shade_row(
+        &self,
+        y: usize,
+        g: &[[f32; 2]],
+        flat: Option<&[[f32; 3]]>,
+        fade: &mut [f32],
+        row: &mut [[f32; 3]],
+    ) {
         let (w, h) = (self.p.width as usize, self.p.height as usize);
         let v = (y as f32 + 0.5) / h as f32 - 0.5;
         for (f, u) in fade.iter_mut().zip(&self.us) {
@@ -142,6 +153,10 @@ impl<'a> ShadedFrame<'a> {
             Shading::Lights(_) => shade_row_lit(&self.lit, g, bg, fade, row),
             Shading::Table(table) => {
                 for x in 0..w {
+                    if let Some(flat) = flat.filter(|_| g[x] == [0.0, 0.0]) {
+                        row[x] = flat[x];
+                        continue;
+                    }
                     let d = table.change(g[x][0], g[x][1], 2.0 * self.us[x], 2.0 * v);
                     row[x] = std::array::from_fn(|c| (bg[x][c] + d[c]) * fade[x]);
                 }
@@ -165,12 +180,49 @@ fn shading_change(
     optics: &SensorOptics,
     heights: &[f32],
 ) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
-    let flat = flat_shading(p, optics);
-    let mut change = shade(p, optics, &slopes(p, heights));
-    for (s, f) in change.iter_mut().zip(&flat) {
-        *s = std::array::from_fn(|c| s[c] - f[c]);
+    let flat = shared_flat_shading(optics);
+    let w = p.width as usize;
+    let g = slopes(p, heights);
+    let frame = ShadedFrame::new(p, optics);
+    let mut change = vec![[0.0f32; 3]; w * p.height as usize];
+    change.par_chunks_mut(w).enumerate().for_each_init(
+        || vec![0.0f32; w],
+        |fade, (y, row)| {
+            let flat = &flat[y * w..][..w];
+            frame.shade_row(y, &g[y * w..][..w], Some(flat), fade, row);
+            for (s, f) in row.iter_mut().zip(flat) {
+                *s = std::array::from_fn(|c| s[c] - f[c]);
+            }
+        },
+    );
+    (flat.to_vec(), change)
+}
+
+/// Optics whose flat shading was made, and it; a few kept.
+type FlatMade = (SensorOptics, Arc<Vec<[f32; 3]>>);
+static FLAT_MADE: Mutex<Vec<FlatMade>> = Mutex::new(Vec::new());
+const FLAT_KEPT: usize = 2;
+
+/// The flat gel's shading of these optics, made once and shared: every frame through a
+/// glow is its flat shading plus the glow of its change, and through a table the flat
+/// shading costs a full frame of lookups (the arm's search for contact renders dozens).
+fn shared_flat_shading(optics: &SensorOptics) -> Arc<Vec<[f32; 3]>> {
+    let found = {
+        let made = FLAT_MADE.lock().unwrap_or_else(|e| e.into_inner());
+        made.iter()
+            .find(|(o, _)| o == optics)
+            .map(|(_, flat)| flat.clone())
+    };
+    if let Some(flat) = found {
+        return flat;
     }
-    (flat, change)
+    let flat = Arc::new(flat_shading(&RenderParams::new(optics, 1), optics));
+    let mut made = FLAT_MADE.lock().unwrap_or_else(|e| e.into_inner());
+    if made.len() >= FLAT_KEPT {
+        made.remove(0);
+    }
+    made.push((optics.clone(), flat.clone()));
+    flat
 }
 
 /// Stages 1-2 and the glow (gel_glow_*.wgsl): the flat gel's shading plus the glow of the
@@ -184,7 +236,7 @@ fn glowing(
     // Every source of the glow is zero on an untouched gel: its frame is the flat shading,
     // bit for bit, without the blurs (the arm's search for contact renders many such).
     if heights.iter().all(|&h| h == 0.0) {
-        return flat_shading(p, optics);
+        return shared_flat_shading(optics).to_vec();
     }
     let (flat, change) = shading_change(p, optics, heights);
     let mut out = glow.apply(&change, heights, p.width as usize, p.height as usize);
@@ -369,7 +421,7 @@ impl CpuRenderer {
             || RowScratch::new(w),
             |s, (y, row)| {
                 slopes_at(&p, &f.normal_mm, y, &mut s.slopes);
-                shading.shade_row(y, &s.slopes, &mut s.fade, &mut s.shaded);
+                shading.shade_row(y, &s.slopes, None, &mut s.fade, &mut s.shaded);
                 expose_row(&p, &dots, frame.seed, y, &mut s.shaded, &mut s.noise, row);
             },
         );
