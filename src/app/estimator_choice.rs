@@ -95,49 +95,159 @@ impl EstimatorChoice {
     }
 
     /// Loads the estimator with calibrated intervals: from `intervals` (a file `eval fruits
-    /// --calibrate` wrote) when given, else the calibration shipped for it at `fidelity`,
-    /// else its own intervals, which say that they are not calibrated. A calibration applies
-    /// only to the `sensor` its presses were read through: the shipped ones were measured on
-    /// the built-in Mini, and a calibrated profile reads with errors of its own.
+    /// --calibrate` wrote) when given, else the one measured through the sensor profile at
+    /// `profile` and kept beside it (`profile_intervals_path`), else the calibration shipped
+    /// for it at `fidelity`, else its own intervals, which say that they are not calibrated.
+    /// A calibration applies only to the `sensor` its presses were read through: the shipped
+    /// ones were measured on the built-in Mini, and a calibrated profile reads with errors of
+    /// its own.
     pub fn open(
         &self,
         flag: &str,
         fidelity: &str,
         intervals: Option<&Path>,
         sensor: &ProfileId,
+        profile: Option<&Path>,
     ) -> Result<BoxedEstimator> {
         let inner = self.open_uncalibrated(flag)?;
         let calibration = match intervals {
             Some(path) => {
-                let text = std::fs::read_to_string(path)
-                    .with_context(|| format!("--intervals {}: cannot read", path.display()))?;
-                let c =
-                    IntervalCalibration::parse(&text, &format!("--intervals {}", path.display()))?;
-                if c.estimator != inner.name() {
-                    bail!(
-                        "--intervals {}: calibrated for the {} estimator, not {}",
-                        path.display(),
-                        c.estimator,
-                        inner.name()
-                    );
-                }
-                let through = c.measured_through();
-                if &through != sensor {
-                    bail!(
-                        "--intervals {}: measured through the sensor {through}, not {sensor} (the one in use); \
-                         make one with `tactex eval fruits --sensor PROFILE --calibrate FILE`",
-                        path.display(),
-                    );
-                }
-                Some(c)
+                Some(self.measured_intervals(path, "--intervals", inner.name(), sensor)?)
             }
-            None => builtin_intervals(self, fidelity, sensor)?,
+            None => match profile {
+                Some(profile) => self.intervals_beside(profile, fidelity, inner.name(), sensor),
+                None => builtin_intervals(self, fidelity, sensor)?,
+            },
         };
         Ok(match calibration {
             Some(calibration) => Box::new(Calibrated { inner, calibration }),
             None => inner,
         })
     }
+
+    /// A calibration file, checked to be for this estimator and measured through `sensor`;
+    /// `what` names it in errors.
+    fn measured_intervals(
+        &self,
+        path: &Path,
+        what: &str,
+        estimator: &str,
+        sensor: &ProfileId,
+    ) -> Result<IntervalCalibration> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("{what} {}: cannot read", path.display()))?;
+        let c = IntervalCalibration::parse(&text, &format!("{what} {}", path.display()))?;
+        if c.estimator != estimator {
+            bail!(
+                "{what} {}: calibrated for the {} estimator, not {estimator}",
+                path.display(),
+                c.estimator,
+            );
+        }
+        let through = c.measured_through();
+        if &through != sensor {
+            bail!(
+                "{what} {}: measured through the sensor {through}, not {sensor} (the one in use); \
+                 make one with `tactex eval fruits --sensor PROFILE --calibrate FILE`",
+                path.display(),
+            );
+        }
+        Ok(c)
+    }
+
+    /// The calibration kept beside the sensor profile at `profile`, when there is one and it
+    /// was measured through this profile as it is now (said on stderr); None when there is
+    /// none (`missing_intervals_note` says so where a command wants it said) or it is stale
+    /// (a note says why and how to make it again).
+    fn intervals_beside(
+        &self,
+        profile: &Path,
+        fidelity: &str,
+        estimator: &str,
+        sensor: &ProfileId,
+    ) -> Option<IntervalCalibration> {
+        match self.look_beside(profile, fidelity, estimator, sensor) {
+            Beside::Found(path, c) => {
+                eprintln!(
+                    "note: intervals measured through this sensor: {}",
+                    path.display()
+                );
+                Some(c)
+            }
+            Beside::Missing(_) => None,
+            Beside::Stale(path, e) => {
+                eprintln!(
+                    "note: {e:#}; the intervals are the estimator's own (the profile changed since?); {}",
+                    self.how_to_measure(profile, fidelity, &path)
+                );
+                None
+            }
+        }
+    }
+
+    /// The note for a profile with no calibration beside it: its intervals are the
+    /// estimator's own, and the command that measures them. None when one is there.
+    pub fn missing_intervals_note(&self, profile: &Path, fidelity: &str) -> Option<String> {
+        let path = profile_intervals_path(profile, self, fidelity);
+        (!path.is_file()).then(|| {
+            format!(
+                "note: --sensor {}: the intervals are the estimator's own, not measured through this sensor; {}",
+                profile.display(),
+                self.how_to_measure(profile, fidelity, &path)
+            )
+        })
+    }
+
+    fn how_to_measure(&self, profile: &Path, fidelity: &str, path: &Path) -> String {
+        format!(
+            "measure them with `tactex eval fruits --sensor {} --fidelity {fidelity} --estimator {} --calibrate {}` (used from then on)",
+            profile.display(),
+            self.flag_value(),
+            path.display()
+        )
+    }
+
+    /// What lies beside the profile at `profile` for this estimator at `fidelity`.
+    pub fn look_beside(
+        &self,
+        profile: &Path,
+        fidelity: &str,
+        estimator: &str,
+        sensor: &ProfileId,
+    ) -> Beside {
+        let path = profile_intervals_path(profile, self, fidelity);
+        if !path.is_file() {
+            return Beside::Missing(path);
+        }
+        match self.measured_intervals(&path, "intervals", estimator, sensor) {
+            Ok(c) => Beside::Found(path, c),
+            Err(e) => Beside::Stale(path, e),
+        }
+    }
+}
+
+/// An interval calibration beside a sensor profile: found and measured through it, missing,
+/// or there but not for this estimator or this profile (why, in the error).
+pub enum Beside {
+    Found(PathBuf, IntervalCalibration),
+    Missing(PathBuf),
+    Stale(PathBuf, anyhow::Error),
+}
+
+/// Where the interval calibration measured through the profile at `profile` for `choice` at
+/// `fidelity` is kept: beside it, `NAME.ESTIMATOR-FIDELITY.intervals.json` for `NAME.toml`
+/// (a model file's estimator by its file stem).
+pub fn profile_intervals_path(profile: &Path, choice: &EstimatorChoice, fidelity: &str) -> PathBuf {
+    let estimator = match choice {
+        EstimatorChoice::Model(path) => path
+            .file_stem()
+            .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned()),
+        other => other.flag_value(),
+    };
+    let stem = profile
+        .file_stem()
+        .map_or_else(|| "profile".into(), |s| s.to_string_lossy().into_owned());
+    profile.with_file_name(format!("{stem}.{estimator}-{fidelity}.intervals.json"))
 }
 
 /// The calibration shipped for `choice` at `fidelity` read through `sensor`: (file name,
@@ -178,4 +288,51 @@ fn builtin_intervals(
             IntervalCalibration::parse(text, &format!("{file} (built in)")).map_err(Into::into)
         })
         .transpose()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn through(sensor: Option<ProfileId>) -> String {
+        let (_, _, _, text) = BUILTIN_INTERVALS
+            .iter()
+            .find(|(e, ..)| *e == "indentation")
+            .expect("shipped");
+        let mut c = IntervalCalibration::parse(text, "shipped").expect("valid");
+        c.sensor = sensor;
+        serde_json::to_string(&c).expect("serialisable")
+    }
+
+    #[test]
+    fn a_profiles_own_intervals_are_found_beside_it_only_when_measured_through_it() {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        let profile = dir.path().join("mine.toml");
+        let mine = ProfileId {
+            name: "mine".into(),
+            sha256: "ab".repeat(32),
+        };
+        let choice = EstimatorChoice::Indentation;
+        let beside = profile_intervals_path(&profile, &choice, "layer");
+        assert_eq!(
+            beside.file_name().and_then(|n| n.to_str()),
+            Some("mine.indentation-layer.intervals.json")
+        );
+        let found = || choice.intervals_beside(&profile, "layer", "indentation", &mine);
+        assert!(found().is_none(), "no file beside the profile");
+        std::fs::write(&beside, through(Some(mine.clone()))).expect("written");
+        assert_eq!(found().and_then(|c| c.sensor), Some(mine.clone()));
+        // Measured through the built-in Mini (or the profile before an edit): not used.
+        std::fs::write(&beside, through(None)).expect("written");
+        assert!(found().is_none());
+        // Given as --intervals, the same file is refused outright.
+        let e = choice
+            .open("--estimator", "layer", Some(&beside), &mine, Some(&profile))
+            .err()
+            .expect("refused");
+        assert!(
+            format!("{e:#}").contains("measured through the sensor"),
+            "{e:#}"
+        );
+    }
 }

@@ -41,6 +41,7 @@ pub fn answer_on_hardware(
         Fidelity::Layer.name(),
         twin.intervals.as_deref(),
         &sensor.id(),
+        twin.sensor.as_deref(),
     )?;
     // The sensors first, so that a missing camera never leaves the arm enabled.
     let mut camera = devices.open_camera()?;

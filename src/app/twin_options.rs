@@ -77,12 +77,12 @@ pub struct OpenedTwin {
 impl TwinOptions {
     pub fn open(&self) -> Result<OpenedTwin> {
         let sensor = load_sensor(self.sensor.as_deref())?;
-        if let (Some(path), None) = (&self.sensor, &self.intervals) {
-            eprintln!(
-                "note: --sensor {0}: the intervals are the estimator's own, not measured through this sensor; \
-                 measure them with `tactex eval fruits --sensor {0} --calibrate FILE` and pass `--intervals FILE`",
-                path.display()
-            );
+        if let (Some(profile), None) = (&self.sensor, &self.intervals)
+            && let Some(note) = self
+                .estimator
+                .missing_intervals_note(profile, self.fidelity.name())
+        {
+            eprintln!("{note}");
         }
         Ok(OpenedTwin {
             detector: DetectorChoice::parse(&self.detector)?,
@@ -93,6 +93,7 @@ impl TwinOptions {
                 self.fidelity.name(),
                 self.intervals.as_deref(),
                 &sensor.id(),
+                self.sensor.as_deref(),
             )?,
             fidelity: self.fidelity,
             sensor,

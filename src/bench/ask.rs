@@ -104,9 +104,13 @@ pub fn run(args: &AskBenchArgs) -> Result<()> {
     let mut estimator_name = String::new();
     for &fidelity in &args.fidelity {
         bar.set_message(fidelity.name());
-        let estimator = args
-            .estimator
-            .open("--estimator", fidelity.name(), None, &sensor.id())?;
+        let estimator = args.estimator.open(
+            "--estimator",
+            fidelity.name(),
+            None,
+            &sensor.id(),
+            args.sensor.as_deref(),
+        )?;
         estimator_name = estimator.name().to_string();
         let twin = Twin {
             scene: &scene,

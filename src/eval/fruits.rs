@@ -13,7 +13,7 @@
 //! calibration instead (run it on another seed than the evaluation's).
 
 use crate::app::detector_choice::DetectorChoice;
-use crate::app::estimator_choice::EstimatorChoice;
+use crate::app::estimator_choice::{Beside, EstimatorChoice};
 use crate::app::{Twin, TwinAnswer};
 use crate::eval::report_matching::match_reports;
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
@@ -558,6 +558,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
             fidelity,
             args.intervals.as_deref(),
             &sensor_id,
+            args.sensor.as_deref(),
         )?,
     };
     if let Some(path) = &args.calibrate
@@ -661,12 +662,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
         protocol,
         estimator: estimator.name().into(),
         fidelity: fidelity.into(),
-        intervals: interval_source(
-            &args.estimator,
-            fidelity,
-            args.intervals.as_ref(),
-            &sensor_id,
-        )?,
+        intervals: interval_source(args, fidelity, estimator.name(), &sensor_id)?,
         sensor: sensor_id,
         seed: args.seed,
         kinds: names
@@ -711,14 +707,23 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
     Ok(())
 }
 
-/// Where the scored intervals come from, in words.
+/// Where the scored intervals come from, in words (as `EstimatorChoice::open` chose them).
 fn interval_source(
-    choice: &EstimatorChoice,
+    args: &FruitEvalArgs,
     fidelity: &str,
-    file: Option<&PathBuf>,
+    estimator: &str,
     sensor: &ProfileId,
 ) -> Result<String> {
-    Ok(match file {
+    let choice = &args.estimator;
+    if args.calibrate.is_some() {
+        return Ok("the estimator's own (this run measures a calibration)".into());
+    }
+    if let (None, Some(profile)) = (&args.intervals, &args.sensor)
+        && let Beside::Found(path, _) = choice.look_beside(profile, fidelity, estimator, sensor)
+    {
+        return Ok(format!("{} (measured through this sensor)", path.display()));
+    }
+    Ok(match &args.intervals {
         Some(p) => format!("--intervals {}", p.display()),
         None => match crate::app::estimator_choice::builtin_interval_file(choice, fidelity, sensor)
         {

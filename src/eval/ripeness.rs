@@ -146,9 +146,13 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         fruits.push(spec.clone());
     }
     let profile = crate::app::load_sensor(args.sensor.as_deref())?;
-    let estimator = args
-        .estimator
-        .open("--estimator", fidelity.name(), None, &profile.id())?;
+    let estimator = args.estimator.open(
+        "--estimator",
+        fidelity.name(),
+        None,
+        &profile.id(),
+        args.sensor.as_deref(),
+    )?;
     // The sensor as it is, unrandomised: a lab's validation run on one sensor.
     let sensor = SensorDraw::of(std::sync::Arc::new(profile));
     let protocol = PressProtocol::default();

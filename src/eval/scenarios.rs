@@ -539,9 +539,13 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let renderer = crate::app::scene_renderer(args.device)?;
     let sensor = crate::app::load_sensor(args.sensor.as_deref())?;
-    let estimator = args
-        .estimator
-        .open("--estimator", args.fidelity.name(), None, &sensor.id())?;
+    let estimator = args.estimator.open(
+        "--estimator",
+        args.fidelity.name(),
+        None,
+        &sensor.id(),
+        args.sensor.as_deref(),
+    )?;
     let scenarios = tiers
         .iter()
         .flat_map(|&t| (0..args.runs).map(move |r| (t, r)))

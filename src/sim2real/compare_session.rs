@@ -446,9 +446,13 @@ pub fn compare_session(args: &SessionCompare) -> Result<SessionComparison> {
             spec.height_px
         );
     }
-    let estimator = args
-        .estimator
-        .open("--estimator", args.fidelity.name(), None, &sensor.id())?;
+    let estimator = args.estimator.open(
+        "--estimator",
+        args.fidelity.name(),
+        None,
+        &sensor.id(),
+        args.sensor,
+    )?;
     let mut sim = SimDevices::with_sensor(&scene, seed, sensor.clone(), args.fidelity)
         .with_context(|| format!("{scene_name}: the twin cannot stand it up"))?;
     let rebuilt = rebuild_frames(&mut sim, &manifest)?;

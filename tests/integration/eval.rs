@@ -54,14 +54,18 @@ fn scores_each_estimator_and_draws_predicted_against_true() {
         .collect();
     assert_eq!(names, ["hertz_slopes", "indentation", "onnx_small"]);
     for e in estimators {
-        assert_eq!(
-            e["n"].as_u64().unwrap() + e["failures"].as_u64().unwrap(),
-            4
-        );
+        let n = e["n"].as_u64().unwrap();
+        assert_eq!(n + e["failures"].as_u64().unwrap(), 4);
+        // A press an estimator cannot stand behind (hertz_slopes: the gel took nearly all
+        // the travel) is refused, and scores need three presses.
         for field in ["rmse", "r2", "spearman"] {
-            assert!(e[field].as_f64().unwrap().is_finite(), "{field}");
+            match n >= 3 {
+                true => assert!(e[field].as_f64().unwrap().is_finite(), "{field}"),
+                false => assert!(e[field].is_null(), "{field} of {n} presses"),
+            }
         }
     }
+    assert_eq!(estimators[1]["n"], 4, "indentation measures every sphere");
     let png = image::open(out.join("hardness.png")).expect("a PNG plot");
     assert!(png.width() > 400 && png.height() > 400);
     let lines = std::fs::read_to_string(out.join("predictions.jsonl")).unwrap();

@@ -186,15 +186,16 @@ impl<T: HardnessEstimator + ?Sized> HardnessEstimator for Box<T> {
     }
 }
 
-/// The least share of the travel the gel may take for an estimator to resolve the object.
-/// The modulus goes as (1 - s) / s, so d ln E / d s = -1 / (s (1 - s)): where s (1 - s) <
-/// 0.02, a reading error of 1% of the travel moves the modulus by more than half. Below it
-/// the object is far softer than the gel and the press cannot say by how much. (At the
-/// stiff end the same loss is a rigid object's bound, which the estimate already says.)
+/// The least share of the travel the gel may take for an estimator to resolve the object,
+/// and the least the object must take. The modulus goes as (1 - s) / s, so d ln E / d s =
+/// -1 / (s (1 - s)): where s (1 - s) < 0.02, a reading error of 1% of the travel moves the
+/// modulus by more than half. Below it the object is far softer than the gel, above one
+/// minus it far stiffer, and the press cannot say by how much (through a profile's reading a
+/// 1.45 MPa banana read 398 MPa there, the depth fit's end of range, as a number).
 pub(crate) const MIN_GEL_SHARE: f64 = 0.0205;
 
-/// Refuses a press in which the gel took too small a share of the travel to resolve the
-/// object, saying so in the user's terms (every physics estimator's rule).
+/// Refuses a press in which the gel took too small or too large a share of the travel to
+/// resolve the object, saying so in the user's terms (every physics estimator's rule).
 pub(crate) fn check_gel_share(share: f64) -> Result<(), EstimateError> {
     if share < MIN_GEL_SHARE {
         return Err(EstimateError::OutsideCompetence(format!(
@@ -202,6 +203,14 @@ pub(crate) fn check_gel_share(share: f64) -> Result<(), EstimateError> {
              resolve (below {:.1}%)",
             100.0 * share,
             100.0 * MIN_GEL_SHARE
+        )));
+    }
+    if share > 1.0 - MIN_GEL_SHARE {
+        return Err(EstimateError::OutsideCompetence(format!(
+            "the gel took {:.1}% of the travel: the object is too stiff against the gel to \
+             resolve (above {:.1}%): the press cannot tell it from a rigid one",
+            100.0 * share,
+            100.0 * (1.0 - MIN_GEL_SHARE),
         )));
     }
     Ok(())

@@ -216,4 +216,14 @@ mod tests {
         assert!(matches!(&err, EstimateError::OutsideCompetence(why) if why.contains("too soft")));
         assert!(check_competence(&fit(20.0, 0.2, 0.0001), 0.03, 0.02, &travel).is_ok());
     }
+
+    #[test]
+    fn an_object_too_stiff_against_the_gel_to_resolve_is_not_a_number_at_the_fits_end() {
+        // The gel took 99.6% of the travel (the depth fit at the end of its range, a thousand
+        // times stiffer than the gel): no modulus, a rigid-like bound in words.
+        let travel = [0.0, 0.25, 0.5, 0.75];
+        let err = check_competence(&fit(9e-4, 0.2, 0.0001), 0.996, 0.7, &travel).unwrap_err();
+        assert!(matches!(&err, EstimateError::OutsideCompetence(why) if why.contains("too stiff")));
+        assert!(check_competence(&fit(0.01, 0.2, 0.0001), 0.95, 0.7, &travel).is_ok());
+    }
 }
