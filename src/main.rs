@@ -18,7 +18,9 @@ fn main() -> ExitCode {
         // A value out of its flag's range is a bad value like any other: one line, exit 1.
         Err(e) if e.kind() == clap::error::ErrorKind::ValueValidation => {
             let text = e.render().to_string();
-            eprintln!("{}", text.lines().next().unwrap_or("error: invalid value"));
+            let line = text.lines().next().unwrap_or("error: invalid value");
+            // clap quotes the value as given: escape codes and bidirectional overrides shown.
+            eprintln!("{}", tactex_core::printable::printable(line));
             return ExitCode::FAILURE;
         }
         Err(e) => e.exit(),

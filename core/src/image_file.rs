@@ -46,6 +46,26 @@ pub fn decode(bytes: &[u8], format: ImageFormat) -> Result<DynamicImage, String>
     reader.decode().map_err(say)
 }
 
+/// Why a decoded image cannot be a tactile frame, if it cannot: a greyscale image (the
+/// shading is read from three channels) or one more than half saturated (it carries no
+/// shading). The frames read, the no-contact references and profiles' backgrounds.
+pub fn tactile_frame_fault(decoded: &DynamicImage) -> Option<String> {
+    if !decoded.color().has_color() {
+        return Some(
+            "a greyscale image; a tactile frame is colour (its shading is read from three channels)"
+                .into(),
+        );
+    }
+    let frame = decoded.to_rgb8();
+    let saturated = frame.pixels().filter(|p| p.0.contains(&255)).count();
+    (2 * saturated > frame.pixels().len()).then(|| {
+        format!(
+            "{:.0}% of its pixels are saturated (255); a tactile frame this blown out carries no shading",
+            100.0 * saturated as f64 / frame.pixels().len() as f64
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

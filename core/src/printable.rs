@@ -2,12 +2,18 @@
 //! print: control characters, terminal escape sequences among them, shown as escapes rather
 //! than acted on by the terminal; and numbers from outside shown short.
 
-/// `text` with every control character but tab written as its Rust escape (`\u{1b}`);
-/// line breaks too, so that an error stays one line.
+/// Characters that reorder or hide text on a terminal without being control characters:
+/// bidirectional overrides and isolates, zero-width spaces and joiners, the byte-order mark.
+pub fn is_hidden(c: char) -> bool {
+    matches!(c, '\u{200B}'..='\u{200F}' | '\u{202A}'..='\u{202E}' | '\u{2060}'..='\u{2064}' | '\u{2066}'..='\u{2069}' | '\u{FEFF}')
+}
+
+/// `text` with every control character but tab, and every hidden one (`is_hidden`), written
+/// as its Rust escape (`\u{1b}`); line breaks too, so that an error stays one line.
 pub fn printable(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for c in text.chars() {
-        if c.is_control() && c != '\t' {
+        if (c.is_control() && c != '\t') || is_hidden(c) {
             out.extend(c.escape_default());
         } else {
             out.push(c);
@@ -34,6 +40,10 @@ mod tests {
         let shown = printable("soft \u{1b}[31mred\u{1b}[0m\r\nnext\u{7}");
         assert_eq!(shown, "soft \\u{1b}[31mred\\u{1b}[0m\\r\\nnext\\u{7}");
         assert!(!shown.chars().any(char::is_control));
+        assert_eq!(
+            printable("lime\u{202E}emil\u{200B}"),
+            "lime\\u{202e}emil\\u{200b}"
+        );
         assert_eq!(
             printable("Which kiwi is softest?\tné"),
             "Which kiwi is softest?\tné"

@@ -236,12 +236,23 @@ pub fn run(args: &PressArgs) -> Result<()> {
     Ok(())
 }
 
+/// `v` rounded to `decimals`, a rounded-away negative zero shown as 0 ("-0.0000 mm" read as
+/// a pull).
+fn shown(v: f64, decimals: i32) -> f64 {
+    let scale = 10f64.powi(decimals);
+    (v * scale).round() / scale + 0.0
+}
+
 fn print_report(r: &PressReport) {
     let object = r
         .object_modulus_mpa
         .map_or("rigid".to_string(), |e| format!("{e:.3} MPa"));
+    let article = match r.shape.chars().next() {
+        Some('a' | 'e' | 'i' | 'o' | 'u') => "an",
+        _ => "a",
+    };
     println!(
-        "{} press of a {} ({object}, {:.1} Shore A) {:.3} mm past first touch:",
+        "{} press of {article} {} ({object}, {:.1} Shore A) {:.3} mm past first touch:",
         r.fidelity, r.shape, r.object_shore_a, r.depth_mm
     );
     println!("  force            {:>10.4} N", r.force_n);
@@ -252,11 +263,12 @@ fn print_report(r: &PressReport) {
     println!("  max pressure     {:>10.4} MPa", r.max_pressure_mpa);
     println!(
         "  gel indentation  {:>10.4} mm (of a {:.2} mm gel)",
-        r.gel_max_indentation_mm, r.gel_thickness_mm
+        shown(r.gel_max_indentation_mm, 4),
+        r.gel_thickness_mm
     );
     println!(
         "  object indent.   {:>10.4} mm",
-        r.object_max_indentation_mm
+        shown(r.object_max_indentation_mm, 4)
     );
     println!(
         "  solver           {} x {} cells of {:.4} mm, {} iterations, residual {:.1e}",

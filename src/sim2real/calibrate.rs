@@ -36,15 +36,16 @@ pub struct CalibrateArgs {
     /// The ball's radius (mm, above 0 up to 100).
     #[arg(long, value_parser = above(0.0, 100.0))]
     pub ball_radius_mm: f64,
-    /// The frames' scale (mm per pixel, above 0 up to 1).
-    #[arg(long, value_parser = above(0.0, 1.0))]
+    /// The frames' scale (mm per pixel, 0.001 to 1).
+    #[arg(long, value_parser = within(tactex_core::tactile::sensor_profile::MIN_MM_PER_PX, 1.0))]
     pub mm_per_px: f64,
     /// The sensor profile to write (TOML; its background goes beside it as
     /// NAME.background.png).
     #[arg(long)]
     pub out: PathBuf,
-    /// The profile's name (default: the output file's stem).
-    #[arg(long)]
+    /// The profile's name (default: the output file's stem); one line of at most 100
+    /// characters.
+    #[arg(long, value_parser = profile_name)]
     pub name: Option<String>,
     /// The gel's Young's modulus (MPa, above 0 up to 1000); default the GelSight Mini's.
     #[arg(long, value_parser = above(0.0, 1000.0))]
@@ -214,6 +215,12 @@ fn read_markers(
     ))
 }
 
+/// `--name`, checked before the fit as the profile will check it.
+fn profile_name(s: &str) -> Result<String, String> {
+    tactex_core::tactile::sensor_profile::check_name(s)?;
+    Ok(s.to_string())
+}
+
 /// Fits the profile the flags describe and writes it to `--out`.
 /// The most table nodes (--mag-bins x --dir-bins) a fit may have: its normal equations are
 /// dense, so its time grows with the cube of the nodes (12 x 48 took 10 s, 12 x 64 23 s).
@@ -235,7 +242,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
             args.out.display()
         );
     }
-    let background = crate::app::load_rgb(&args.background)?;
+    let background = crate::app::load_tactile_frame(&args.background).context("--background")?;
     // Before the fit: a marker frame that cannot be read fails first.
     let markers = match &args.markers {
         Some(path) => Some((path, read_markers(path, background.dimensions(), scale)?)),

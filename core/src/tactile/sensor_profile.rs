@@ -8,6 +8,7 @@
 //! contents (the canonical TOML, without the background's file name, then the background's
 //! pixels), so two profiles that render alike hash alike wherever their files live.
 
+use crate::printable::short_number;
 use crate::tactile::gel_glow::GelGlow;
 use crate::tactile::photometric::PhotometricModel;
 use crate::tactile::shading_table::ShadingTable;
@@ -20,6 +21,20 @@ use std::path::{Path, PathBuf};
 pub const PROFILE_FORMAT: &str = "tactex-sensor-profile/1";
 /// A profile's name is shown in every report: one short line.
 pub const MAX_NAME_CHARS: usize = 100;
+
+/// Whether `name` can name a profile: one line of at most `MAX_NAME_CHARS` characters with
+/// no control characters and none that reorder or hide text on a terminal (bidirectional
+/// overrides, zero-width characters); Err says what is wrong, the name shown escaped.
+pub fn check_name(name: &str) -> Result<(), String> {
+    let hidden = crate::printable::is_hidden;
+    if name.chars().count() > MAX_NAME_CHARS || name.chars().any(|c| c.is_control() || hidden(c)) {
+        return Err(format!(
+            "'{}', expected one line of at most {MAX_NAME_CHARS} characters without control, bidirectional or zero-width characters",
+            crate::printable::printable(&name.chars().take(40).collect::<String>())
+        ));
+    }
+    Ok(())
+}
 /// Its `source` note, free text of a few paragraphs at most.
 pub const MAX_SOURCE_CHARS: usize = 10_000;
 /// The thinnest gel a profile or `--gel-thickness-mm` may give: vision-based tactile gels are
@@ -28,6 +43,8 @@ pub const MAX_SOURCE_CHARS: usize = 10_000;
 pub const MIN_GEL_THICKNESS_MM: f64 = 0.5;
 /// The finest pixel a profile may have: a micrometre on the gel (GelSight sensors: 0.02-0.1 mm).
 pub const MIN_MM_PER_PX: f64 = 0.001;
+/// The largest ambient and light gain an analytic profile may give, relative to the flat gel.
+pub const MAX_LIGHT_GAIN: f64 = 10.0;
 
 /// How gel surface slopes become colour.
 #[derive(Clone, Debug, PartialEq)]
@@ -273,15 +290,19 @@ impl SensorProfile {
             SYNTHETIC => None,
             name => {
                 let at = dir.join(name);
-                let img = crate::image_file::open(&at)
-                    .map_err(|e| {
-                        err(
-                            "optics.background",
-                            format!("{}: not a readable image: {e}", at.display()),
-                        )
-                    })?
-                    .to_rgb8();
-                Some(img)
+                let img = crate::image_file::open(&at).map_err(|e| {
+                    err(
+                        "optics.background",
+                        format!("{}: not a readable image: {e}", at.display()),
+                    )
+                })?;
+                if let Some(fault) = crate::image_file::tactile_frame_fault(&img) {
+                    return Err(err(
+                        "optics.background",
+                        format!("{}: {fault}", at.display()),
+                    ));
+                }
+                Some(img.to_rgb8())
             }
         };
         let c = &raw.camera;
@@ -330,15 +351,8 @@ impl SensorProfile {
             return bad("name", "must not be empty".into());
         }
         // Both are printed in every report and answer: a line of plain text, and a note.
-        let name = self.name();
-        if name.chars().count() > MAX_NAME_CHARS || name.chars().any(char::is_control) {
-            return bad(
-                "name",
-                format!(
-                    "'{}', expected one line of at most {MAX_NAME_CHARS} characters without control characters",
-                    crate::printable::printable(&name.chars().take(40).collect::<String>())
-                ),
-            );
+        if let Err(message) = check_name(self.name()) {
+            return bad("name", message);
         }
         if self.source.chars().count() > MAX_SOURCE_CHARS
             || self
@@ -438,14 +452,26 @@ impl SensorProfile {
                 {
                     return bad("optics.lights.directions", "must be unit vectors".into());
                 }
-                if !(l.ambient.is_finite() && l.ambient >= 0.0) {
+                // Both relative to the flat gel's light: beyond ten times it the shading
+                // overflows the frame's range long before the camera's, and 1e300 overflows
+                // the renderer's arithmetic.
+                if !(l.ambient.is_finite() && (0.0..=MAX_LIGHT_GAIN).contains(&l.ambient)) {
                     return bad(
                         "optics.lights.ambient",
-                        format!("{}, expected >= 0", l.ambient),
+                        format!(
+                            "{}, expected 0 to {MAX_LIGHT_GAIN}",
+                            short_number(l.ambient)
+                        ),
                     );
                 }
-                if !positive(l.gain) {
-                    return bad("optics.lights.gain", format!("{}, expected > 0", l.gain));
+                if !(positive(l.gain) && l.gain <= MAX_LIGHT_GAIN) {
+                    return bad(
+                        "optics.lights.gain",
+                        format!(
+                            "{}, expected above 0 up to {MAX_LIGHT_GAIN}",
+                            short_number(l.gain)
+                        ),
+                    );
                 }
                 if !l.lights.iter().all(|d| d.z > 0.0) {
                     return bad(
@@ -686,6 +712,20 @@ mod tests {
         std::fs::write(&path, p.to_toml("bench.background.png")).unwrap();
         let e = SensorProfile::load(&path).unwrap_err();
         assert_eq!(e.field, "camera.vignette", "{e}");
+        // A background that is no tactile frame (greyscale, or blown out) is refused.
+        p.vignette = 0.0;
+        std::fs::write(&path, p.to_toml("bench.background.png")).unwrap();
+        let (w, h) = p.background.as_ref().unwrap().dimensions();
+        image::GrayImage::from_pixel(w, h, image::Luma([120]))
+            .save(&bg)
+            .unwrap();
+        let e = SensorProfile::load(&path).unwrap_err();
+        assert_eq!(e.field, "optics.background", "{e}");
+        RgbImage::from_pixel(w, h, image::Rgb([255, 255, 255]))
+            .save(&bg)
+            .unwrap();
+        let e = SensorProfile::load(&path).unwrap_err();
+        assert!(e.to_string().contains("saturated"), "{e}");
     }
 
     #[test]
@@ -732,6 +772,8 @@ mod tests {
                 "gel.thickness_mm",
             ),
             ("vignette = 0.55", "vignette = 2.0", "camera.vignette"),
+            ("gain = 1.0", "gain = 1e300", "optics.lights.gain"),
+            ("ambient = 0.45", "ambient = 11.0", "optics.lights.ambient"),
             ("darkness = 0.82", "darkness = -0.1", "markers.darkness"),
             ("radius_mm = 0.25", "radius_mm = 1.5", "markers.radius_mm"),
             (
@@ -768,6 +810,7 @@ mod tests {
         // Text that reaches every report: one short printable line of a name, a bounded note.
         for (to, field) in [
             ("name = \"Mini\\u001b[31m\"", "name"),
+            ("name = \"Mini\\u202Eevil\"", "name"),
             (
                 &*format!("name = \"{}\"", "x".repeat(MAX_NAME_CHARS + 1)),
                 "name",
