@@ -11,6 +11,7 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::hardness::scale::Hardness;
+use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_sim::contact::{Fidelity, GelFields, Grid};
 use tactex_sim::render::gel::{DeviceChoice, open_renderer};
 
@@ -216,7 +217,9 @@ pub fn run(args: &PressArgs) -> Result<()> {
     if let Some(out) = &args.out {
         // The renderer first: a missing device fails before any file is written.
         let choice = open_renderer(args.device)?;
-        let out = OutputDir::create("--out", out)?;
+        let mut out = OutputDir::create("--out", out)?;
+        out.keep(args.sensor.iter().flat_map(|p| SensorProfile::files(p)));
+        out.keep(args.mesh.clone());
         let dir = out.path();
         if let Some(note) = &choice.note {
             eprintln!("note: {note}");

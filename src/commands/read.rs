@@ -103,12 +103,10 @@ pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImag
     if let Some(out) = &args.out {
         use crate::report::output::same_file;
         // The profile's own files too: its background is the default reference.
-        let sensor_files = args.sensor.iter().flat_map(|s| {
-            [
-                s.clone(),
-                tactex_core::tactile::sensor_profile::SensorProfile::background_path(s),
-            ]
-        });
+        let sensor_files = args
+            .sensor
+            .iter()
+            .flat_map(|s| tactex_core::tactile::sensor_profile::SensorProfile::files(s));
         let inputs: Vec<PathBuf> = [args.image.clone()]
             .into_iter()
             .chain(args.reference.clone())

@@ -120,6 +120,8 @@ pub struct OutputDir {
     target: PathBuf,
     staging: PathBuf,
     finished: bool,
+    /// The command's input files, which no output may replace.
+    inputs: Vec<PathBuf>,
 }
 
 impl OutputDir {
@@ -150,7 +152,15 @@ impl OutputDir {
             target,
             staging,
             finished: false,
+            inputs: Vec::new(),
         })
+    }
+
+    /// Files the command reads (a sensor profile and its background, a mesh), which
+    /// `finish` refuses to replace: a profile kept in the output directory under an output's
+    /// name would be overwritten by it.
+    pub fn keep(&mut self, inputs: impl IntoIterator<Item = PathBuf>) {
+        self.inputs.extend(inputs);
     }
 
     /// Where the command writes its files until `finish`.
@@ -167,6 +177,14 @@ impl OutputDir {
                 format!("{} {}: cannot create", self.flag, self.target.display())
             })?;
         } else {
+            if let Some(dest) = first_input_replaced(&self.staging, &self.target, &self.inputs)? {
+                bail!(
+                    "{}: is one of this command's inputs, and {} {} would write over it; nothing was written",
+                    dest.display(),
+                    self.flag,
+                    self.target.display()
+                );
+            }
             if let Some((dest, is_dir)) = first_conflict(&self.staging, &self.target)? {
                 let (there, ours) = if is_dir {
                     ("a directory", "a file")
@@ -215,6 +233,27 @@ fn first_conflict(from: &Path, to: &Path) -> Result<Option<(PathBuf, bool)>> {
             }
         } else if there.is_dir() {
             return Ok(Some((dest, true)));
+        }
+    }
+    Ok(None)
+}
+
+/// The first file of `from` whose place in `to` is one of `inputs`.
+fn first_input_replaced(from: &Path, to: &Path, inputs: &[PathBuf]) -> Result<Option<PathBuf>> {
+    if inputs.is_empty() {
+        return Ok(None);
+    }
+    for entry in
+        std::fs::read_dir(from).with_context(|| format!("{}: cannot read", from.display()))?
+    {
+        let entry = entry?;
+        let dest = to.join(entry.file_name());
+        if entry.file_type()?.is_dir() {
+            if let Some(found) = first_input_replaced(&entry.path(), &dest, inputs)? {
+                return Ok(Some(found));
+            }
+        } else if inputs.iter().any(|i| same_file(i, &dest)) {
+            return Ok(Some(dest));
         }
     }
     Ok(None)

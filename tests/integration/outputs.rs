@@ -81,6 +81,40 @@ fn press_whose_output_file_is_a_directory_writes_nothing_and_the_retry_writes_al
 }
 
 #[test]
+fn press_into_the_directory_of_its_sensor_profile_does_not_write_over_the_profiles_files() {
+    // A profile kept in the output directory whose background is named as an output
+    // (reference.png): the press would have replaced it with its own rendered frame.
+    let tmp = tempfile::tempdir().unwrap();
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fots/profile");
+    let text = std::fs::read_to_string(fixture.join("fots-9.toml"))
+        .unwrap()
+        .replace("fots-9.background.png", "reference.png");
+    std::fs::write(tmp.path().join("p.toml"), text).unwrap();
+    let background = tmp.path().join("reference.png");
+    std::fs::copy(fixture.join("fots-9.background.png"), &background).unwrap();
+    let before = std::fs::read(&background).unwrap();
+    let profile = tmp.path().join("p.toml");
+    let mut args = PRESS[..PRESS.len() - 1].to_vec();
+    let out = tmp.path().to_str().unwrap();
+    args.extend(["--sensor", profile.to_str().unwrap(), "--out", out]);
+    let err = error_line(&tactex(&args));
+    assert!(
+        err.contains("reference.png: is one of this command's inputs"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(&background).unwrap(),
+        before,
+        "the background is intact"
+    );
+    assert_eq!(
+        entries(tmp.path()),
+        ["p.toml", "reference.png"],
+        "nothing written"
+    );
+}
+
+#[test]
 fn an_output_directory_another_tactex_writes_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("o");

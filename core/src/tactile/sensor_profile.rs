@@ -619,6 +619,25 @@ impl SensorProfile {
         path.with_file_name(format!("{stem}.background.png"))
     }
 
+    /// The files the profile at `path` is made of: itself, and the background image its
+    /// text names (when it names a file). Read loosely: for keeping outputs off them, not
+    /// for loading.
+    pub fn files(path: &Path) -> Vec<PathBuf> {
+        let background = std::fs::read_to_string(path)
+            .ok()
+            .and_then(|text| text.parse::<toml::Table>().ok())
+            .and_then(|t| {
+                t.get("optics")?
+                    .get("background")?
+                    .as_str()
+                    .filter(|name| *name != SYNTHETIC)
+                    .map(|name| path.parent().unwrap_or(Path::new("")).join(name))
+            });
+        std::iter::once(path.to_path_buf())
+            .chain(background)
+            .collect()
+    }
+
     /// Its name and the SHA-256 of its contents.
     pub fn id(&self) -> ProfileId {
         let mut h = Sha256::new();
