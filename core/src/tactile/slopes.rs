@@ -25,6 +25,22 @@ pub struct SlopeField {
     pub valid: Vec<bool>,
 }
 
+impl SlopeField {
+    /// An unread field on the 2 x 2 blocks of this one's frame: a block is readable where
+    /// all four of its pixels are.
+    fn halved(&self, half: &HalfResolution) -> SlopeField {
+        let n = half.coarse_width() * half.coarse_height();
+        SlopeField {
+            width: half.coarse_width(),
+            height: half.coarse_height(),
+            mm_per_px: 2.0 * self.mm_per_px,
+            gx: vec![0.0; n],
+            gy: vec![0.0; n],
+            valid: half.down_valid(&self.valid),
+        }
+    }
+}
+
 /// Below this sum of the three channels a pixel is a marker dot's, and carries no shading:
 /// 210 (70 grey levels a channel), or 0.45 of the no-contact frame's median where that is
 /// dimmer, since a dim sensor's lit gel itself sits near 70 (a dot takes 60-85% of the light
@@ -124,14 +140,7 @@ pub fn recover_slopes(
     let half = HalfResolution::of(w, h).filter(|_| 2.0 * spec.mm_per_px <= NOISE_SMOOTHING_MM);
     let (mut field, observed, glow) = match half {
         Some(half) => (
-            SlopeField {
-                width: half.coarse_width(),
-                height: half.coarse_height(),
-                mm_per_px: 2.0 * spec.mm_per_px,
-                gx: vec![0.0; half.coarse_width() * half.coarse_height()],
-                gy: vec![0.0; half.coarse_width() * half.coarse_height()],
-                valid: half.down_valid(&field.valid),
-            },
+            field.halved(&half),
             half.down(&observed),
             spec.glow.as_ref().map(GelGlow::at_half_resolution),
         ),
@@ -210,22 +219,13 @@ impl FirstReading {
         change: &[[f32; 3]],
         full: &SlopeField,
     ) -> Self {
-        let (cw, ch) = (half.coarse_width(), half.coarse_height());
-        let mm_per_px = 2.0 * full.mm_per_px;
+        let mut field = full.halved(half);
         let inverse = GlowInverse::shared(
             &glow.at_half_resolution(),
-            cw,
-            ch,
-            NOISE_SMOOTHING_MM / mm_per_px,
+            field.width,
+            field.height,
+            NOISE_SMOOTHING_MM / field.mm_per_px,
         );
-        let mut field = SlopeField {
-            width: cw,
-            height: ch,
-            mm_per_px,
-            gx: vec![0.0; cw * ch],
-            gy: vec![0.0; cw * ch],
-            valid: half.down_valid(&full.valid),
-        };
         read_table(table, &inverse.solve(&half.down(change)), &mut field);
         let depth: Vec<f32> = integrate_slopes(&field)
             .into_iter()
