@@ -58,17 +58,71 @@ pub fn tactile_frame_fault(decoded: &DynamicImage) -> Option<String> {
     }
     let frame = decoded.to_rgb8();
     let saturated = frame.pixels().filter(|p| p.0.contains(&255)).count();
-    (2 * saturated > frame.pixels().len()).then(|| {
-        format!(
+    if 2 * saturated > frame.pixels().len() {
+        return Some(format!(
             "{:.0}% of its pixels are saturated (255); a tactile frame this blown out carries no shading",
             100.0 * saturated as f64 / frame.pixels().len() as f64
+        ));
+    }
+    let spread = spread_grey(&frame);
+    (spread < MIN_SPREAD_GREY).then(|| {
+        format!(
+            "featureless (98% of its pixels within {spread} grey levels in every channel); a tactile frame shows its gel's shading and markers"
         )
     })
+}
+
+/// The dimmest, lowest-contrast sensor made (the synthetic dim-tinted profile's background)
+/// spans 16 grey levels between its 1st and 99th percentiles; a blank frame spans a camera's
+/// noise. A reading of a blank frame against a reference finds a deep imprint everywhere.
+const MIN_SPREAD_GREY: u8 = 4;
+
+/// The largest, over the three channels, of the span between the 1st and 99th percentile.
+fn spread_grey(frame: &image::RgbImage) -> u8 {
+    let n = frame.pixels().len();
+    (0..3)
+        .map(|c| {
+            let mut histogram = [0usize; 256];
+            for p in frame.pixels() {
+                histogram[p.0[c] as usize] += 1;
+            }
+            let level = |share: f64| {
+                let want = (share * n as f64) as usize;
+                let mut seen = 0;
+                histogram
+                    .iter()
+                    .position(|&k| {
+                        seen += k;
+                        seen > want
+                    })
+                    .unwrap_or(255) as u8
+            };
+            level(0.99) - level(0.01)
+        })
+        .max()
+        .unwrap_or(0)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_blank_frame_is_not_a_tactile_frame() {
+        let blank = DynamicImage::ImageRgb8(image::RgbImage::from_pixel(
+            64,
+            48,
+            image::Rgb([140, 120, 100]),
+        ));
+        let fault = tactile_frame_fault(&blank).unwrap();
+        assert!(fault.starts_with("featureless"), "{fault}");
+        // A dim, low-contrast gel (a 12-level vignette) is a frame.
+        let dim = image::RgbImage::from_fn(64, 48, |x, _| {
+            let v = 60 + (x * 12 / 63) as u8;
+            image::Rgb([v, v + 3, v + 6])
+        });
+        assert_eq!(tactile_frame_fault(&DynamicImage::ImageRgb8(dim)), None);
+    }
 
     #[test]
     fn an_image_claiming_more_pixels_than_any_sensor_is_refused_before_decoding() {

@@ -45,6 +45,19 @@ pub fn load(
     size: (u32, u32),
 ) -> Result<Vec<(BallPress, RgbImage)>> {
     super::file_input::present(annotations, "")?;
+    if annotations.is_dir() {
+        bail!(
+            "--annotations {}: is a directory; give the CSV of image,center_x_px,center_y_px,contact_radius_px",
+            annotations.display()
+        );
+    }
+    super::file_input::present(images, "")?;
+    if !images.is_dir() {
+        bail!(
+            "--images {}: not a directory; give the folder the annotations' images are in",
+            images.display()
+        );
+    }
     let presses = read_annotations(annotations)?;
     let mut out = Vec::new();
     for (k, press) in presses.into_iter().enumerate() {

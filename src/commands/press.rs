@@ -29,9 +29,10 @@ pub struct PressArgs {
     /// The object's shape.
     #[arg(long, value_enum)]
     shape: Shape,
-    /// Sphere radius (mm, above 0 up to 500).
-    #[arg(long, default_value_t = 10.0, value_parser = above(0.0, 500.0))]
-    radius_mm: f64,
+    /// Sphere radius (mm, above 0 up to 500; default 10); an ellipsoid or box without
+    /// --size-mm is a ball or cube of 2 radii.
+    #[arg(long, value_parser = above(0.0, 500.0))]
+    radius_mm: Option<f64>,
     /// Ellipsoid or box size X,Y,Z (mm, full extents, each above 0 up to 1000); default a
     /// cube or ball of 2 radii.
     #[arg(long, value_delimiter = ',', value_parser = above(0.0, 1000.0))]
@@ -46,9 +47,9 @@ pub struct PressArgs {
     /// Mesh file (.obj, .gltf, .glb) for --shape mesh, pressed at the middle of its top.
     #[arg(long)]
     mesh: Option<PathBuf>,
-    /// Mesh units to metres (scenes use metres; above 0 up to 1000).
-    #[arg(long, default_value_t = 1.0, value_parser = above(0.0, 1000.0))]
-    mesh_scale: f64,
+    /// Mesh units to metres for --mesh (scenes use metres; above 0 up to 1000; default 1).
+    #[arg(long, value_parser = above(0.0, 1000.0))]
+    mesh_scale: Option<f64>,
     /// Object hardness as in scene files: "35A", "55 00", "rigid".
     #[arg(long, conflicts_with = "modulus_mpa")]
     hardness: Option<String>,
@@ -105,8 +106,13 @@ pub struct PressArgs {
     json: bool,
 }
 
+/// Sphere radius when --radius-mm is not given (mm).
+const DEFAULT_RADIUS_MM: f64 = 10.0;
+
 fn shape(args: &PressArgs) -> Result<PressShape> {
-    let size = |default: f64| -> Result<[f64; 3]> {
+    refuse_unused_flags(args)?;
+    let radius_mm = args.radius_mm.unwrap_or(DEFAULT_RADIUS_MM);
+    let size = || -> Result<[f64; 3]> {
         match &args.size_mm {
             Some(v) => {
                 if v.len() != 3 {
@@ -114,27 +120,51 @@ fn shape(args: &PressArgs) -> Result<PressShape> {
                 }
                 Ok([v[0], v[1], v[2]])
             }
-            None => Ok([2.0 * default; 3]),
+            None => Ok([2.0 * radius_mm; 3]),
         }
     };
     Ok(match args.shape {
-        Shape::Sphere => PressShape::Sphere {
-            radius_mm: args.radius_mm,
-        },
-        Shape::Ellipsoid => PressShape::Ellipsoid {
-            size_mm: size(args.radius_mm)?,
-        },
-        Shape::Box => PressShape::Box {
-            size_mm: size(args.radius_mm)?,
-        },
+        Shape::Sphere => PressShape::Sphere { radius_mm },
+        Shape::Ellipsoid => PressShape::Ellipsoid { size_mm: size()? },
+        Shape::Box => PressShape::Box { size_mm: size()? },
         Shape::Mesh => PressShape::Mesh {
             path: args
                 .mesh
                 .clone()
                 .context("--shape mesh needs --mesh FILE")?,
-            scale: args.mesh_scale,
+            scale: args.mesh_scale.unwrap_or(1.0),
         },
     })
+}
+
+/// A size flag the chosen shape does not read would be dropped without a word, and the user
+/// would believe the press was of the object they described.
+fn refuse_unused_flags(args: &PressArgs) -> Result<()> {
+    let shape = match args.shape {
+        Shape::Sphere => "sphere",
+        Shape::Ellipsoid => "ellipsoid",
+        Shape::Box => "box",
+        Shape::Mesh => "mesh",
+    };
+    let given = [
+        ("--radius-mm", args.radius_mm.is_some()),
+        ("--size-mm", args.size_mm.is_some()),
+        ("--mesh", args.mesh.is_some()),
+        ("--mesh-scale", args.mesh_scale.is_some()),
+    ];
+    let used: &[&str] = match args.shape {
+        Shape::Sphere => &["--radius-mm"],
+        Shape::Ellipsoid | Shape::Box if args.size_mm.is_some() => &["--size-mm"],
+        Shape::Ellipsoid | Shape::Box => &["--radius-mm", "--size-mm"],
+        Shape::Mesh => &["--mesh", "--mesh-scale"],
+    };
+    if let Some((flag, _)) = given.iter().find(|(flag, on)| *on && !used.contains(flag)) {
+        bail!(
+            "{flag}: not read for --shape {shape}, which takes {}",
+            used.join(" or ")
+        );
+    }
+    Ok(())
 }
 
 fn object(args: &PressArgs) -> Result<Hardness> {
@@ -185,6 +215,14 @@ pub fn request(args: &PressArgs) -> Result<PressRequest> {
         spec.markers.rows = rows;
     }
     if let Some(pitch) = args.marker_pitch_mm {
+        let m = &spec.markers;
+        // Dots wider than their spacing would merge into one dark gel, not a grid.
+        if m.cols * m.rows > 0 && pitch <= 2.0 * m.radius_mm {
+            bail!(
+                "--marker-pitch-mm {pitch}: not over the markers' diameter ({:.3} mm); they would overlap",
+                2.0 * m.radius_mm
+            );
+        }
         spec.markers.pitch_mm = pitch;
     }
     if let Some(t) = args.gel_thickness_mm {

@@ -228,6 +228,76 @@ fn bad_press_input_is_one_clear_line_and_a_failure() {
             vec!["--shape", "sphere", "--depth-mm", "1", "--tolerance", "0"],
             "tolerance",
         ),
+        (
+            vec![
+                "--shape",
+                "sphere",
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "1",
+                "--marker-pitch-mm",
+                "1e-6",
+            ],
+            "--marker-pitch-mm 0.000001: not over the markers' diameter",
+        ),
+        // A size the shape does not read would press another object than the one described.
+        (
+            vec![
+                "--shape",
+                "sphere",
+                "--size-mm",
+                "3,3,3",
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "1",
+            ],
+            "--size-mm: not read for --shape sphere",
+        ),
+        (
+            vec![
+                "--shape",
+                "box",
+                "--size-mm",
+                "3,3,3",
+                "--radius-mm",
+                "2",
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "1",
+            ],
+            "--radius-mm: not read for --shape box",
+        ),
+        (
+            vec![
+                "--shape",
+                "ellipsoid",
+                "--mesh-scale",
+                "1e-9",
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "1",
+            ],
+            "--mesh-scale",
+        ),
+        (
+            vec![
+                "--shape",
+                "mesh",
+                "--mesh",
+                empty.to_str().unwrap(),
+                "--radius-mm",
+                "4",
+                "--hardness",
+                "30A",
+                "--depth-mm",
+                "1",
+            ],
+            "--radius-mm: not read for --shape mesh",
+        ),
     ];
     for (args, named) in cases {
         let mut all = vec!["press"];

@@ -169,6 +169,7 @@ fn bad_profiles_fail_in_one_line_naming_the_field() {
             "optics.table",
         ),
         ("cols = 9", "cols = \"nine\"", "line"),
+        ("cols = 9", "cols = 0", "markers"),
     ] {
         assert!(stock.contains(from), "{from}");
         let path = dir.path().join("bad.toml");

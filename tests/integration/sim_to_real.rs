@@ -379,6 +379,32 @@ fn calibrate_rejects_bad_input_in_one_line_and_writes_nothing() {
         assert!(!out.exists());
         assert!(!background_of_dir.exists(), "{err}");
     }
+    // The folder and the CSV swapped: the flag is named, not only the OS's error.
+    for (images, annotations, expect) in [
+        (&images, &images, "--annotations"),
+        (&good_csv, &good_csv, "--images"),
+    ] {
+        let run = tactex(&[
+            "calibrate",
+            "--images",
+            images.to_str().unwrap(),
+            "--annotations",
+            annotations.to_str().unwrap(),
+            "--background",
+            background.to_str().unwrap(),
+            "--ball-radius-mm",
+            "2.35",
+            "--mm-per-px",
+            MM_PER_PX,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!run.status.success());
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.starts_with(&format!("error: {expect} ")), "{err}");
+        assert!(!out.exists());
+    }
 }
 
 /// The real presses read through the fixture profile's table and glow, as the indentation
@@ -540,7 +566,11 @@ fn read_draws_the_indentation_map_and_refuses_a_frame_of_another_size() {
     assert_eq!(rgb(&copy), rgb(&frame));
     // A frame of the stock Mini's size through the FOTS profile: one line, nothing written.
     let small = dir.path().join("small.png");
-    RgbImage::new(320, 240).save(&small).unwrap();
+    RgbImage::from_fn(320, 240, |x, y| {
+        image::Rgb([(x / 2) as u8, (y / 2) as u8, 90])
+    })
+    .save(&small)
+    .unwrap();
     let out_png = dir.path().join("no.png");
     let out = tactex(&[
         "read",
@@ -561,10 +591,10 @@ fn read_draws_the_indentation_map_and_refuses_a_frame_of_another_size() {
 }
 
 /// Frames `read` cannot read are refused in one line naming the file or flag, and nothing is
-/// written: a greyscale frame (the shading is read from three channels), a blown-out
+/// written: a greyscale or blank frame (the shading is read from three channels), a blown-out
 /// reference, and a picture asked for under another format's name.
 #[test]
-fn read_refuses_a_greyscale_frame_a_blown_out_reference_and_a_jpg_name() {
+fn read_refuses_a_greyscale_or_blank_frame_a_blown_out_reference_and_a_jpg_name() {
     let f = fixtures();
     let dir = tempfile::tempdir().unwrap();
     // A copy of the profile: one case asks to draw over its background.
@@ -583,6 +613,11 @@ fn read_refuses_a_greyscale_frame_a_blown_out_reference_and_a_jpg_name() {
     RgbImage::from_pixel(w, h, image::Rgb([255, 255, 255]))
         .save(&white)
         .unwrap();
+    // A blank frame read against the gel's reference once read as a 2-6 mm imprint.
+    let blank = dir.path().join("blank.png");
+    RgbImage::from_pixel(w, h, image::Rgb([140, 120, 100]))
+        .save(&blank)
+        .unwrap();
     let out_png = dir.path().join("view.png");
     let out_jpg = dir.path().join("view.jpg");
     let frame = frame.to_str().unwrap();
@@ -595,6 +630,11 @@ fn read_refuses_a_greyscale_frame_a_blown_out_reference_and_a_jpg_name() {
         (
             vec![frame, "--reference", white.to_str().unwrap()],
             "--reference",
+            &out_png,
+        ),
+        (
+            vec![blank.to_str().unwrap()],
+            "blank.png: featureless",
             &out_png,
         ),
         (vec![frame], "--out", &out_jpg),

@@ -521,6 +521,15 @@ impl SensorProfile {
                 format!("{} x {} markers, at most 10000", m.cols, m.rows),
             );
         }
+        if (m.cols == 0) != (m.rows == 0) {
+            return bad(
+                "markers",
+                format!(
+                    "cols = {}, rows = {}: a grid has both, or both are 0 for none",
+                    m.cols, m.rows
+                ),
+            );
+        }
         if !(positive(m.pitch_mm)) {
             return bad("markers.pitch_mm", format!("{}, expected > 0", m.pitch_mm));
         }

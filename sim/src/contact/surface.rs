@@ -171,6 +171,16 @@ impl ObjectSurface {
         }
     }
 
+    /// Height of the widest section above the gel plane, where the model's lower half of a
+    /// sphere or ellipsoid ends; None for shapes held whole (a box's sides, a mesh's top).
+    pub fn equator_height_mm(&self) -> Option<f64> {
+        match self {
+            ObjectSurface::Sphere { radius_mm, .. } => Some(*radius_mm),
+            ObjectSurface::Ellipsoid { semi_axes_mm, .. } => Some(semi_axes_mm.z),
+            ObjectSurface::Box { .. } | ObjectSurface::Mesh(_) => None,
+        }
+    }
+
     /// Heights at the grid's cell centres (row-major; infinity where nothing is above).
     pub fn heights(&self, grid: &Grid) -> Vec<f64> {
         match self {

@@ -261,3 +261,31 @@ fn bad_input_is_refused_with_the_field_named() {
     );
     assert!("quantum".parse::<Fidelity>().is_err());
 }
+
+/// A 0.3 mm ball pressed 2 mm in would have the gel wrap its sides; the model holds its lower
+/// half, so the press is made but says where it stops being the object's, and a press that
+/// stays below the widest section says nothing.
+#[test]
+fn a_press_past_a_small_objects_widest_section_says_so() {
+    let ball = ObjectSurface::Sphere {
+        radius_mm: 0.3,
+        centre_mm: DVec2::ZERO,
+    };
+    let deep = ContactSolver::new()
+        .solve(&problem(&ball, None, 2.0), Fidelity::Layer)
+        .unwrap();
+    assert_finite(&deep);
+    assert!(
+        deep.warnings.iter().any(|w| w.contains("past its widest section")),
+        "{:?}",
+        deep.warnings
+    );
+    let shallow = ContactSolver::new()
+        .solve(&problem(&ball, None, 0.2), Fidelity::Layer)
+        .unwrap();
+    assert!(
+        !shallow.warnings.iter().any(|w| w.contains("widest")),
+        "{:?}",
+        shallow.warnings
+    );
+}
