@@ -160,13 +160,13 @@ impl ContactSolver {
             return Ok(ContactSolution::no_contact(problem, fidelity, warnings));
         }
         let approach = problem.approach_mm;
-        if let Some(equator) = problem.surface.equator_height_mm() {
-            if first + approach > equator {
-                warnings.push(format!(
-                    "the press reaches {:.3} mm up the object, past its widest section ({equator:.3} mm up): the gel would wrap its sides, which are not modelled, so the contact stops at its widest",
-                    first + approach
-                ));
-            }
+        if let Some(equator) = problem.surface.equator_height_mm()
+            && first + approach > equator
+        {
+            warnings.push(format!(
+                "the press reaches {:.3} mm up the object, past its widest section ({equator:.3} mm up): the gel would wrap its sides, which are not modelled, so the contact stops at its widest",
+                first + approach
+            ));
         }
         // Cells outside the pad have no gel under them.
         let pad = problem.pad;

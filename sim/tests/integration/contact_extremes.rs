@@ -276,7 +276,9 @@ fn a_press_past_a_small_objects_widest_section_says_so() {
         .unwrap();
     assert_finite(&deep);
     assert!(
-        deep.warnings.iter().any(|w| w.contains("past its widest section")),
+        deep.warnings
+            .iter()
+            .any(|w| w.contains("past its widest section")),
         "{:?}",
         deep.warnings
     );
