@@ -38,27 +38,29 @@ impl TriMesh {
         )
     }
 
-    /// Whether `p` lies inside the closed mesh: a vertical ray from it crosses the surface an
-    /// odd number of times. The ray is nudged off the axes so that it misses edges.
+    /// Whether `p` lies inside the mesh: its winding number, the solid angle its triangles
+    /// subtend over 4 pi, is at least a half (Jacobson et al., SIGGRAPH 2013). Unlike a ray's
+    /// parity it holds for meshes from scans and exporters: an open surface reads near 1
+    /// inside, a face stored twice counts twice, and either orientation reads the same.
     pub fn contains(&self, p: DVec3) -> bool {
-        let (x, y) = (p.x + 1.37e-9, p.y + 2.71e-9);
-        let mut crossings = 0;
-        for t in &self.triangles {
-            let [a, b, c] = t.map(|i| self.vertices[i as usize]);
-            let d = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-            if d.abs() < 1e-18 {
-                continue;
-            }
-            let u = ((x - a.x) * (c.y - a.y) - (c.x - a.x) * (y - a.y)) / d;
-            let v = ((b.x - a.x) * (y - a.y) - (x - a.x) * (b.y - a.y)) / d;
-            if u < 0.0 || v < 0.0 || u + v > 1.0 {
-                continue;
-            }
-            if a.z + u * (b.z - a.z) + v * (c.z - a.z) > p.z {
-                crossings += 1;
-            }
-        }
-        crossings % 2 == 1
+        self.winding_number(p).abs() >= 0.5
+    }
+
+    /// Sum of the signed solid angles of the triangles seen from `p`, over 4 pi (the formula of
+    /// Van Oosterom and Strackee, 1983).
+    fn winding_number(&self, p: DVec3) -> f64 {
+        let total: f64 = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.vertices[i as usize] - p);
+                let (la, lb, lc) = (a.length(), b.length(), c.length());
+                let det = a.dot(b.cross(c));
+                let div = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+                2.0 * det.atan2(div)
+            })
+            .sum();
+        total / (4.0 * std::f64::consts::PI)
     }
 
     /// Scales each axis so the bounding box is `size` and centres it at the origin.
@@ -507,7 +509,7 @@ fn gltf_node(
 mod tests {
 
     #[test]
-    fn a_point_is_inside_a_closed_mesh_by_the_parity_of_a_vertical_ray() {
+    fn a_point_is_inside_a_mesh_by_its_winding_number() {
         let ball = ellipsoid(DVec3::new(0.03, 0.02, 0.04));
         assert!(ball.contains(DVec3::ZERO));
         assert!(ball.contains(DVec3::new(0.025, 0.0, 0.0)));
@@ -517,6 +519,21 @@ mod tests {
         let cube = cuboid(DVec3::splat(0.02));
         assert!(cube.contains(DVec3::new(0.009, -0.009, 0.009)));
         assert!(!cube.contains(DVec3::new(0.011, 0.0, 0.0)));
+        // Exporters' meshes: faces stored twice, a face missing, the faces turned inside out.
+        let inside = DVec3::new(0.005, -0.004, 0.003);
+        let outside = DVec3::new(0.0, 0.0, 0.015);
+        let mut twice = cube.clone();
+        twice.triangles.extend(cube.triangles.clone());
+        let mut open = cube.clone();
+        open.triangles.truncate(open.triangles.len() - 2);
+        let mut turned = cube.clone();
+        for t in &mut turned.triangles {
+            t.swap(1, 2);
+        }
+        for (name, mesh) in [("twice", &twice), ("open", &open), ("turned", &turned)] {
+            assert!(mesh.contains(inside), "{name}");
+            assert!(!mesh.contains(outside), "{name}");
+        }
     }
 
     use super::*;
