@@ -219,6 +219,23 @@ impl HardnessEstimator for OnnxEstimator {
         &self.name
     }
 
+    fn cannot_read(&self, spec: &TactileSpec, frames: usize) -> Option<String> {
+        let last = *self.card.frame_picks.last().expect("checked at load");
+        if last >= frames {
+            return Some(format!(
+                "its card's frame_picks read press frame {} of {frames}",
+                last + 1
+            ));
+        }
+        let (w, h) = (self.card.width, self.card.height);
+        ((w, h) != (spec.width_px, spec.height_px)).then(|| {
+            format!(
+                "it reads {w} x {h} frames (its card's width, height) and the sensor makes {} x {}; a model for this sensor is trained on its frames (datagen tactile --sensor)",
+                spec.width_px, spec.height_px
+            )
+        })
+    }
+
     fn estimate(
         &self,
         press: &PressSequence,

@@ -79,9 +79,10 @@ impl EstimatorChoice {
         }
     }
 
-    /// Loads the estimator with its own intervals; `flag` names the option in errors.
-    pub fn open_uncalibrated(&self, flag: &str) -> Result<BoxedEstimator> {
-        Ok(match self {
+    /// Loads the estimator with its own intervals, checked to read `sensor`'s presses;
+    /// `flag` names the option in errors.
+    pub fn open_uncalibrated(&self, flag: &str, sensor: &SensorProfile) -> Result<BoxedEstimator> {
+        let estimator: BoxedEstimator = match self {
             Self::Learned => Box::new(tactex_learned::builtin::builtin_small()?),
             Self::Indentation => Box::new(IndentationEstimator::default()),
             Self::Hertz => Box::new(HertzSlopeEstimator::default()),
@@ -91,7 +92,16 @@ impl EstimatorChoice {
                 }
                 Box::new(tactex_learned::builtin::from_file(flag, path)?)
             }
-        })
+        };
+        let frames = tactex_core::press::protocol::PressProtocol::default().frames;
+        if let Some(why) = estimator.cannot_read(&sensor.spec, frames) {
+            bail!(
+                "{flag} {}: cannot read the presses of {}: {why}",
+                self.flag_value(),
+                sensor.id()
+            );
+        }
+        Ok(estimator)
     }
 
     /// Loads the estimator with calibrated intervals: from `intervals` (a file `eval fruits
@@ -106,10 +116,11 @@ impl EstimatorChoice {
         flag: &str,
         fidelity: &str,
         intervals: Option<&Path>,
-        sensor: &ProfileId,
+        sensor: &SensorProfile,
         profile: Option<&Path>,
     ) -> Result<BoxedEstimator> {
-        let inner = self.open_uncalibrated(flag)?;
+        let inner = self.open_uncalibrated(flag, sensor)?;
+        let sensor = &sensor.id();
         let calibration = match intervals {
             Some(path) => {
                 Some(self.measured_intervals(path, "--intervals", inner.name(), sensor)?)
@@ -325,9 +336,11 @@ mod tests {
         // Measured through the built-in Mini (or the profile before an edit): not used.
         std::fs::write(&beside, through(None)).expect("written");
         assert!(found().is_none());
-        // Given as --intervals, the same file is refused outright.
+        // Given as --intervals through another sensor, a file is refused outright.
+        std::fs::write(&beside, through(Some(mine.clone()))).expect("written");
+        let mini = SensorProfile::gelsight_mini();
         let e = choice
-            .open("--estimator", "layer", Some(&beside), &mine, Some(&profile))
+            .open("--estimator", "layer", Some(&beside), &mini, None)
             .err()
             .expect("refused");
         assert!(

@@ -40,7 +40,7 @@ pub fn answer_on_hardware(
         "--estimator",
         Fidelity::Layer.name(),
         twin.intervals.as_deref(),
-        &sensor.id(),
+        &sensor,
         twin.sensor.as_deref(),
     )?;
     // The sensors first, so that a missing camera never leaves the arm enabled.

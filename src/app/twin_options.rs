@@ -77,6 +77,13 @@ pub struct OpenedTwin {
 impl TwinOptions {
     pub fn open(&self) -> Result<OpenedTwin> {
         let sensor = load_sensor(self.sensor.as_deref())?;
+        let estimator = self.estimator.open(
+            "--estimator",
+            self.fidelity.name(),
+            self.intervals.as_deref(),
+            &sensor,
+            self.sensor.as_deref(),
+        )?;
         if let (Some(profile), None) = (&self.sensor, &self.intervals)
             && let Some(note) = self
                 .estimator
@@ -88,13 +95,7 @@ impl TwinOptions {
             detector: DetectorChoice::parse(&self.detector)?,
             renderer: scene_renderer(self.device)?,
             explainer: explainer(self.explainer, self.llm_config.as_ref())?,
-            estimator: self.estimator.open(
-                "--estimator",
-                self.fidelity.name(),
-                self.intervals.as_deref(),
-                &sensor.id(),
-                self.sensor.as_deref(),
-            )?,
+            estimator,
             fidelity: self.fidelity,
             sensor,
         })

@@ -108,7 +108,7 @@ pub fn run(args: &AskBenchArgs) -> Result<()> {
             "--estimator",
             fidelity.name(),
             None,
-            &sensor.id(),
+            &sensor,
             args.sensor.as_deref(),
         )?;
         estimator_name = estimator.name().to_string();

@@ -552,12 +552,12 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
     let sensor_id = sensor.id();
     let estimator = match &args.calibrate {
         // The residuals do not depend on the intervals; the file is for new presses.
-        Some(_) => args.estimator.open_uncalibrated("--estimator")?,
+        Some(_) => args.estimator.open_uncalibrated("--estimator", &sensor)?,
         None => args.estimator.open(
             "--estimator",
             fidelity,
             args.intervals.as_deref(),
-            &sensor_id,
+            &sensor,
             args.sensor.as_deref(),
         )?,
     };

@@ -150,7 +150,7 @@ pub fn run(args: &RipenessEvalArgs) -> Result<()> {
         "--estimator",
         fidelity.name(),
         None,
-        &profile.id(),
+        &profile,
         args.sensor.as_deref(),
     )?;
     // The sensor as it is, unrandomised: a lab's validation run on one sensor.

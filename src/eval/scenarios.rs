@@ -543,7 +543,7 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
         "--estimator",
         args.fidelity.name(),
         None,
-        &sensor.id(),
+        &sensor,
         args.sensor.as_deref(),
     )?;
     let scenarios = tiers

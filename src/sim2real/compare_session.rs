@@ -450,7 +450,7 @@ pub fn compare_session(args: &SessionCompare) -> Result<SessionComparison> {
         "--estimator",
         args.fidelity.name(),
         None,
-        &sensor.id(),
+        &sensor,
         args.sensor,
     )?;
     let mut sim = SimDevices::with_sensor(&scene, seed, sensor.clone(), args.fidelity)

@@ -455,3 +455,25 @@ fn calibrating_the_twins_own_mini_gives_the_mini_back() {
         "the bare background scores {bare}, the presses {mae}"
     );
 }
+
+/// A model reads one frame size: through a profile of another (the FOTS profile's 240 x 320
+/// against the built-in model's 320 x 240) every fruit came back not measured after all the
+/// presses were made. It is refused when chosen, naming the flag and both sizes.
+#[test]
+fn a_model_for_another_frame_size_is_refused_before_any_press() {
+    let profile = fixtures().join("profile/fots-9.toml");
+    let err = one_line_error(&tactex(&[
+        "ask",
+        "How hard is the lime?",
+        "--estimator",
+        "learned",
+        "--sensor",
+        profile.to_str().unwrap(),
+    ]));
+    assert!(
+        err.contains("--estimator learned")
+            && err.contains("reads 320 x 240 frames")
+            && err.contains("makes 240 x 320"),
+        "{err}"
+    );
+}

@@ -169,6 +169,13 @@ pub trait HardnessEstimator: Send + Sync {
         press: &PressSequence,
         spec: &TactileSpec,
     ) -> Result<HardnessEstimate, EstimateError>;
+
+    /// Why this estimator cannot read the presses of `spec`'s sensor, `frames` long, if it
+    /// cannot: a learned model reads one frame size and its picked frames. Asked when the
+    /// estimator is chosen, so a mismatch fails before any press is made.
+    fn cannot_read(&self, _spec: &TactileSpec, _frames: usize) -> Option<String> {
+        None
+    }
 }
 
 /// A boxed estimator estimates as the one inside (the binary picks one at run time).
@@ -183,6 +190,10 @@ impl<T: HardnessEstimator + ?Sized> HardnessEstimator for Box<T> {
         spec: &TactileSpec,
     ) -> Result<HardnessEstimate, EstimateError> {
         (**self).estimate(press, spec)
+    }
+
+    fn cannot_read(&self, spec: &TactileSpec, frames: usize) -> Option<String> {
+        (**self).cannot_read(spec, frames)
     }
 }
 

@@ -375,6 +375,10 @@ impl<E: HardnessEstimator> HardnessEstimator for Calibrated<E> {
         }
         Ok(estimate)
     }
+
+    fn cannot_read(&self, spec: &TactileSpec, frames: usize) -> Option<String> {
+        self.inner.cannot_read(spec, frames)
+    }
 }
 
 #[cfg(test)]
