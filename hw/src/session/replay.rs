@@ -68,7 +68,23 @@ pub fn open_session(
         .chain(manifest.tactile.frames.iter().map(|f| &f.image));
     for file in files {
         let p = dir.join(file);
-        if Path::new(file).is_absolute() || file.contains("..") || !p.is_file() {
+        let outside = Path::new(file).is_absolute()
+            || Path::new(file)
+                .components()
+                .any(|c| matches!(c, std::path::Component::ParentDir));
+        if outside {
+            // A session is one folder: a recording never points out of it, so a path that
+            // does is refused whatever it names, and the file is not looked at.
+            return Err(SessionError::Field {
+                path: path.clone(),
+                field: "frames".into(),
+                message: format!(
+                    "'{}' lies outside the session folder; a session's files are named relative to it, without '..'",
+                    tactex_core::printable::printable(file)
+                ),
+            });
+        }
+        if !p.is_file() {
             return Err(SessionError::file(&p, "listed in the manifest but missing"));
         }
     }

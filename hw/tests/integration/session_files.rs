@@ -166,3 +166,29 @@ fn replayed_devices_give_back_what_was_recorded_and_refuse_the_rest() {
     assert!(err.to_string().contains("has 2 tactile frames"), "{err}");
     assert!(c.capture().is_err());
 }
+
+/// A manifest naming a file out of its folder (`../../etc/passwd`) is refused for that
+/// reason, not reported as a missing frame.
+#[test]
+fn a_manifest_pointing_out_of_its_session_is_refused_for_that() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let (mut cam, mut tac, mut arm) = devices();
+    let recorder = SessionRecorder::create(&dir).unwrap();
+    {
+        recorder.camera(&mut cam).capture().unwrap();
+        recorder.tactile(&mut tac).capture().unwrap();
+        recorder.arm(&mut arm).unwrap();
+    }
+    recorder.finish("test", "How hard is it?", None).unwrap();
+    let manifest = dir.join("manifest.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&manifest).unwrap()).unwrap();
+    m["tactile"]["frames"][0]["image"] = "../../../../etc/passwd".into();
+    std::fs::write(&manifest, m.to_string()).unwrap();
+    let err = open_session(&dir).err().expect("refused").to_string();
+    assert!(
+        err.contains("manifest.json") && err.contains("lies outside the session folder"),
+        "{err}"
+    );
+}
