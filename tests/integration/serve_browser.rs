@@ -60,4 +60,37 @@ fn the_page_shows_the_live_view_the_answer_and_the_tactile_frames() {
     let shot = image::open(&screenshot).expect("a screenshot PNG");
     assert!(shot.width() >= 1000 && shot.height() >= 600);
     eprintln!("screenshot: {}", screenshot.display());
+    readme_screenshot_shows(&report["answer"], &screenshot);
+}
+
+/// README shows this test's screenshot, and beside it the answer the page gave then. The
+/// answer is deterministic (the built-in scene and seed), so when the twin's answer changes
+/// the stored one no longer matches and the test fails until the screenshot is made again:
+/// `TACTEX_BLESS=1 cargo test --test integration serve_browser -- --include-ignored`
+/// (the latency figures in it are the machine's of that run).
+fn readme_screenshot_shows(answer: &serde_json::Value, screenshot: &Path) {
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/results/serve");
+    let stored = docs.join("screenshot.json");
+    let now = serde_json::json!({ "question": "Which fruit is the softest?", "answer": answer });
+    if std::env::var_os("TACTEX_BLESS").is_some() {
+        // Three quarters of the page's width keeps README's image readable and its file small.
+        let shot = image::open(screenshot).expect("a screenshot PNG");
+        shot.resize(
+            shot.width() * 3 / 4,
+            shot.height() * 3 / 4,
+            image::imageops::FilterType::Triangle,
+        )
+        .save(docs.join("screenshot.png"))
+        .expect("writes the screenshot");
+        std::fs::write(&stored, format!("{:#}\n", now)).expect("writes the answer");
+        return;
+    }
+    let then: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(&stored).expect("docs/results/serve/screenshot.json"),
+    )
+    .expect("JSON");
+    assert_eq!(
+        then, now,
+        "README's screenshot (docs/results/serve) shows another answer than the page gives now; make it again with TACTEX_BLESS=1 (see this test's doc)"
+    );
 }
