@@ -15,6 +15,7 @@ mod input_bounds;
 mod numeric_flags;
 mod outputs;
 mod press;
+mod qa_corpus;
 mod sensor_profile;
 mod serve;
 mod serve_browser;
