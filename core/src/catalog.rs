@@ -33,6 +33,9 @@ pub struct FruitSpec {
     pub plural: String,
     #[serde(default)]
     pub synonyms: Vec<String>,
+    /// The kitchen's groups it belongs to (`CategorySpec::name`): "citrus", "stone fruit".
+    #[serde(default)]
+    pub categories: Vec<String>,
     pub shape: FruitShape,
     pub size_m: [f64; 3],
     pub poisson: f64,
@@ -81,14 +84,26 @@ pub enum CatalogError {
     },
 }
 
+/// A group of fruit a question may name ("the citrus fruits"), and the words that name it:
+/// one to three lower-case words each ("stone fruit").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CategorySpec {
+    pub name: String,
+    pub words: Vec<String>,
+}
+
 #[derive(Clone, Debug, Deserialize)]
 struct CatalogFile {
     fruit: Vec<FruitSpec>,
+    #[serde(default)]
+    category: Vec<CategorySpec>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FruitCatalog {
     pub fruits: Vec<FruitSpec>,
+    pub categories: Vec<CategorySpec>,
 }
 
 impl FruitCatalog {
@@ -145,8 +160,63 @@ impl FruitCatalog {
             if f.stages.last().is_some_and(|s| s.threshold_mpa != 0.0) {
                 return Err(bad("the softest stage's threshold_mpa must be 0".into()));
             }
+            if let Some(c) = f
+                .categories
+                .iter()
+                .find(|c| !file.category.iter().any(|k| &k.name == *c))
+            {
+                return Err(bad(format!(
+                    "categories: '{c}' is not a [[category]] of the catalog"
+                )));
+            }
         }
-        Ok(Self { fruits: file.fruit })
+        for c in &file.category {
+            let bad = |message: String| CatalogError::Malformed {
+                path: path.into(),
+                message: format!("category '{}': {message}", c.name),
+            };
+            if c.words.is_empty() {
+                return Err(bad("words: none".into()));
+            }
+            for w in &c.words {
+                let parts: Vec<&str> = w.split(' ').collect();
+                let plain = |p: &&str| !p.is_empty() && p.chars().all(|ch| ch.is_ascii_lowercase());
+                if parts.len() > 3 || !parts.iter().all(plain) {
+                    return Err(bad(format!(
+                        "words: '{w}' must be one to three lower-case words"
+                    )));
+                }
+                if file.fruit.iter().any(|f| f.answers_to(w)) {
+                    return Err(bad(format!("words: '{w}' names a fruit")));
+                }
+            }
+        }
+        Ok(Self {
+            fruits: file.fruit,
+            categories: file.category,
+        })
+    }
+
+    /// The category named by the words at the start of `words`, and how many words name it:
+    /// the longest phrase that matches ("citrus fruits" before "citrus").
+    pub fn category_at(&self, words: &[&str]) -> Option<(&CategorySpec, usize)> {
+        self.categories
+            .iter()
+            .flat_map(|c| c.words.iter().map(move |w| (c, w)))
+            .filter_map(|(c, w)| {
+                let n = w.split(' ').count();
+                (words.len() >= n && words[..n].join(" ") == *w).then_some((c, n))
+            })
+            .max_by_key(|(_, n)| *n)
+    }
+
+    /// The names of the fruit in a category, in catalog order.
+    pub fn members(&self, category: &str) -> Vec<String> {
+        self.fruits
+            .iter()
+            .filter(|f| f.categories.iter().any(|c| c == category))
+            .map(|f| f.name.clone())
+            .collect()
     }
 
     pub fn get(&self, name: &str) -> Option<&FruitSpec> {
@@ -182,6 +252,10 @@ mod tests {
         assert_eq!(banana.stage("ripe").unwrap().modulus_mpa, 0.8);
         assert_eq!(banana.stage("unripe").unwrap().modulus_mpa, 2.5);
         assert_eq!(c.find_word("tomatoes").unwrap().name, "tomato");
+        assert_eq!(c.members("citrus"), ["lime", "lemon", "orange"]);
+        let (stone, n) = c.category_at(&["stone", "fruits", "please"]).unwrap();
+        assert_eq!((stone.name.as_str(), n), ("stone fruit", 2));
+        assert!(c.category_at(&["stone"]).is_none());
     }
 
     #[test]

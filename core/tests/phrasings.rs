@@ -70,6 +70,7 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     let mut count = None;
     let mut ranked = false;
     let mut unknown = Vec::new();
+    let mut categories: Vec<String> = Vec::new();
     for pair in extras.split(' ').filter(|p| !p.is_empty()) {
         // A word without '=' continues a two-word position.
         let Some((key, value)) = pair.split_once('=') else {
@@ -82,6 +83,8 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
             "ranked" => ranked = value == "true",
             "unknown" => unknown.push(value.to_string()),
             "position" => position = Some(value.to_string()),
+            // A group's name may take two words ("stone fruit"), written with '_'.
+            "category" => categories.push(value.replace('_', " ")),
             other => panic!("phrasings.tsv: extra {other:?}"),
         }
     }
@@ -113,6 +116,12 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     }
     if query.ranked != ranked {
         wrong.push(format!("ranked {}, expected {ranked}", query.ranked));
+    }
+    let got_categories: Vec<&str> = query.categories.iter().map(|c| c.name.as_str()).collect();
+    if got_categories != categories {
+        wrong.push(format!(
+            "categories {got_categories:?}, expected {categories:?}"
+        ));
     }
     if query.unknown != unknown {
         wrong.push(format!("unknown {:?}, expected {unknown:?}", query.unknown));

@@ -122,7 +122,7 @@ pub fn explain(
     // Named kinds that are missing get their own sentence below; only a question about every
     // fruit (perhaps of a colour or place) is answered with "none".
     if objects.is_empty() && missing.is_empty() {
-        let mut which = String::from("fruit");
+        let mut which = query.asked_kind();
         if let Some(c) = &query.filters.color {
             which = format!("{c} {which}");
         }
@@ -141,11 +141,7 @@ pub fn explain(
                 (Property::Ripeness, Some(Extreme::Least)) => "least ripe",
                 (Property::Ripeness, _) => "ripest",
             };
-            let kind = if query.all || query.targets.is_empty() {
-                "fruit".to_string()
-            } else {
-                query.targets.join(" or ")
-            };
+            let kind = query.asked_kind();
             parts.push(format!(
                 "The {word} {kind} is {}.",
                 describe(&objects[selected[0]])
@@ -211,7 +207,7 @@ pub fn explain(
     }
     // A fruit that was found but could not be pressed is said so, with why, once.
     for (i, m) in objects.iter().enumerate() {
-        let asked = query.all || query.targets.is_empty() || query.targets.contains(&m.label);
+        let asked = query.wants(&m.label);
         if m.hardness.is_none() && asked && !selected.contains(&i) {
             parts.push(capitalise(&format!("{}.", describe(m))));
         }

@@ -151,6 +151,8 @@ pub const PHRASES: &[(&str, &str)] = &[
     ("apart from", "except"),
     ("but not", "except"),
     ("leaving out", "except"),
+    ("not counting", "except"),
+    ("not including", "except"),
     ("with the exception of", "except"),
     ("in the middle", "centre"),
     ("in front", "front"),

@@ -46,6 +46,25 @@ pub struct Filters {
     pub count: Option<usize>,
 }
 
+/// A group of the catalog the prompt names ("the citrus fruits"), with its kinds.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CategoryFilter {
+    pub name: String,
+    /// Catalog names (singular) of its kinds.
+    pub members: Vec<String>,
+}
+
+impl CategoryFilter {
+    /// How an answer names one of the group: "citrus fruit", "stone fruit", "berry".
+    pub fn noun(&self) -> String {
+        if self.name.ends_with("fruit") || self.name == "berry" {
+            self.name.clone()
+        } else {
+            format!("{} fruit", self.name)
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Query {
     pub intent: Intent,
@@ -53,6 +72,9 @@ pub struct Query {
     pub extreme: Option<Extreme>,
     /// Catalog names (singular) the prompt names, in the order named.
     pub targets: Vec<String>,
+    /// Groups of the catalog the prompt names ("citrus"): their kinds are asked about as the
+    /// targets are.
+    pub categories: Vec<CategoryFilter>,
     /// The prompt is about every fruit on the table ("which fruit", "all fruits"), or every
     /// one the filters keep.
     pub all: bool,
@@ -149,6 +171,9 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let has = |set: &[&str]| words.iter().any(|w| set.contains(&w.as_str()));
 
     let mut targets: Vec<String> = Vec::new();
+    let mut categories: Vec<CategoryFilter> = Vec::new();
+    // Words already read as part of a category's phrase ("stone fruits").
+    let mut consumed_until = 0;
     let mut exclude: Vec<String> = Vec::new();
     let mut unknown: Vec<String> = Vec::new();
     let mut filters = Filters::default();
@@ -163,8 +188,31 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     for (i, w) in words.iter().enumerate() {
         let w = w.as_str();
         let prev = if i > 0 { at(i - 1) } else { None };
+        if i < consumed_until {
+            continue;
+        }
         if lexicon::EXCLUDING.contains(&w) {
             excluding = true;
+            continue;
+        }
+        let rest: Vec<&str> = words[i..].iter().take(3).map(String::as_str).collect();
+        if let Some((category, n)) = catalog.category_at(&rest) {
+            consumed_until = i + n;
+            let members = catalog.members(&category.name);
+            if excluding {
+                for m in members {
+                    if !exclude.contains(&m) {
+                        exclude.push(m);
+                    }
+                }
+            } else if !categories.iter().any(|c| c.name == category.name) {
+                categories.push(CategoryFilter {
+                    name: category.name.clone(),
+                    members,
+                });
+            }
+            let last = rest[n - 1];
+            plural |= !excluding && last.ends_with('s') && !last.ends_with("us");
             continue;
         }
         if lexicon::COLOURS.contains(&w) {
@@ -264,7 +312,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let known = || catalog.names().join(", ");
     let filtered = filters.color.is_some() || filters.position.is_some();
     let all = generic || !exclude.is_empty() || (targets.is_empty() && filtered);
-    if targets.is_empty() && !all {
+    if targets.is_empty() && categories.is_empty() && !all {
         return Err(match unknown.first() {
             Some(name) => QueryError::UnknownFruit {
                 name: name.clone(),
@@ -330,6 +378,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         property,
         extreme,
         targets,
+        categories,
         all,
         exclude,
         filters,
@@ -358,8 +407,25 @@ fn position_phrase(positions: &[&str]) -> Option<String> {
 impl Query {
     /// Whether an object with this label is among those the query asks about.
     pub fn wants(&self, label: &str) -> bool {
-        !self.exclude.iter().any(|e| e == label)
-            && (self.all || self.targets.iter().any(|t| t == label))
+        let named = self.targets.iter().any(|t| t == label);
+        let grouped = self
+            .categories
+            .iter()
+            .any(|c| c.members.iter().any(|m| m == label));
+        // A group bounds "all": "of all the fruit, which citrus is softest" is about the citrus.
+        let every = self.all && self.categories.is_empty();
+        !self.exclude.iter().any(|e| e == label) && (every || named || grouped)
+    }
+
+    /// How the answer names what was asked about: "fruit", "citrus fruit", "lime or lemon".
+    pub fn asked_kind(&self) -> String {
+        let mut kinds = self.targets.clone();
+        kinds.extend(self.categories.iter().map(CategoryFilter::noun));
+        if kinds.is_empty() || (self.all && self.categories.is_empty()) {
+            "fruit".into()
+        } else {
+            kinds.join(" or ")
+        }
     }
 }
 
@@ -761,5 +827,51 @@ mod tests {
             (query.targets.clone(), query.unknown.clone()),
             (names(&["kiwi"]), names(&["grape"]))
         );
+    }
+
+    #[test]
+    fn a_category_of_the_catalog_asks_about_its_kinds() {
+        let citrus = q("Sort the citrus fruits by how soft they are");
+        assert_eq!(
+            (citrus.intent, citrus.property, citrus.ranked),
+            (Intent::Summarize, Property::Softness, true)
+        );
+        assert_eq!(citrus.categories.len(), 1);
+        assert_eq!(
+            citrus.categories[0].members,
+            names(&["lime", "lemon", "orange"])
+        );
+        assert!(citrus.wants("lemon") && !citrus.wants("apple"));
+        assert_eq!(citrus.asked_kind(), "citrus fruit");
+
+        let stone = q("Which stone fruit is the softest?");
+        assert_eq!(
+            (stone.intent, stone.extreme),
+            (Intent::Extreme, Some(Extreme::Most))
+        );
+        assert!(stone.wants("peach") && stone.wants("mango") && !stone.wants("lime"));
+        assert_eq!(stone.asked_kind(), "stone fruit");
+
+        // "of all the fruit" does not widen a group.
+        let of_all = q("Of all the fruits, which tropical one is the hardest?");
+        assert!(
+            of_all.wants("banana") && !of_all.wants("apple"),
+            "{of_all:?}"
+        );
+
+        assert_eq!(q("How ripe are the berries?").intent, Intent::Summarize);
+
+        let but = q("Which fruit is the softest, except the citrus?");
+        assert!(but.categories.is_empty());
+        assert_eq!(but.exclude, names(&["lime", "lemon", "orange"]));
+        assert!(but.wants("apple") && !but.wants("orange"));
+
+        // A fruit whose name holds a group's word is the fruit.
+        let straw = q("Is the strawberry softer than the apple?");
+        assert_eq!(
+            (straw.intent, straw.targets.clone()),
+            (Intent::Compare, names(&["strawberry", "apple"]))
+        );
+        assert!(straw.categories.is_empty());
     }
 }
