@@ -3,7 +3,7 @@
 
 use clap::Parser;
 use std::process::ExitCode;
-use tactex::cli::{Cli, Command, error_line, process};
+use tactex::cli::{Cli, Command, error_line, process, usage_error_line};
 
 // Frames, fields and FFT scratch are allocated and freed by the hundred per press; glibc
 // returns blocks this size to the kernel on every free and faults them back in, which cost
@@ -15,15 +15,23 @@ fn main() -> ExitCode {
     process::ensure_runtime_dir();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        // A value out of its flag's range is a bad value like any other: one line, exit 1.
-        Err(e) if e.kind() == clap::error::ErrorKind::ValueValidation => {
-            let text = e.render().to_string();
-            let line = text.lines().next().unwrap_or("error: invalid value");
-            // clap quotes the value as given: escape codes and bidirectional overrides shown.
-            eprintln!("{}", tactex_core::printable::printable(line));
+        // Help and the version are what was asked for.
+        Err(e)
+            if matches!(
+                e.kind(),
+                clap::error::ErrorKind::DisplayHelp
+                    | clap::error::ErrorKind::DisplayVersion
+                    | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) =>
+        {
+            e.exit()
+        }
+        // A bad value, a flag missing or in conflict: bad input like any other, one line
+        // (clap quotes values as given: escape codes and bidirectional overrides shown).
+        Err(e) => {
+            eprintln!("{}", usage_error_line(&e));
             return ExitCode::FAILURE;
         }
-        Err(e) => e.exit(),
     };
     if !matches!(cli.command, Command::Serve(_) | Command::Twin(_)) {
         process::quiet_on_closed_pipe();

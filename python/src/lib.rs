@@ -69,13 +69,11 @@ fn parse(argv: Vec<String>) -> PyResult<Command> {
     let all = std::iter::once("tactex".to_string()).chain(argv);
     match Cli::try_parse_from(all) {
         Ok(cli) => Ok(cli.command),
-        Err(e) => {
-            let text = e.render().to_string();
-            let line = text.lines().next().unwrap_or("invalid arguments");
-            Err(PyValueError::new_err(
-                line.trim_start_matches("error: ").to_string(),
-            ))
-        }
+        Err(e) => Err(PyValueError::new_err(
+            tactex::cli::usage_error_line(&e)
+                .trim_start_matches("error: ")
+                .to_string(),
+        )),
     }
 }
 

@@ -173,7 +173,33 @@ impl TriMesh {
         if area <= 0.0 {
             return Err(bad("zero surface area"));
         }
+        let open = self.open_edges();
+        if open > 0 {
+            return Err(bad(&format!(
+                "the surface is open: {open} edges border one triangle only; a solid's mesh is closed (fill its holes)"
+            )));
+        }
         Ok(())
+    }
+
+    /// Edges that border one triangle only, vertices taken by position (exporters split a
+    /// vertex where its normals or texture coordinates change). A gap there lets the gel
+    /// reach inside: a cube missing its top was pressed on its floor, at no force.
+    fn open_edges(&self) -> usize {
+        let key = |i: u32| self.vertices[i as usize].to_array().map(f64::to_bits);
+        let mut edges: std::collections::HashMap<_, usize> = std::collections::HashMap::new();
+        for t in &self.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                let (a, b) = (key(a), key(b));
+                if a == b {
+                    continue;
+                }
+                *edges
+                    .entry(if a < b { (a, b) } else { (b, a) })
+                    .or_default() += 1;
+            }
+        }
+        edges.values().filter(|&&n| n == 1).count()
     }
 }
 
@@ -583,5 +609,18 @@ mod tests {
                 .starts_with(&garbage.display().to_string())
         );
         assert!(load(&dir.path().join("missing.obj")).is_err());
+        // A cube without its top: the gel reached its floor and read no force.
+        let cube = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n\
+            f 1 3 2\nf 2 3 4\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\n";
+        let open = dir.path().join("open.obj");
+        std::fs::write(&open, cube).unwrap();
+        let e = load(&open).unwrap_err().to_string();
+        assert!(
+            e.contains("open.obj") && e.contains("the surface is open: 4 edges"),
+            "{e}"
+        );
+        let closed = dir.path().join("closed.obj");
+        std::fs::write(&closed, format!("{cube}f 5 6 8\nf 5 8 7\n")).unwrap();
+        assert!(load(&closed).is_ok());
     }
 }

@@ -214,9 +214,58 @@ pub fn error_line(e: &anyhow::Error) -> String {
     tactex_core::printable::printable(&line)
 }
 
+/// A command-line parse error as one line: its first paragraph, whose lines (a list of the
+/// required flags not given) are joined, without the usage that follows; escapes shown.
+pub fn usage_error_line(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let first: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.trim().is_empty())
+        .map(str::trim)
+        .collect();
+    let line = if first.is_empty() {
+        "error: invalid arguments".to_string()
+    } else {
+        first.join(" ")
+    };
+    tactex_core::printable::printable(&line)
+}
+
 #[cfg(test)]
 mod tests {
     use super::error_line;
+
+    #[test]
+    fn a_parse_error_is_one_line_naming_the_flags() {
+        use clap::Parser;
+        let missing = crate::cli::Cli::try_parse_from(["tactex", "contact", "frame.png"])
+            .err()
+            .expect("--reference is required");
+        let line = super::usage_error_line(&missing);
+        assert!(
+            line.starts_with("error: ") && line.contains("--reference") && !line.contains('\n'),
+            "{line}"
+        );
+        let conflict = crate::cli::Cli::try_parse_from([
+            "tactex",
+            "press",
+            "--shape",
+            "sphere",
+            "--depth-mm",
+            "1",
+            "--hardness",
+            "35A",
+            "--modulus-mpa",
+            "2",
+        ])
+        .err()
+        .expect("conflicting flags");
+        let line = super::usage_error_line(&conflict);
+        assert!(
+            line.contains("--modulus-mpa") && !line.contains("Usage"),
+            "{line}"
+        );
+    }
 
     #[test]
     fn an_error_line_says_each_cause_once_and_shows_control_characters() {

@@ -2,8 +2,8 @@
 //! paper's contact criterion against a no-contact frame, and the contact circle and region.
 
 use crate::app::flag_range::above;
-use crate::app::load_rgb;
-use anyhow::{Result, bail};
+use crate::app::load_tactile_frame;
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -42,8 +42,8 @@ struct ContactReport {
 
 pub fn run(args: &ContactArgs) -> Result<()> {
     let mm_per_px = args.mm_per_px;
-    let image = load_rgb(&args.image)?;
-    let reference = load_rgb(&args.reference)?;
+    let image = load_tactile_frame(&args.image)?;
+    let reference = load_tactile_frame(&args.reference).context("--reference")?;
     if reference.dimensions() != image.dimensions() {
         bail!(
             "{}: {} x {} px, the image is {} x {}",

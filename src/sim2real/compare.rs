@@ -20,6 +20,7 @@ use image::RgbImage;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::tactile::ball_calibration::BallPress;
+use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_core::tactile::ssim::{gray, ssim};
 use tactex_sim::contact::{ContactSolver, Fidelity};
 use tactex_sim::render::gel::{
@@ -250,6 +251,18 @@ fn compare_ball_presses(args: &CompareArgs) -> Result<CompareReport> {
         args.split,
         (spec.width_px, spec.height_px),
     )?;
+    // Claimed before any work: an --out that cannot be written fails first, and the side by
+    // sides, named as the real frames are, may not land on them (--out the images' folder).
+    let out_dir = match args.out.as_deref() {
+        Some(dir) => {
+            let mut claimed = OutputDir::create("--out", dir)?;
+            claimed.keep(presses.iter().map(|(p, _)| images.join(&p.image)));
+            claimed.keep([annotations.clone()]);
+            claimed.keep(SensorProfile::files(profile_path));
+            Some(claimed)
+        }
+        None => None,
+    };
     let choice = open_renderer(args.device)?;
     if let Some(note) = &choice.note {
         eprintln!("note: {note}");
@@ -278,11 +291,6 @@ fn compare_ball_presses(args: &CompareArgs) -> Result<CompareReport> {
     });
     let mut images = renderer.render_batch(&optics, &frames)?;
     let background = images.pop().expect("the flat frame was rendered last");
-    let out_dir = args
-        .out
-        .as_deref()
-        .map(|dir| OutputDir::create("--out", dir))
-        .transpose()?;
     let mut out = Vec::new();
     for (((press, real), (depth, force, _, warnings)), rendered) in
         presses.iter().zip(&rebuilt).zip(&images)

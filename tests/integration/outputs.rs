@@ -203,3 +203,38 @@ fn a_scene_data_set_another_tactex_writes_is_refused() {
     assert!(err.contains("is writing this data set here"), "{err}");
     assert!(lock.join("tactex.pid").exists());
 }
+
+#[test]
+fn compare_into_the_folder_of_its_real_frames_does_not_write_over_them() {
+    // The side by sides are named as the real frames: --out the frames' folder replaced
+    // them with 720 x 320 comparisons, and the next run failed on their size.
+    let tmp = tempfile::tempdir().unwrap();
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fots");
+    let presses = tmp.path().join("presses");
+    std::fs::create_dir(&presses).unwrap();
+    for entry in std::fs::read_dir(fixtures.join("ball-presses")).unwrap() {
+        let entry = entry.unwrap().path();
+        std::fs::copy(&entry, presses.join(entry.file_name().unwrap())).unwrap();
+    }
+    let before = entries(&presses);
+    let frame = std::fs::read(presses.join("0001.png")).unwrap();
+    let profile = fixtures.join("profile/fots-9.toml");
+    let err = error_line(&tactex(&[
+        "compare",
+        "--sensor",
+        profile.to_str().unwrap(),
+        "--images",
+        presses.to_str().unwrap(),
+        "--annotations",
+        presses.join("annotations.csv").to_str().unwrap(),
+        "--split",
+        "all",
+        "--device",
+        "cpu",
+        "--out",
+        presses.to_str().unwrap(),
+    ]));
+    assert!(err.contains("is one of this command's inputs"), "{err}");
+    assert_eq!(entries(&presses), before, "nothing written");
+    assert_eq!(std::fs::read(presses.join("0001.png")).unwrap(), frame);
+}
