@@ -10,7 +10,7 @@ use glam::DVec2;
 use image::RgbImage;
 use std::path::{Path, PathBuf};
 use tactex_core::hertz::Elastic;
-use tactex_core::tactile::ball_calibration::{BallPress, read_annotations};
+use tactex_core::tactile::ball_calibration::{AnnotationError, BallPress, read_annotations};
 use tactex_core::tactile::spec::GelSpec;
 use tactex_sim::contact::{ContactProblem, ContactSolver, Fidelity, ObjectSurface};
 use tactex_sim::render::gel::{
@@ -66,33 +66,42 @@ pub fn load(
         }
         let path: PathBuf = images.join(&press.image);
         let img = load_rgb(&path)?;
+        let bad_press = |path: &Path, message: String| AnnotationError::Press {
+            path: path.display().to_string(),
+            message,
+        };
         if img.dimensions() != size {
-            bail!(
-                "{}: {} x {} px, the background is {} x {}",
-                path.display(),
-                img.width(),
-                img.height(),
-                size.0,
-                size.1
-            );
+            return Err(bad_press(
+                &path,
+                format!(
+                    "{} x {} px, the background is {} x {}",
+                    img.width(),
+                    img.height(),
+                    size.0,
+                    size.1
+                ),
+            )
+            .into());
         }
         let [x, y] = press.centre_px;
         if x >= size.0 as f64 || y >= size.1 as f64 {
-            bail!(
-                "{}: press {} is centred outside the {} x {} frame",
-                annotations.display(),
-                press.image,
-                size.0,
-                size.1
-            );
+            return Err(bad_press(
+                annotations,
+                format!(
+                    "press {} is centred outside the {} x {} frame",
+                    press.image, size.0, size.1
+                ),
+            )
+            .into());
         }
         out.push((press, img));
     }
     if out.is_empty() {
-        bail!(
-            "{}: no presses in the {split:?} split",
-            annotations.display()
-        );
+        return Err(AnnotationError::Press {
+            path: annotations.display().to_string(),
+            message: format!("no presses in the {split:?} split"),
+        }
+        .into());
     }
     Ok(out)
 }

@@ -106,6 +106,15 @@ mod tests {
         assert_eq!(ErrorKind::of(&anyhow::Error::new(e)), ErrorKind::BadInput);
         let e = anyhow::anyhow!("--depth-mm: -1 is outside [0, 30]");
         assert_eq!(ErrorKind::of(&e), ErrorKind::BadInput);
+        // An annotated press wider than its ball (docs/python.md's calibrate example at a
+        // scale off by 0.2% raised RuntimeError for it).
+        let e = tactex_core::tactile::ball_calibration::AnnotationError::Press {
+            path: "annotations.csv".into(),
+            message:
+                "0034.png has a contact radius of 2.36 mm, not smaller than the ball's 2.35 mm"
+                    .into(),
+        };
+        assert_eq!(ErrorKind::of(&anyhow::Error::new(e)), ErrorKind::BadInput);
         let e: anyhow::Result<()> =
             Err(anyhow::anyhow!("no Vulkan adapter")).context("opening the renderer");
         assert_eq!(ErrorKind::of(&e.unwrap_err()), ErrorKind::Failure);

@@ -20,6 +20,10 @@ pub struct BallPress {
 pub enum AnnotationError {
     #[error("{path}: {message}")]
     Read { path: String, message: String },
+    /// A press the file lists that cannot be used as it is: its image's size, a circle off
+    /// the frame or wider than the ball.
+    #[error("{path}: {message}")]
+    Press { path: String, message: String },
     #[error("{path}:{line}: {message}")]
     Row {
         path: String,
