@@ -76,17 +76,17 @@ pub struct PressArgs {
     /// Gel thickness (mm, 0.5 to 50); GelSight Mini ~4.
     #[arg(long, value_parser = within(tactex_core::tactile::sensor_profile::MIN_GEL_THICKNESS_MM, 50.0))]
     gel_thickness_mm: Option<f64>,
-    /// Gel Young's modulus (MPa, above 0 up to 1000); GelSight Mini ~0.15-0.45.
-    #[arg(long, value_parser = above(0.0, 1000.0))]
+    /// Gel Young's modulus (MPa, 0.01 to 50, as `ask` takes it); GelSight Mini ~0.15-0.45.
+    #[arg(long, value_parser = within(0.01, 50.0))]
     gel_modulus_mpa: Option<f64>,
     /// Write the gel displacement and pressure maps (16-bit PNG + JSON sidecar), the
     /// rendered GelSight Mini frame (tactile.png) and a no-contact frame (reference.png) here.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Device that renders tactile.png: auto (a hardware GPU if there is one, else the
-    /// CPU), gpu (any Vulkan adapter, software included) or cpu.
-    #[arg(long, default_value = "auto")]
-    device: DeviceChoice,
+    /// Device that renders tactile.png: auto (the default: a hardware GPU if there is one,
+    /// else the CPU), gpu (any Vulkan adapter, software included) or cpu.
+    #[arg(long)]
+    device: Option<DeviceChoice>,
     /// Sensor profile whose gel, frame and optics the press uses (TOML); default the
     /// built-in GelSight Mini. The gel and marker flags override its values.
     #[arg(long)]
@@ -99,8 +99,8 @@ pub struct PressArgs {
     #[arg(long, value_parser = above(0.0, 20.0))]
     marker_pitch_mm: Option<f64>,
     /// Seed of the rendered frame's camera noise.
-    #[arg(long, default_value_t = 0)]
-    seed: u32,
+    #[arg(long)]
+    seed: Option<u32>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     json: bool,
@@ -195,7 +195,7 @@ fn at_on_pad(at: Option<&[f64]>, pad_mm: [f64; 2]) -> Result<[f64; 2]> {
 impl PressArgs {
     /// The device that renders the frames.
     pub fn device(&self) -> DeviceChoice {
-        self.device
+        self.device.unwrap_or(DeviceChoice::Auto)
     }
 }
 
@@ -216,6 +216,22 @@ pub fn request(args: &PressArgs) -> Result<PressRequest> {
     }
     if let Some(pitch) = args.marker_pitch_mm {
         let m = &spec.markers;
+        if m.cols * m.rows == 0 {
+            bail!("--marker-pitch-mm: the gel has no markers (--marker-grid 0x0 or the profile's)");
+        }
+        let pad = spec.pad_size_mm();
+        let span = [f64::from(m.cols - 1) * pitch, f64::from(m.rows - 1) * pitch];
+        if span[0] > pad[0] || span[1] > pad[1] {
+            bail!(
+                "--marker-pitch-mm {pitch}: a {} x {} grid spans {:.1} x {:.1} mm, past the {:.1} x {:.1} mm pad",
+                m.cols,
+                m.rows,
+                span[0],
+                span[1],
+                pad[0],
+                pad[1]
+            );
+        }
         // Dots wider than their spacing would merge into one dark gel, not a grid.
         if m.cols * m.rows > 0 && pitch <= 2.0 * m.radius_mm {
             bail!(
@@ -245,16 +261,29 @@ pub fn request(args: &PressArgs) -> Result<PressRequest> {
         cell_mm: args.grid_mm,
         tolerance: args.tolerance,
         sensor,
-        seed: args.seed,
+        seed: args.seed.unwrap_or(0),
     })
 }
 
 pub fn run(args: &PressArgs) -> Result<()> {
     let request = request(args)?;
+    if args.out.is_none() {
+        // These shape the rendered frame, which only --out writes: without it they would do
+        // nothing, and the user would believe they had (their values are checked first).
+        let frame_flags = [
+            ("--marker-grid", args.marker_grid.is_some()),
+            ("--marker-pitch-mm", args.marker_pitch_mm.is_some()),
+            ("--seed", args.seed.is_some()),
+            ("--device", args.device.is_some()),
+        ];
+        if let Some((flag, _)) = frame_flags.iter().find(|(_, given)| *given) {
+            bail!("{flag}: sets the rendered frame, which press writes only with --out DIR");
+        }
+    }
     let mut press = request.solve()?;
     if let Some(out) = &args.out {
         // The renderer first: a missing device fails before any file is written.
-        let choice = open_renderer(args.device)?;
+        let choice = open_renderer(args.device())?;
         let mut out = OutputDir::create("--out", out)?;
         out.keep(args.sensor.iter().flat_map(|p| SensorProfile::files(p)));
         out.keep(args.mesh.clone());

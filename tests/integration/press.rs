@@ -141,6 +141,8 @@ fn bad_press_input_is_one_clear_line_and_a_failure() {
     let dir = tempfile::tempdir().unwrap();
     let empty = dir.path().join("empty.obj");
     std::fs::write(&empty, "# nothing\n").unwrap();
+    let out = dir.path().join("o");
+    let out_dir = out.to_str().unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
             vec![
@@ -238,6 +240,8 @@ fn bad_press_input_is_one_clear_line_and_a_failure() {
                 "1",
                 "--marker-pitch-mm",
                 "1e-6",
+                "--out",
+                out_dir,
             ],
             "--marker-pitch-mm 0.000001: not over the markers' diameter",
         ),
