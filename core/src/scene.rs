@@ -427,6 +427,34 @@ impl Scene {
         };
 
         let kind_name = o.kind.to_ascii_lowercase();
+        // A size the kind does not read would be dropped without a word, and the scene would
+        // hold another object than the one written.
+        let reads: &[&str] = match kind_name.as_str() {
+            "sphere" => &["radius_m"],
+            "ellipsoid" => &["radii_m"],
+            "box" => &["size_m"],
+            "mesh" => &["mesh", "scale"],
+            _ if catalog.find_word(&kind_name).is_some() => &["size_m"],
+            // An unknown kind is named as such below.
+            _ => &["radius_m", "radii_m", "size_m", "mesh", "scale"],
+        };
+        let given = [
+            ("radius_m", o.radius_m.is_some()),
+            ("radii_m", o.radii_m.is_some()),
+            ("size_m", o.size_m.is_some()),
+            ("mesh", o.mesh.is_some()),
+            ("scale", o.scale.is_some()),
+        ];
+        if let Some((name, _)) = given.iter().find(|(n, on)| *on && !reads.contains(n)) {
+            return Err(err(
+                &field(name),
+                format!(
+                    "not read for kind '{}', which takes {}",
+                    crate::printable::printable(&kind_name),
+                    reads.join(" or ")
+                ),
+            ));
+        }
         let (kind, label, hardness, ripeness, color) = match kind_name.as_str() {
             "sphere" | "ellipsoid" | "box" | "mesh" => {
                 if o.ripeness.is_some() {
@@ -662,6 +690,29 @@ mod tests {
             e.contains("objects[0].ripeness: unknown ripeness stage 'rotten'"),
             "{e}"
         );
+        // A size the kind does not read: the scene would hold another object than written.
+        for (kind, extra, field) in [
+            (
+                "apple",
+                "scale = 0.001",
+                "objects[0].scale: not read for kind 'apple'",
+            ),
+            (
+                "sphere",
+                "radius_m = 0.02\nsize_m = [1, 1, 1]\nhardness = \"rigid\"",
+                "objects[0].size_m",
+            ),
+            (
+                "box",
+                "size_m = [0.02, 0.02, 0.02]\nradius_m = 0.5\nhardness = \"rigid\"",
+                "objects[0].radius_m",
+            ),
+        ] {
+            let e = error_of(&format!(
+                "name = \"x\"\n[[objects]]\nkind = \"{kind}\"\nposition_m = [0, 0]\n{extra}\n"
+            ));
+            assert!(e.contains(field), "{e}");
+        }
         let e = error_of("name = \"x\"\n[[objects]]\nkind = \"banana\"\nposition_m = [nan, 0]\n");
         assert!(e.contains("objects[0].position_m: must be finite"), "{e}");
         let e = error_of("name = \"x\"\n[[objects]]\nkind = \"banana\"\nposition_m = [3.0, 0]\n");

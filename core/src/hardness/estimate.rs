@@ -216,6 +216,15 @@ pub(crate) fn check_gel_share(share: f64) -> Result<(), EstimateError> {
             100.0 * MIN_GEL_SHARE
         )));
     }
+    if share > 1.0 {
+        // More than all of it: the reading, not the object, is out of bounds.
+        return Err(EstimateError::OutsideCompetence(format!(
+            "the frames read {:.0}% of the travel as the gel's indentation, more than the \
+             whole travel: the reading overshoots here (a stiff object read deep), so the \
+             press cannot tell the object from a rigid one",
+            100.0 * share
+        )));
+    }
     if share > 1.0 - MIN_GEL_SHARE {
         return Err(EstimateError::OutsideCompetence(format!(
             "the gel took {:.1}% of the travel: the object is too stiff against the gel to \
@@ -476,4 +485,27 @@ fn radial_centre(f: &SlopeField) -> Option<(f64, f64)> {
         return None;
     }
     Some(((a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det))
+}
+
+#[cfg(test)]
+mod gel_share_tests {
+    use super::*;
+
+    /// The rule in its three outcomes; a reading past the whole travel is said to be the
+    /// reading's fault (it printed "the gel took 125% of the travel").
+    #[test]
+    fn a_gel_share_outside_competence_says_why_in_the_users_terms() {
+        assert!(check_gel_share(0.5).is_ok());
+        let why = |s: f64| match check_gel_share(s) {
+            Err(EstimateError::OutsideCompetence(m)) => m,
+            other => panic!("{s}: {other:?}"),
+        };
+        assert!(why(0.01).contains("too soft against the gel"));
+        assert!(why(0.99).contains("too stiff against the gel"));
+        let over = why(1.25);
+        assert!(
+            over.contains("125% of the travel") && over.contains("more than the whole travel"),
+            "{over}"
+        );
+    }
 }
