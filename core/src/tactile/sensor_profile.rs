@@ -26,6 +26,9 @@ pub const MAX_NAME_CHARS: usize = 100;
 /// no control characters and none that reorder or hide text on a terminal (bidirectional
 /// overrides, zero-width characters); Err says what is wrong, the name shown escaped.
 pub fn check_name(name: &str) -> Result<(), String> {
+    if name.trim().is_empty() {
+        return Err("empty; a name says which sensor or scene this is".into());
+    }
     let hidden = crate::printable::is_hidden;
     if name.chars().count() > MAX_NAME_CHARS || name.chars().any(|c| c.is_control() || hidden(c)) {
         return Err(format!(
