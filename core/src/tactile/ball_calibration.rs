@@ -43,6 +43,8 @@ pub fn read_annotations(path: &Path) -> Result<Vec<BallPress>, AnnotationError> 
         path: shown.clone(),
         message: e.to_string(),
     })?;
+    // Spreadsheets save CSV with a byte-order mark, which would stick to the first column.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let mut lines = text.lines().enumerate();
     let expected = ["image", "center_x_px", "center_y_px", "contact_radius_px"];
     match lines.next() {
@@ -297,6 +299,13 @@ mod tests {
         .unwrap();
         let e = read_annotations(&p).unwrap_err().to_string();
         assert!(e.contains("a.csv:2") && e.contains("center_y_px"), "{e}");
+        // A spreadsheet's byte-order mark is not part of the header.
+        std::fs::write(
+            &p,
+            "\u{feff}image,center_x_px,center_y_px,contact_radius_px\n0001.png,76,182,38\n",
+        )
+        .unwrap();
+        assert_eq!(read_annotations(&p).unwrap().len(), 1);
         std::fs::write(&p, "img,x\n").unwrap();
         assert!(
             read_annotations(&p)
