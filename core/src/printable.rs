@@ -8,6 +8,28 @@ pub fn is_hidden(c: char) -> bool {
     matches!(c, '\u{200B}'..='\u{200F}' | '\u{202A}'..='\u{202E}' | '\u{2060}'..='\u{2064}' | '\u{2066}'..='\u{2069}' | '\u{FEFF}')
 }
 
+/// A name (a sensor profile's, a scene's, an object's label) is shown in every report: one
+/// short line.
+pub const MAX_NAME_CHARS: usize = 100;
+
+/// Whether `name` can name a profile, a scene or an object: one line of at most
+/// `MAX_NAME_CHARS` characters with no control characters and none that reorder or hide text
+/// on a terminal (bidirectional overrides, zero-width characters); Err says what is wrong,
+/// the name shown escaped.
+pub fn check_name(name: &str) -> Result<(), String> {
+    if name.trim().is_empty() {
+        return Err("empty; a name says which sensor or scene this is".into());
+    }
+    if name.chars().count() > MAX_NAME_CHARS || name.chars().any(|c| c.is_control() || is_hidden(c))
+    {
+        return Err(format!(
+            "'{}', expected one line of at most {MAX_NAME_CHARS} characters without control, bidirectional or zero-width characters",
+            printable(&name.chars().take(40).collect::<String>())
+        ));
+    }
+    Ok(())
+}
+
 /// `text` with every control character but tab, and every hidden one (`is_hidden`), written
 /// as its Rust escape (`\u{1b}`); line breaks too, so that an error stays one line.
 pub fn printable(text: &str) -> String {

@@ -229,10 +229,10 @@ impl Scene {
             .map_err(|e| err("toml", crate::file_failure::toml_failure(text, &e)))?;
 
         // Names and labels are printed in answers and reports: one plain line each.
-        crate::tactile::sensor_profile::check_name(&raw.name).map_err(|m| err("name", m))?;
+        crate::printable::check_name(&raw.name).map_err(|m| err("name", m))?;
         for (i, o) in raw.objects.iter().enumerate() {
             if let Some(label) = &o.label {
-                crate::tactile::sensor_profile::check_name(label)
+                crate::printable::check_name(label)
                     .map_err(|m| err(&format!("objects[{i}].label"), m))?;
             }
         }

@@ -217,7 +217,7 @@ fn read_markers(
 
 /// `--name`, checked before the fit as the profile will check it.
 fn profile_name(s: &str) -> Result<String, String> {
-    tactex_core::tactile::sensor_profile::check_name(s)?;
+    tactex_core::printable::check_name(s)?;
     Ok(s.to_string())
 }
 

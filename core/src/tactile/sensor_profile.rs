@@ -19,25 +19,7 @@ use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 pub const PROFILE_FORMAT: &str = "tactex-sensor-profile/1";
-/// A profile's name is shown in every report: one short line.
-pub const MAX_NAME_CHARS: usize = 100;
-
-/// Whether `name` can name a profile: one line of at most `MAX_NAME_CHARS` characters with
-/// no control characters and none that reorder or hide text on a terminal (bidirectional
-/// overrides, zero-width characters); Err says what is wrong, the name shown escaped.
-pub fn check_name(name: &str) -> Result<(), String> {
-    if name.trim().is_empty() {
-        return Err("empty; a name says which sensor or scene this is".into());
-    }
-    let hidden = crate::printable::is_hidden;
-    if name.chars().count() > MAX_NAME_CHARS || name.chars().any(|c| c.is_control() || hidden(c)) {
-        return Err(format!(
-            "'{}', expected one line of at most {MAX_NAME_CHARS} characters without control, bidirectional or zero-width characters",
-            crate::printable::printable(&name.chars().take(40).collect::<String>())
-        ));
-    }
-    Ok(())
-}
+use crate::printable::check_name;
 /// Its `source` note, free text of a few paragraphs at most.
 pub const MAX_SOURCE_CHARS: usize = 10_000;
 /// The thinnest gel a profile or `--gel-thickness-mm` may give: vision-based tactile gels are
@@ -843,7 +825,10 @@ mod tests {
             ("name = \"Mini\\u001b[31m\"", "name"),
             ("name = \"Mini\\u202Eevil\"", "name"),
             (
-                &*format!("name = \"{}\"", "x".repeat(MAX_NAME_CHARS + 1)),
+                &*format!(
+                    "name = \"{}\"",
+                    "x".repeat(crate::printable::MAX_NAME_CHARS + 1)
+                ),
                 "name",
             ),
             (
