@@ -63,6 +63,15 @@ impl TriMesh {
         total / (4.0 * std::f64::consts::PI)
     }
 
+    /// Its largest extent in metres at `scale` (its units to metres) when that is not a size
+    /// an object on a table has (`scene::OBJECT_SIZE_M`, as a scene's shapes); None when it is.
+    pub fn size_off_table_m(&self, scale: f64) -> Option<f64> {
+        let (lo, hi) = self.bounds();
+        let size_m = (hi - lo).max_element() * scale;
+        let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
+        (!(size_m.is_finite() && (least..=most).contains(&size_m))).then_some(size_m)
+    }
+
     /// Scales each axis so the bounding box is `size` and centres it at the origin.
     fn fit_box(mut self, size: DVec3) -> Self {
         let (lo, hi) = self.bounds();

@@ -81,10 +81,8 @@ impl SimWorld {
                     })?;
                     let (lo, hi) = m.bounds();
                     let centre = (lo + hi) / 2.0;
-                    // The same sizes as a scene's shapes may have, the mesh's units applied.
-                    let size_m = (hi - lo).max_element() * *scale;
-                    let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
-                    if !(size_m.is_finite() && (least..=most).contains(&size_m)) {
+                    if let Some(size_m) = m.size_off_table_m(*scale) {
+                        let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
                         return Err(WorldError::Object {
                             scene: shown.clone(),
                             index,
@@ -263,7 +261,13 @@ impl SimWorld {
                         .step_by(step)
                         .map(|v| x.centre + (*v - x.centre) * 0.8)
                         .collect();
-                    let inside = samples.iter().filter(|p| y.mesh.contains(**p)).count();
+                    // Only points in the other's box can be inside it; the winding number
+                    // costs a solid angle per triangle, so the box goes first.
+                    let (lo, hi) = y.mesh.bounds();
+                    let inside = samples
+                        .iter()
+                        .filter(|p| p.cmpge(lo).all() && p.cmple(hi).all() && y.mesh.contains(**p))
+                        .count();
                     inside * 5 > samples.len()
                 };
                 if deep(a, b) || deep(b, a) {

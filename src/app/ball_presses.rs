@@ -66,10 +66,6 @@ pub fn load(
         }
         let path: PathBuf = images.join(&press.image);
         let img = load_rgb(&path)?;
-        let bad_press = |path: &Path, message: String| AnnotationError::Press {
-            path: path.display().to_string(),
-            message,
-        };
         if img.dimensions() != size {
             return Err(bad_press(
                 &path,
@@ -97,13 +93,42 @@ pub fn load(
         out.push((press, img));
     }
     if out.is_empty() {
-        return Err(AnnotationError::Press {
-            path: annotations.display().to_string(),
-            message: format!("no presses in the {split:?} split"),
-        }
-        .into());
+        return Err(bad_press(annotations, format!("no presses in the {split:?} split")).into());
     }
     Ok(out)
+}
+
+/// A listed press that cannot be used as it is, in the file that lists it.
+fn bad_press(path: &Path, message: String) -> AnnotationError {
+    AnnotationError::Press {
+        path: path.display().to_string(),
+        message,
+    }
+}
+
+/// Refuses a press whose annotated contact is as wide as the ball (`ball_radius_mm`), at
+/// `mm_per_px`: inside the contact the gel takes the ball's shape, which no contact wider
+/// than the ball can. `calibrate` and `compare` apply the one rule.
+pub fn check_within_ball(
+    presses: &[(BallPress, RgbImage)],
+    annotations: &Path,
+    mm_per_px: f64,
+    ball_radius_mm: f64,
+) -> Result<()> {
+    for (press, _) in presses {
+        let radius_mm = press.contact_radius_px * mm_per_px;
+        if radius_mm >= ball_radius_mm {
+            return Err(bad_press(
+                annotations,
+                format!(
+                    "{} has a contact radius of {radius_mm:.2} mm, not smaller than the ball's {ball_radius_mm} mm",
+                    press.image
+                ),
+            )
+            .into());
+        }
+    }
+    Ok(())
 }
 
 /// The box of four contact radii around a press, `[x0, y0, x1, y1)`, clipped to the frame:

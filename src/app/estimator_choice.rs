@@ -68,6 +68,26 @@ impl FromStr for EstimatorChoice {
 
 pub type BoxedEstimator = Box<dyn HardnessEstimator + Send + Sync>;
 
+/// Why `estimator` cannot read the presses `sensor` makes (the protocol's frames), if it
+/// cannot.
+pub fn unreadable(estimator: &dyn HardnessEstimator, sensor: &SensorProfile) -> Option<String> {
+    let frames = tactex_core::press::protocol::PressProtocol::default().frames;
+    estimator.cannot_read(&sensor.spec, frames)
+}
+
+/// Refuses, before any press is made, an estimator that cannot read `sensor`'s presses;
+/// `what` names it as the user chose it ("--estimator learned", "--model m.onnx").
+pub fn check_reads(
+    estimator: &dyn HardnessEstimator,
+    what: &str,
+    sensor: &SensorProfile,
+) -> Result<()> {
+    match unreadable(estimator, sensor) {
+        Some(why) => bail!("{what}: cannot read the presses of {}: {why}", sensor.id()),
+        None => Ok(()),
+    }
+}
+
 impl EstimatorChoice {
     /// The value of `--estimator` that names this choice.
     pub fn flag_value(&self) -> String {
@@ -93,14 +113,11 @@ impl EstimatorChoice {
                 Box::new(tactex_learned::builtin::from_file(flag, path)?)
             }
         };
-        let frames = tactex_core::press::protocol::PressProtocol::default().frames;
-        if let Some(why) = estimator.cannot_read(&sensor.spec, frames) {
-            bail!(
-                "{flag} {}: cannot read the presses of {}: {why}",
-                self.flag_value(),
-                sensor.id()
-            );
-        }
+        check_reads(
+            estimator.as_ref(),
+            &format!("{flag} {}", self.flag_value()),
+            sensor,
+        )?;
         Ok(estimator)
     }
 

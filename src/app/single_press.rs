@@ -80,11 +80,8 @@ impl PressShape {
             PressShape::Mesh { path, scale } => {
                 let mesh = tactex_sim::mesh::load(path)?;
                 mesh.validate(&path.display().to_string())?;
-                // The sizes a scene's objects may have, the mesh's units applied.
-                let (lo, hi) = mesh.bounds();
-                let size_m = (hi - lo).max_element() * scale;
-                let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
-                if !(size_m.is_finite() && (least..=most).contains(&size_m)) {
+                if let Some(size_m) = mesh.size_off_table_m(*scale) {
+                    let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
                     anyhow::bail!(
                         "--mesh {}: {} m across at --mesh-scale {}, not a size an object on a table has ({least} to {most} m); set --mesh-scale to the mesh's unit in metres",
                         path.display(),

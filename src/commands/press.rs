@@ -140,12 +140,10 @@ fn shape(args: &PressArgs) -> Result<PressShape> {
 /// A size flag the chosen shape does not read would be dropped without a word, and the user
 /// would believe the press was of the object they described.
 fn refuse_unused_flags(args: &PressArgs) -> Result<()> {
-    let shape = match args.shape {
-        Shape::Sphere => "sphere",
-        Shape::Ellipsoid => "ellipsoid",
-        Shape::Box => "box",
-        Shape::Mesh => "mesh",
-    };
+    let shape = args
+        .shape
+        .to_possible_value()
+        .expect("every shape is a --shape value");
     let given = [
         ("--radius-mm", args.radius_mm.is_some()),
         ("--size-mm", args.size_mm.is_some()),
@@ -160,7 +158,8 @@ fn refuse_unused_flags(args: &PressArgs) -> Result<()> {
     };
     if let Some((flag, _)) = given.iter().find(|(flag, on)| *on && !used.contains(flag)) {
         bail!(
-            "{flag}: not read for --shape {shape}, which takes {}",
+            "{flag}: not read for --shape {}, which takes {}",
+            shape.get_name(),
             used.join(" or ")
         );
     }
@@ -233,7 +232,7 @@ pub fn request(args: &PressArgs) -> Result<PressRequest> {
             );
         }
         // Dots wider than their spacing would merge into one dark gel, not a grid.
-        if m.cols * m.rows > 0 && pitch <= 2.0 * m.radius_mm {
+        if pitch <= 2.0 * m.radius_mm {
             bail!(
                 "--marker-pitch-mm {pitch}: not over the markers' diameter ({:.3} mm); they would overlap",
                 2.0 * m.radius_mm

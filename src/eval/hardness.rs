@@ -3,9 +3,10 @@
 //! by RMSE, R2 and Spearman's rho (core's stats, checked against scipy), with the paper's
 //! Fig. 5 (predicted against true hardness) as a PNG.
 
+use crate::app::estimator_choice::{check_reads, unreadable};
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::report::plot::{self, ScatterSeries};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -15,7 +16,6 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::hardness::estimate::{Evidence, HardnessEstimator, HertzSlopeEstimator};
 use tactex_core::hardness::indentation_estimator::IndentationEstimator;
 use tactex_core::hardness::scale::shore_a_to_modulus_mpa;
-use tactex_core::press::protocol::PressProtocol;
 use tactex_core::stats::{r_squared, rmse, spearman};
 use tactex_sim::contact::ContactSolver;
 use tactex_sim::datagen::tactile_sample::ShapeFamily;
@@ -113,12 +113,11 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
         Box::new(HertzSlopeEstimator::default()),
         Box::new(IndentationEstimator::default()),
     ];
-    let frames = PressProtocol::default().frames;
     if !args.no_builtin_model {
         let builtin = tactex_learned::builtin::builtin_small()?;
         // Through a profile of another frame size the built-in model reads nothing: it is
         // left out with why, and the geometric estimators are scored.
-        match builtin.cannot_read(&space.sensor.spec, frames) {
+        match unreadable(&builtin, &space.sensor) {
             None => estimators.push(Box::new(builtin)),
             Some(why) => eprintln!(
                 "note: the built-in model is left out: {why} (--model scores one trained on it)"
@@ -127,13 +126,11 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
     }
     for path in &args.model {
         let model = tactex_learned::builtin::from_file("--model", path)?;
-        if let Some(why) = model.cannot_read(&space.sensor.spec, frames) {
-            bail!(
-                "--model {}: cannot read the presses of {}: {why}",
-                path.display(),
-                sensor_id
-            );
-        }
+        check_reads(
+            &model,
+            &format!("--model {}", path.display()),
+            &space.sensor,
+        )?;
         estimators.push(Box::new(model));
     }
     // Claimed before the presses: an --out that cannot be written fails first.

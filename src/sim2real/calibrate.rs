@@ -12,7 +12,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::ground::centroid::median;
 use tactex_core::tactile::ball_calibration::{
-    AnnotationError, BallPress, SampleRule, camera_noise_sigma, samples_from_ball_press,
+    BallPress, SampleRule, camera_noise_sigma, samples_from_ball_press,
 };
 use tactex_core::tactile::gel_glow::{GelGlow, GlowDesign, GlowPress};
 use tactex_core::tactile::sensor_profile::{CalibrationFit, ProfileId, SensorProfile};
@@ -277,21 +277,11 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
             );
         }
     }
+    ball_presses::check_within_ball(&presses, &args.annotations, scale, radius)?;
     let rule = SampleRule::default();
     let mut samples = Vec::new();
     let mut noise = Vec::new();
     for (press, img) in &presses {
-        if press.contact_radius_px * scale >= radius {
-            return Err(AnnotationError::Press {
-                path: args.annotations.display().to_string(),
-                message: format!(
-                    "{} has a contact radius of {:.2} mm, not smaller than the ball's {radius} mm",
-                    press.image,
-                    press.contact_radius_px * scale
-                ),
-            }
-            .into());
-        }
         samples.extend(samples_from_ball_press(
             img,
             &background,

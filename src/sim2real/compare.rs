@@ -251,20 +251,7 @@ fn compare_ball_presses(args: &CompareArgs) -> Result<CompareReport> {
         args.split,
         (spec.width_px, spec.height_px),
     )?;
-    for (press, _) in &presses {
-        // The rule `calibrate` applies: a contact as wide as the ball is no ball press.
-        let radius_mm = press.contact_radius_px * spec.mm_per_px;
-        if radius_mm >= fit.ball_radius_mm {
-            return Err(tactex_core::tactile::ball_calibration::AnnotationError::Press {
-                path: annotations.display().to_string(),
-                message: format!(
-                    "{} has a contact radius of {radius_mm:.2} mm, not smaller than the profile's {} mm ball",
-                    press.image, fit.ball_radius_mm
-                ),
-            }
-            .into());
-        }
-    }
+    ball_presses::check_within_ball(&presses, annotations, spec.mm_per_px, fit.ball_radius_mm)?;
     // Claimed before any work: an --out that cannot be written fails first, and the side by
     // sides, named as the real frames are, may not land on them (--out the images' folder).
     let out_dir = match args.out.as_deref() {
