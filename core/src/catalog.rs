@@ -90,6 +90,8 @@ pub enum CatalogError {
 #[serde(deny_unknown_fields)]
 pub struct CategorySpec {
     pub name: String,
+    /// How an answer names one of the group: "citrus fruit", "berry".
+    pub noun: String,
     pub words: Vec<String>,
 }
 
@@ -178,12 +180,24 @@ impl FruitCatalog {
             if c.words.is_empty() {
                 return Err(bad("words: none".into()));
             }
+            let plain = |phrase: &str| {
+                let parts: Vec<&str> = phrase.split(' ').collect();
+                parts.len() <= 3
+                    && parts
+                        .iter()
+                        .all(|p| !p.is_empty() && p.chars().all(|ch| ch.is_ascii_lowercase()))
+            };
+            if !plain(&c.noun) {
+                return Err(bad(format!(
+                    "noun: '{}' must be one to three lower-case words",
+                    crate::printable::printable(&c.noun)
+                )));
+            }
             for w in &c.words {
-                let parts: Vec<&str> = w.split(' ').collect();
-                let plain = |p: &&str| !p.is_empty() && p.chars().all(|ch| ch.is_ascii_lowercase());
-                if parts.len() > 3 || !parts.iter().all(plain) {
+                if !plain(w) {
                     return Err(bad(format!(
-                        "words: '{w}' must be one to three lower-case words"
+                        "words: '{}' must be one to three lower-case words",
+                        crate::printable::printable(w)
                     )));
                 }
                 if file.fruit.iter().any(|f| f.answers_to(w)) {

@@ -50,19 +50,10 @@ pub struct Filters {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CategoryFilter {
     pub name: String,
+    /// How an answer names one of the group (the catalog's `noun`): "citrus fruit", "berry".
+    pub noun: String,
     /// Catalog names (singular) of its kinds.
     pub members: Vec<String>,
-}
-
-impl CategoryFilter {
-    /// How an answer names one of the group: "citrus fruit", "stone fruit", "berry".
-    pub fn noun(&self) -> String {
-        if self.name.ends_with("fruit") || self.name == "berry" {
-            self.name.clone()
-        } else {
-            format!("{} fruit", self.name)
-        }
-    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -208,6 +199,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             } else if !categories.iter().any(|c| c.name == category.name) {
                 categories.push(CategoryFilter {
                     name: category.name.clone(),
+                    noun: category.noun.clone(),
                     members,
                 });
             }
@@ -420,7 +412,7 @@ impl Query {
     /// How the answer names what was asked about: "fruit", "citrus fruit", "lime or lemon".
     pub fn asked_kind(&self) -> String {
         let mut kinds = self.targets.clone();
-        kinds.extend(self.categories.iter().map(CategoryFilter::noun));
+        kinds.extend(self.categories.iter().map(|c| c.noun.clone()));
         if kinds.is_empty() || (self.all && self.categories.is_empty()) {
             "fruit".into()
         } else {
