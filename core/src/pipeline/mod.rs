@@ -126,19 +126,26 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
 
     // Each press is read on a second thread as soon as it is taken, while the arm goes on to
     // the next object (the real arm's travel hides it the same way): the hardness stage's
-    // wall time is what remains after the last press.
+    // wall time is what remains after the last press. The arm's thread, done pressing, reads
+    // the presses still queued beside the reader.
     let spec = tactile.spec().clone();
+    let (to_reader, pressed_rx) = std::sync::mpsc::channel::<(usize, PressSequence)>();
+    let pressed_rx = std::sync::Mutex::new(pressed_rx);
     let (estimated, presses) = std::thread::scope(|scope| {
-        let (to_reader, pressed_rx) = std::sync::mpsc::channel::<(usize, PressSequence)>();
-        let reader = scope.spawn(move || {
-            pressed_rx
-                .into_iter()
-                .map(|(index, sequence)| {
-                    let estimate = estimator.estimate(&sequence, &spec);
-                    (index, sequence, estimate)
-                })
-                .collect::<Vec<_>>()
-        });
+        let read_queued = || {
+            let mut read = Vec::new();
+            loop {
+                // The lock is held only while taking the next press, not while reading it.
+                let next = pressed_rx.lock().unwrap_or_else(|e| e.into_inner()).recv();
+                let Ok((index, sequence)) = next else {
+                    break;
+                };
+                let estimate = estimator.estimate(&sequence, &spec);
+                read.push((index, sequence, estimate));
+            }
+            read
+        };
+        let reader = scope.spawn(read_queued);
         let t = start("press", arm);
         let mut presses: Vec<Result<PressTaken, NotMeasured>> = Vec::new();
         for (index, target) in targets.iter().enumerate() {
@@ -167,9 +174,12 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
         lap("press", arm, t);
         drop(to_reader);
         let t = start("hardness", arm);
-        let estimated = reader
-            .join()
-            .map_err(|_| PipelineError::Estimator("the hardness reader panicked".into()))?;
+        let mut estimated = read_queued();
+        estimated.extend(
+            reader
+                .join()
+                .map_err(|_| PipelineError::Estimator("the hardness reader panicked".into()))?,
+        );
         Ok::<_, PipelineError>(((estimated, t), presses))
     })?;
     let (estimated, t) = estimated;

@@ -4,7 +4,7 @@
 //! boundaries, so an imprint touching the edge is not wrapped onto the opposite side.
 
 use super::slopes::SlopeField;
-use crate::spectral::fft2;
+use crate::spectral::{fft2, real_pair_at};
 use rustfft::num_complex::Complex;
 
 /// Sides of the border whose medians differ by more than this share of the imprint's depth
@@ -19,22 +19,22 @@ pub fn integrate_slopes(field: &SlopeField) -> Vec<f64> {
     let (w, h) = (field.width, field.height);
     let (w2, h2) = (2 * w, 2 * h);
     // Mirror extension: gx is odd across vertical edges and even across horizontal ones,
-    // gy the other way round.
-    let mut px = vec![Complex::new(0.0, 0.0); w2 * h2];
-    let mut py = vec![Complex::new(0.0, 0.0); w2 * h2];
+    // gy the other way round. Both are real, so one transform of gx + i gy carries both.
+    let mut p = vec![Complex::new(0.0, 0.0); w2 * h2];
     for y in 0..h2 {
         let (sy, yy) = if y < h { (1.0, y) } else { (-1.0, h2 - 1 - y) };
         for x in 0..w2 {
             let (sx, xx) = if x < w { (1.0, x) } else { (-1.0, w2 - 1 - x) };
             let k = yy * w + xx;
             if field.valid[k] {
-                px[y * w2 + x].re = sx * field.gx[k] as f64 * mm_per_px;
-                py[y * w2 + x].re = sy * field.gy[k] as f64 * mm_per_px;
+                p[y * w2 + x] = Complex::new(
+                    sx * field.gx[k] as f64 * mm_per_px,
+                    sy * field.gy[k] as f64 * mm_per_px,
+                );
             }
         }
     }
-    fft2(&mut px, w2, h2, false);
-    fft2(&mut py, w2, h2, false);
+    fft2(&mut p, w2, h2, false);
     let freq = |k: usize, n: usize| {
         let signed = if k <= n / 2 {
             k as f64
@@ -51,8 +51,9 @@ pub fn integrate_slopes(field: &SlopeField) -> Vec<f64> {
             let d = wx * wx + wy * wy;
             if d > 0.0 {
                 let k = v * w2 + u;
+                let (px, py) = real_pair_at(&p, w2, h2, k);
                 // Z = -j (wx Px + wy Py) / (wx^2 + wy^2)
-                let num = px[k] * wx + py[k] * wy;
+                let num = px * wx + py * wy;
                 z[k] = Complex::new(num.im, -num.re) / d;
             }
         }

@@ -208,50 +208,54 @@ pub fn blur<const N: usize>(
     // column at once (it vectorises): rows_t[j * height + y].
     let columns = blur_samples(width, step);
     let mut transposed = vec![[0.0f32; N]; src.len()];
-    for (y, row) in src.chunks_exact(width).enumerate() {
-        for (x, v) in row.iter().enumerate() {
-            transposed[x * height + y] = *v;
-        }
-    }
+    transpose::transpose(src, &mut transposed, width, height);
     let mut rows_t = vec![[0.0f32; N]; columns.len() * height];
+    let mut taps: Vec<&[f32]> = Vec::with_capacity(k.len());
     for (&x, out) in columns.iter().zip(rows_t.chunks_exact_mut(height)) {
-        let out = out.as_flattened_mut();
-        for (i, w) in k.iter().enumerate() {
+        taps.clear();
+        taps.extend((0..k.len()).map(|i| {
             let xx = (x + i).saturating_sub(r).min(width - 1);
-            let column = transposed[xx * height..][..height].as_flattened();
-            for (o, v) in out.iter_mut().zip(column) {
-                *o += w * v;
-            }
-        }
+            transposed[xx * height..][..height].as_flattened()
+        }));
+        weighted_sum(out.as_flattened_mut(), &taps, &k);
     }
-    // Down each sampled column at the sample rows: coarse[ys * cw + j].
-    let sample_rows = blur_samples(height, step);
+    // Down the sampled columns at the sample rows, on those columns turned back into rows so
+    // that each tap adds a whole row of samples at once: coarse[ys * cw + j].
     let cw = columns.len();
+    let mut rows = vec![[0.0f32; N]; cw * height];
+    transpose::transpose(&rows_t, &mut rows, height, cw);
+    let sample_rows = blur_samples(height, step);
     let mut coarse = vec![[0.0f32; N]; cw * sample_rows.len()];
-    for (j, column) in rows_t.chunks_exact(height).enumerate() {
-        for (ys, &y) in sample_rows.iter().enumerate() {
-            let o = &mut coarse[ys * cw + j];
-            for (i, w) in k.iter().enumerate() {
-                let v = column[(y + i).saturating_sub(r).min(height - 1)];
-                for c in 0..N {
-                    o[c] += w * v[c];
-                }
-            }
-        }
+    for (&y, out) in sample_rows.iter().zip(coarse.chunks_exact_mut(cw)) {
+        taps.clear();
+        taps.extend((0..k.len()).map(|i| {
+            let yy = (y + i).saturating_sub(r).min(height - 1);
+            rows[yy * cw..][..cw].as_flattened()
+        }));
+        weighted_sum(out.as_flattened_mut(), &taps, &k);
     }
-    let (across, down) = (
-        between_samples(&columns, width),
-        between_samples(&sample_rows, height),
-    );
-    let mut out = vec![[0.0f32; N]; src.len()];
-    for (row_out, &(y0, y1, ty)) in out.chunks_exact_mut(width).zip(&down) {
-        let (a, b) = (&coarse[y0 * cw..][..cw], &coarse[y1 * cw..][..cw]);
+    // Back to every pixel: each sample row across to every column, then each pixel row
+    // between its two sample rows.
+    let across = between_samples(&columns, width);
+    let mut wide = vec![[0.0f32; N]; width * sample_rows.len()];
+    for (a, row_out) in coarse.chunks_exact(cw).zip(wide.chunks_exact_mut(width)) {
         for (o, &(x0, x1, tx)) in row_out.iter_mut().zip(&across) {
             for c in 0..N {
-                let top = a[x0][c] * (1.0 - tx) + a[x1][c] * tx;
-                let bottom = b[x0][c] * (1.0 - tx) + b[x1][c] * tx;
-                o[c] = top * (1.0 - ty) + bottom * ty;
+                o[c] = a[x0][c] * (1.0 - tx) + a[x1][c] * tx;
             }
+        }
+    }
+    let mut out = vec![[0.0f32; N]; src.len()];
+    for (row_out, &(y0, y1, ty)) in out
+        .chunks_exact_mut(width)
+        .zip(&between_samples(&sample_rows, height))
+    {
+        let (top, bottom) = (
+            wide[y0 * width..][..width].as_flattened(),
+            wide[y1 * width..][..width].as_flattened(),
+        );
+        for ((o, t), b) in row_out.as_flattened_mut().iter_mut().zip(top).zip(bottom) {
+            *o = t * (1.0 - ty) + b * ty;
         }
     }
     out
@@ -271,28 +275,47 @@ fn blur_every_pixel<const N: usize>(
         padded[..r].fill(row_in[0]);
         padded[r..r + width].copy_from_slice(row_in);
         padded[r + width..].fill(row_in[width - 1]);
-        // Taps outer, pixels inner: each pixel still sums its taps in order from -r, and the
-        // inner loop runs along the row, where it vectorises.
-        let row_out = row_out.as_flattened_mut();
-        for (i, w) in k.iter().enumerate() {
-            let shifted = padded[i..i + width].as_flattened();
-            for (o, v) in row_out.iter_mut().zip(shifted) {
-                *o += w * v;
-            }
-        }
+        let taps: Vec<&[f32]> = (0..k.len())
+            .map(|i| padded[i..i + width].as_flattened())
+            .collect();
+        weighted_sum(row_out.as_flattened_mut(), &taps, k);
     }
     let mut out = vec![[0.0f32; N]; src.len()];
+    let mut taps: Vec<&[f32]> = Vec::with_capacity(k.len());
     for (y, row_out) in out.chunks_exact_mut(width).enumerate() {
-        let row_out = row_out.as_flattened_mut();
-        for (i, w) in k.iter().enumerate() {
+        taps.clear();
+        taps.extend((0..k.len()).map(|i| {
             let yy = (y + i).saturating_sub(r).min(height - 1);
-            let row_in = rows[yy * width..][..width].as_flattened();
-            for (o, v) in row_out.iter_mut().zip(row_in) {
-                *o += w * v;
-            }
-        }
+            rows[yy * width..][..width].as_flattened()
+        }));
+        weighted_sum(row_out.as_flattened_mut(), &taps, k);
     }
     out
+}
+
+/// `out[j] = k[0] taps[0][j] + k[1] taps[1][j] + ...`, summed in that order from zero (so
+/// every renderer's sum of a sample's taps from -r to r gives the same bits), a block of
+/// outputs at a time with its sums held in registers across the taps.
+fn weighted_sum(out: &mut [f32], taps: &[&[f32]], k: &[f32]) {
+    const BLOCK: usize = 32;
+    let n = out.len();
+    let whole = n - n % BLOCK;
+    for start in (0..whole).step_by(BLOCK) {
+        let mut sum = [0.0f32; BLOCK];
+        for (tap, w) in taps.iter().zip(k) {
+            for (s, v) in sum.iter_mut().zip(&tap[start..start + BLOCK]) {
+                *s += w * v;
+            }
+        }
+        out[start..start + BLOCK].copy_from_slice(&sum);
+    }
+    for (j, o) in out.iter_mut().enumerate().skip(whole) {
+        let mut sum = 0.0f32;
+        for (tap, w) in taps.iter().zip(k) {
+            sum += w * tap[j];
+        }
+        *o = sum;
+    }
 }
 
 /// A term's source over a whole frame, blurred. A one-channel source is blurred alone (a

@@ -6,7 +6,7 @@
 //! regularised inverse per frequency (on the frame's mirror extension, so nothing wraps); the
 //! other terms are taken from the previous reading and subtracted.
 
-use crate::spectral::fft2;
+use crate::spectral::{fft2, real_pair_at};
 use crate::tactile::gel_glow::{GelGlow, GlowSource, gaussian_kernel};
 use rustfft::num_complex::Complex;
 use std::sync::{Arc, Mutex};
@@ -177,37 +177,47 @@ impl GlowInverse {
     }
 
     /// The shading change whose linear glow is `observed` (row-major, width x height).
+    /// The channels are real and the inverse is a real filter even in frequency, so channels
+    /// 0 and 1 share one transform each way (as re and im) and channel 2 has its own.
     pub fn solve(&self, observed: &[[f32; 3]]) -> Vec<[f32; 3]> {
         let (w, h) = (self.width, self.height);
         let (n, m) = (2 * w, 2 * h);
-        let mut spectra: Vec<Vec<Complex<f64>>> = (0..3)
-            .map(|c| {
-                let mut data = vec![Complex::new(0.0, 0.0); n * m];
-                for y in 0..m {
-                    let yy = if y < h { y } else { m - 1 - y };
-                    for x in 0..n {
-                        let xx = if x < w { x } else { n - 1 - x };
-                        data[y * n + x].re = f64::from(observed[yy * w + xx][c]);
-                    }
-                }
-                fft2(&mut data, n, m, false);
-                data
-            })
-            .collect();
-        for (k, b) in self.inverse.iter().enumerate() {
-            let o = [spectra[0][k], spectra[1][k], spectra[2][k]];
-            for (i, s) in spectra.iter_mut().enumerate() {
-                s[k] = o[0] * b[3 * i] + o[1] * b[3 * i + 1] + o[2] * b[3 * i + 2];
+        let mut pair = vec![Complex::new(0.0, 0.0); n * m];
+        let mut third = vec![Complex::new(0.0, 0.0); n * m];
+        for y in 0..m {
+            let yy = if y < h { y } else { m - 1 - y };
+            for x in 0..n {
+                let xx = if x < w { x } else { n - 1 - x };
+                let o = observed[yy * w + xx];
+                pair[y * n + x] = Complex::new(f64::from(o[0]), f64::from(o[1]));
+                third[y * n + x].re = f64::from(o[2]);
             }
         }
+        fft2(&mut pair, n, m, false);
+        fft2(&mut third, n, m, false);
+        let mut pair_out = vec![Complex::new(0.0, 0.0); n * m];
+        for (k, b) in self.inverse.iter().enumerate() {
+            let (o0, o1) = real_pair_at(&pair, n, m, k);
+            let o = [o0, o1, third[k]];
+            let s = |i: usize| o[0] * b[3 * i] + o[1] * b[3 * i + 1] + o[2] * b[3 * i + 2];
+            let (s0, s1) = (s(0), s(1));
+            // S0 + i S1, whose inverse is s0 + i s1.
+            pair_out[k] = Complex::new(s0.re - s1.im, s0.im + s1.re);
+            // `third` is read at k alone, so its result can take its place.
+            third[k] = s(2);
+        }
+        fft2(&mut pair_out, n, m, true);
+        fft2(&mut third, n, m, true);
         let scale = 1.0 / (n * m) as f64;
         let mut out = vec![[0.0f32; 3]; w * h];
-        for (c, s) in spectra.iter_mut().enumerate() {
-            fft2(s, n, m, true);
-            for y in 0..h {
-                for x in 0..w {
-                    out[y * w + x][c] = (s[y * n + x].re * scale) as f32;
-                }
+        for y in 0..h {
+            for x in 0..w {
+                let (p, t) = (pair_out[y * n + x], third[y * n + x]);
+                out[y * w + x] = [
+                    (p.re * scale) as f32,
+                    (p.im * scale) as f32,
+                    (t.re * scale) as f32,
+                ];
             }
         }
         out
