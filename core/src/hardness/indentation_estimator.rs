@@ -64,6 +64,12 @@ impl HardnessEstimator for IndentationEstimator {
             contact_axes.push(reading.contact_axes_mm);
             within_frame.push(reading.within_frame);
             peaks.push(reading.peak_mm);
+            // Once the imprint reaches the frame's edge, the deeper frames' imprints reach it
+            // too, and they are not fitted: they are not read (a fruit's contact outgrows a
+            // real sensor's frame after about three of the eight).
+            if !reading.within_frame && peaks.len() >= MIN_FITTED_FRAMES {
+                break;
+            }
         }
         if !peaks.last().is_some_and(|p| *p > 0.0) {
             return Err(EstimateError::NoImprint);
@@ -71,9 +77,9 @@ impl HardnessEstimator for IndentationEstimator {
         // An imprint that reaches the frame's edge has no undisturbed gel left to zero the
         // integration on, so its peak reads short: fit the frames whose imprint lies within
         // the frame, or the first three (the least cut) when fewer do.
-        let mut used: Vec<usize> = (0..n).filter(|k| within_frame[*k]).collect();
-        if used.len() < 3 {
-            used = (0..n.min(3)).collect();
+        let mut used: Vec<usize> = (0..peaks.len()).filter(|k| within_frame[*k]).collect();
+        if used.len() < MIN_FITTED_FRAMES {
+            used = (0..peaks.len().min(MIN_FITTED_FRAMES)).collect();
         }
         let pick = |v: &[f64]| used.iter().map(|k| v[*k]).collect::<Vec<f64>>();
         let h = spec.gel.thickness_mm;
@@ -140,6 +146,9 @@ impl HardnessEstimator for IndentationEstimator {
         })
     }
 }
+
+/// The fewest frames the depth fit takes: the first ones when fewer lie within the frame.
+const MIN_FITTED_FRAMES: usize = 3;
 
 /// A fit whose residual is more than this share of the last frame's depth does not describe
 /// the press: the depths do not grow with the travel as two elastic bodies' do.

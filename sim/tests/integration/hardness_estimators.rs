@@ -100,3 +100,59 @@ fn a_press_does_not_depend_on_what_the_solver_pressed_before() {
         assert_eq!(a.force_n, b.force_n);
     }
 }
+
+#[test]
+fn frames_past_the_first_one_cut_by_the_frames_edge_are_not_read() {
+    // A wide soft sphere: its contact outgrows the Mini's frame within the press.
+    let spec = TactileSpec::gelsight_mini();
+    let optics = SensorOptics::for_spec(&spec);
+    let sphere = ObjectSurface::Sphere {
+        radius_mm: 60.0,
+        centre_mm: DVec2::new(0.5, 0.3),
+    };
+    let setup = PressSetup {
+        surface: &sphere,
+        object: Elastic {
+            modulus_mpa: Some(0.3),
+            poisson: 0.35,
+        },
+        gel: spec.gel,
+        fidelity: Fidelity::Layer,
+        optics: &optics,
+        phase_mm: 0.1,
+        cell_mm: None,
+        seed: 5,
+    };
+    let press = plan_press(&mut ContactSolver::new(), &setup, &PressProtocol::default())
+        .expect("the press finds contact");
+    let sequence = press.sequence(press.render(&mut CpuRenderer, &optics).expect("renders"));
+    let within: Vec<bool> = sequence
+        .frames
+        .iter()
+        .map(|f| {
+            tactex_core::tactile::frame_reading::read_frame(
+                &f.image,
+                &sequence.reference.image,
+                &spec,
+            )
+            .expect("same size")
+            .within_frame
+        })
+        .collect();
+    let first_cut = (3..within.len())
+        .find(|k| !within[*k])
+        .expect("the imprint reaches the frame's edge within the press");
+    assert!(first_cut + 1 < within.len(), "{within:?}");
+    let estimator = IndentationEstimator::default();
+    let read = estimator.estimate(&sequence, &spec).expect("an estimate");
+    // The frames past the first cut one replaced by a blank gel: nothing changes.
+    let mut blanked = sequence.clone();
+    for frame in &mut blanked.frames[first_cut + 1..] {
+        frame.image = sequence.reference.image.clone();
+    }
+    let read_blanked = estimator.estimate(&blanked, &spec).expect("an estimate");
+    assert_eq!(
+        format!("{:?}", read.hardness),
+        format!("{:?}", read_blanked.hardness)
+    );
+}
