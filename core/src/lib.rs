@@ -29,6 +29,7 @@ pub mod press;
 pub mod printable;
 pub mod query;
 pub mod scene;
+pub mod scoped_map;
 pub mod serde_exact;
 pub mod spectral;
 pub mod stats;

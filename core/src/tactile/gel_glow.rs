@@ -5,6 +5,7 @@
 //! indentation and of the change weighted by the indentation, fitted by least squares to
 //! real presses in `tactex calibrate` and applied by both renderers.
 
+use crate::scoped_map::map_on_cores;
 use serde::{Deserialize, Serialize};
 
 /// The largest blur a profile may ask for (pixels, 1 sigma): bounds the work per frame.
@@ -484,9 +485,13 @@ impl GelGlow {
         width: usize,
         height: usize,
     ) -> Vec<[f32; 3]> {
+        let terms = self.terms();
+        // The blurs are independent: made on the cores, summed in the terms' order.
+        let blurred = map_on_cores(&terms, |term| {
+            blurred_source(term, change, indentation_mm, width, height)
+        });
         let mut out = vec![[0.0f32; 3]; change.len()];
-        for term in self.terms() {
-            let blurred = blurred_source(&term, change, indentation_mm, width, height);
+        for (term, blurred) in terms.iter().zip(blurred) {
             for (o, b) in out.iter_mut().zip(&blurred) {
                 for (c, row) in term.mix.iter().enumerate() {
                     o[c] += row[0] * b[0] + row[1] * b[1] + row[2] * b[2];
