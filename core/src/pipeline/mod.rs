@@ -174,12 +174,11 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
         lap("press", arm, t);
         drop(to_reader);
         let t = start("hardness", arm);
-        let mut estimated = read_queued();
-        estimated.extend(
-            reader
-                .join()
-                .map_err(|_| PipelineError::Estimator("the hardness reader panicked".into()))?,
-        );
+        let panicked = |_| PipelineError::Estimator("the hardness reader panicked".into());
+        // A panic in an estimator is an error of the question here as on the reader's thread.
+        let mut estimated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(read_queued))
+            .map_err(panicked)?;
+        estimated.extend(reader.join().map_err(panicked)?);
         Ok::<_, PipelineError>(((estimated, t), presses))
     })?;
     let (estimated, t) = estimated;

@@ -16,6 +16,16 @@ fn ask_on(
     shows: bool,
     refuse_below_m: f64,
 ) -> Answer {
+    ask_with(centre, object_m, shows, refuse_below_m, &TwoMpa).expect("the question is answered")
+}
+
+fn ask_with(
+    centre: (f64, f64),
+    object_m: Option<(f64, f64)>,
+    shows: bool,
+    refuse_below_m: f64,
+    estimator: &dyn HardnessEstimator,
+) -> Result<Answer, PipelineError> {
     let z = Rc::new(Cell::new(0.3));
     let xy = Rc::new(Cell::new((0.0, 0.0)));
     let mut gel = Gel {
@@ -41,11 +51,38 @@ fn ask_on(
             arm: &mut arm,
         },
         &OneApple,
-        &TwoMpa,
+        estimator,
         &explain::TemplateExplainer,
         &PipelineConfig::default(),
     )
-    .expect("the question is answered")
+}
+
+/// Panics on every press, as a broken estimator would.
+struct Panics;
+impl HardnessEstimator for Panics {
+    fn name(&self) -> &str {
+        "panics"
+    }
+    fn estimate(
+        &self,
+        _: &PressSequence,
+        _: &TactileSpec,
+    ) -> Result<HardnessEstimate, EstimateError> {
+        panic!("a broken estimator")
+    }
+}
+
+#[test]
+fn an_estimator_that_panics_fails_the_question_with_an_error_not_a_panic() {
+    // Whichever thread reads the press (the reader, or the arm's once it is done pressing).
+    for _ in 0..4 {
+        let failed = ask_with((48.0, 40.0), None, true, 0.0, &Panics);
+        assert!(
+            matches!(&failed, Err(PipelineError::Estimator(why)) if why.contains("panicked")),
+            "{:?}",
+            failed.map(|a| a.answer)
+        );
+    }
 }
 
 #[test]
