@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde::Serialize;
 use std::path::PathBuf;
-use tactex_core::tactile::contact::{ContactEvidence, ContactRule, contact_evidence};
+use tactex_core::tactile::contact::{ContactEvidence, ContactRule, bin_for, contact_evidence};
 use tactex_core::tactile::contact_circle::{ContactCircle, estimate_contact_circle};
 
 #[derive(Args, Debug)]
@@ -18,7 +18,8 @@ pub struct ContactArgs {
     #[arg(long)]
     pub reference: PathBuf,
     /// Millimetres per pixel (above 0 up to 1), to give the circle in mm too (GelSight Mini
-    /// at 320x240: 0.0634).
+    /// at 320x240: 0.0634); frames of pixels finer than 0.05 mm are then binned to it for the
+    /// criterion, whose thresholds were measured at that size.
     #[arg(long, value_parser = above(0.0, 1.0))]
     pub mm_per_px: Option<f64>,
     /// Print one JSON object on stdout.
@@ -54,10 +55,14 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             image.height()
         );
     }
-    let Some(evidence) = contact_evidence(&image, &reference, &ContactRule::default()) else {
+    let rule = ContactRule::default();
+    let Some(evidence) = contact_evidence(&image, &reference, &rule, mm_per_px) else {
         bail!(
-            "{}: too small for the contact test's 32 px tiles",
-            args.image.display()
+            "{}: too small for the contact test's {} px tiles (binned {}x{} for --mm-per-px)",
+            args.image.display(),
+            rule.tile_px,
+            bin_for(rule.pixel_mm, mm_per_px),
+            bin_for(rule.pixel_mm, mm_per_px),
         );
     };
     let circle = evidence

@@ -216,6 +216,7 @@ fn pair_markers(
 struct RecordedDescent<'a> {
     run: &'a [usize],
     recorded: &'a [TactileFrame],
+    mm_per_px: f64,
 }
 
 /// The recording holds fewer frames at the spot than the protocol asks for.
@@ -242,6 +243,10 @@ impl PressProbe for RecordedDescent<'_> {
 
     fn record(&mut self, k: usize) -> Result<usize, RecordingEnds> {
         self.at(1 + k)
+    }
+
+    fn mm_per_px(&self) -> f64 {
+        self.mm_per_px
     }
 }
 
@@ -281,7 +286,11 @@ fn compare_press(
         max_search_steps: run.len(),
         ..PressProtocol::default()
     };
-    let mut descent = RecordedDescent { run, recorded };
+    let mut descent = RecordedDescent {
+        run,
+        recorded,
+        mm_per_px: spec.mm_per_px,
+    };
     let (contact, evidence, press_frames) = match run_press(&protocol, &mut descent) {
         Ok(PressOutcome::Pressed(p)) => (
             run.iter().position(|&i| i == p.frames[0]),

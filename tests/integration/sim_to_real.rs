@@ -15,6 +15,9 @@ fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fots")
 }
 
+/// The FOTS frames' pixel size (its profile's, from the marked ball presses).
+const FOTS_MM_PER_PX: Option<f64> = Some(0.05107252298263534);
+
 fn rgb(path: &Path) -> RgbImage {
     image::open(path).unwrap().to_rgb8()
 }
@@ -149,10 +152,10 @@ fn contact_criterion_fires_on_every_ball_press_and_not_on_the_background() {
     let rule = ContactRule::default();
     let background = rgb(&fixtures().join("background.png"));
     for frame in ball_press_frames() {
-        let e = contact_evidence(&rgb(&frame), &background, &rule).unwrap();
+        let e = contact_evidence(&rgb(&frame), &background, &rule, FOTS_MM_PER_PX).unwrap();
         assert!(e.contact, "{}: {e:?}", frame.display());
     }
-    let same = contact_evidence(&background, &background, &rule).unwrap();
+    let same = contact_evidence(&background, &background, &rule, FOTS_MM_PER_PX).unwrap();
     assert!(!same.contact && same.min_tile_ssim > 0.999);
     // A later no-contact frame: camera noise of 2 grey levels and a colour drift of 15 levels
     // in blue, about what the FOTS frames show between shots.
@@ -172,7 +175,7 @@ fn contact_criterion_fires_on_every_ball_press_and_not_on_the_background() {
             (p[c] as f64 + noise + drift).round().clamp(0.0, 255.0) as u8
         }))
     });
-    let e = contact_evidence(&drifted, &background, &rule).unwrap();
+    let e = contact_evidence(&drifted, &background, &rule, FOTS_MM_PER_PX).unwrap();
     assert!(!e.contact, "{e:?}");
 }
 

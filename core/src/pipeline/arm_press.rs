@@ -70,16 +70,21 @@ impl<T: TactileSensor, A: Arm> PressProbe for ArmProbe<'_, T, A> {
     fn record(&mut self, k: usize) -> Result<(TactileFrame, f64), DeviceError> {
         self.lowered(k)
     }
+    fn mm_per_px(&self) -> f64 {
+        self.tactile.spec().mm_per_px
+    }
 }
 
-/// Where the imprint of the first contact frame lies, as a fraction of the frame's width and
-/// height: the middle of its colour change against `reference` (where the change, smoothed
-/// over a few pixels against noise and marker dots, exceeds half its largest value); None
-/// when nothing changed. A press is cut when the middle falls in the frame's outer eighth: at
-/// first contact the imprint is small and a press centred on the object has it in the middle,
-/// a long ridge across the pad included; deeper frames of a large fruit reach the edge and are
-/// still read.
-pub(super) fn imprint_middle(
+/// How far the first contact frame's imprint lies from the frame's middle, as fractions of
+/// the frame's width and height; None when nothing changed. The imprint is where its colour
+/// change against `reference` (smoothed over a few pixels against noise and marker dots)
+/// rises more than half way from the frame's median change (camera noise) to its peak. A
+/// press is cut when the offset reaches the frame's outer eighth: at first contact the
+/// imprint is small and a press centred on the object has it in the middle; deeper frames of
+/// a large fruit reach the edge and are still read. A ridge (an imprint at least three times
+/// as long as wide: a banana's or a cucumber's top) crosses the pad whatever the pad's place
+/// along it, brighter where the ridge stands higher, so only its offset across counts.
+pub(super) fn imprint_offset(
     first_contact: &TactileFrame,
     reference: &TactileFrame,
 ) -> Option<glam::DVec2> {
@@ -93,19 +98,40 @@ pub(super) fn imprint_middle(
         image::Luma([(0..3).map(|c| (p[c] as f32 - q[c] as f32).abs()).sum()])
     });
     let smooth = imageproc::filter::gaussian_blur_f32(&change, 4.0);
-    let peak = smooth.pixels().map(|p| p[0]).fold(0.0, f32::max);
-    if peak <= 0.0 {
+    let mut levels: Vec<f32> = smooth.pixels().map(|p| p[0]).collect();
+    let peak = levels.iter().copied().fold(0.0, f32::max);
+    let middle_level = levels.len() / 2;
+    let noise = *levels
+        .select_nth_unstable_by(middle_level, f32::total_cmp)
+        .1;
+    if peak <= noise {
         return None;
     }
-    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
-    for (x, y, p) in smooth.enumerate_pixels() {
-        if p[0] > 0.5 * peak {
-            sx += x as f64;
-            sy += y as f64;
-            n += 1.0;
-        }
+    let cut = noise + 0.5 * (peak - noise);
+    let inside: Vec<glam::DVec2> = smooth
+        .enumerate_pixels()
+        .filter(|(_, _, p)| p[0] > cut)
+        .map(|(x, y, _)| glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5))
+        .collect();
+    let n = inside.len() as f64;
+    let mean = inside.iter().sum::<glam::DVec2>() / n;
+    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
+    for d in inside.iter().map(|p| *p - mean) {
+        sxx += d.x * d.x;
+        syy += d.y * d.y;
+        sxy += d.x * d.y;
     }
-    Some(glam::DVec2::new(sx / n / w as f64, sy / n / h as f64))
+    let (sxx, syy, sxy) = (sxx / n, syy / n, sxy / n);
+    // The spread's principal axes: a ridge's long one runs along it.
+    let half_gap = (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt();
+    let (long, short) = (0.5 * (sxx + syy) + half_gap, 0.5 * (sxx + syy) - half_gap);
+    let mut offset = mean - 0.5 * glam::DVec2::new(w as f64, h as f64);
+    if long >= 9.0 * short.max(0.0) && long > 0.0 {
+        let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+        let along = glam::DVec2::new(angle.cos(), angle.sin());
+        offset -= offset.dot(along) * along;
+    }
+    Some(offset / glam::DVec2::new(w as f64, h as f64))
 }
 
 /// Above the target, run the press protocol from `approach_clearance_mm` above the surface
@@ -212,15 +238,11 @@ pub(super) fn press_at<T: TactileSensor, A: Arm>(
         .map(|(_, z)| (contact_z - z) * 1e3)
         .collect();
     let frames: Vec<TactileFrame> = pressed.frames.into_iter().map(|(f, _)| f).collect();
-    if let Some(middle) = imprint_middle(&frames[0], &reference)
-        && !((0.125..=0.875).contains(&middle.x) && (0.125..=0.875).contains(&middle.y))
+    if let Some(offset) = imprint_offset(&frames[0], &reference)
+        && (offset.x.abs() > 0.375 || offset.y.abs() > 0.375)
     {
         // From the frame's middle to the imprint's, in the pad's frame, then the world's.
-        let in_pad_mm = DVec3::new(
-            (middle.x - 0.5) * pad_mm[0],
-            (middle.y - 0.5) * pad_mm[1],
-            0.0,
-        );
+        let in_pad_mm = DVec3::new(offset.x * pad_mm[0], offset.y * pad_mm[1], 0.0);
         let in_world = above(0.0).rotation * in_pad_mm * 1e-3;
         return Ok(Attempt::Cut {
             offset_m: in_world.truncate(),
@@ -236,4 +258,87 @@ pub(super) fn press_at<T: TactileSensor, A: Arm>(
         evidence: pressed.evidence,
         recentred_mm: None,
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use image::{Rgb, RgbImage};
+
+    /// A 160 x 120 gel with camera noise, darkened by `dent(x, y)` grey levels.
+    fn frame(seed: u64, dent: impl Fn(f64, f64) -> f64) -> TactileFrame {
+        let mut state = seed;
+        let image = RgbImage::from_fn(160, 120, |x, y| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let noise = ((state >> 33) % 3) as f64 - 1.0;
+            let v = (120.0 + noise - dent(x as f64, y as f64)).round() as u8;
+            Rgb([v, v, v])
+        });
+        TactileFrame {
+            image,
+            timestamp_s: 0.0,
+        }
+    }
+
+    fn offset(dent: impl Fn(f64, f64) -> f64) -> glam::DVec2 {
+        imprint_offset(&frame(7, dent), &frame(1, |_, _| 0.0)).unwrap()
+    }
+
+    fn disc(cx: f64, cy: f64) -> impl Fn(f64, f64) -> f64 {
+        move |x, y| {
+            if (x - cx).hypot(y - cy) < 8.0 {
+                30.0
+            } else {
+                0.0
+            }
+        }
+    }
+
+    #[test]
+    fn a_round_imprint_is_placed_where_it_lies() {
+        let o = offset(disc(80.0, 60.0));
+        assert!(o.length() < 0.02, "{o}");
+        let o = offset(disc(12.0, 60.0));
+        assert!(o.x < -0.375 && o.y.abs() < 0.02, "{o}");
+    }
+
+    /// A ridge along a line through (cx, cy) at `angle`, deeper towards +x: a banana's top.
+    fn ridge(cx: f64, cy: f64, angle: f64) -> impl Fn(f64, f64) -> f64 {
+        let (along, across) = (
+            glam::DVec2::new(angle.cos(), angle.sin()),
+            glam::DVec2::new(-angle.sin(), angle.cos()),
+        );
+        move |x, y| {
+            let d = glam::DVec2::new(x - cx, y - cy);
+            if d.dot(across).abs() < 4.0 {
+                20.0 + 0.2 * d.dot(along)
+            } else {
+                0.0
+            }
+        }
+    }
+
+    #[test]
+    fn a_ridge_across_the_pad_counts_only_its_offset_across() {
+        // Brighter at one end, so its bright half lies far out along it, but through the middle.
+        for angle in [0.0f64, 0.3, -0.5, 1.2] {
+            let o = offset(ridge(80.0, 60.0, angle));
+            assert!(o.x.abs() < 0.375 && o.y.abs() < 0.375, "angle {angle}: {o}");
+            assert!(o.length() < 0.05, "angle {angle}: {o}");
+        }
+        // Along the frame's top edge: cut, and the pad is sent straight across to it.
+        let o = offset(ridge(80.0, 8.0, 0.0));
+        assert!(o.y < -0.375 && o.x.abs() < 0.01, "{o}");
+    }
+
+    #[test]
+    fn noise_alone_places_no_imprint_off_the_middle() {
+        let o = imprint_offset(&frame(7, |_, _| 0.0), &frame(1, |_, _| 0.0));
+        assert!(
+            o.is_none_or(|o| o.x.abs() < 0.375 && o.y.abs() < 0.375),
+            "{o:?}"
+        );
+    }
 }

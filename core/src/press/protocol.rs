@@ -52,6 +52,8 @@ pub trait PressProbe {
     fn look(&mut self, at: Look) -> Result<(RgbImage, Self::Frame), Self::Error>;
     /// The frame with the pad lowered `k` steps, recorded without a contact test.
     fn record(&mut self, k: usize) -> Result<Self::Frame, Self::Error>;
+    /// The frames' pixel size (mm), which the contact criterion bins to its own.
+    fn mm_per_px(&self) -> f64;
 }
 
 /// A press as the protocol recorded it.
@@ -107,7 +109,12 @@ pub fn run_press<P: PressProbe>(
     protocol.validate().map_err(PressError::Invalid)?;
     let (reference_image, reference) = probe.look(Look::Reference).map_err(PressError::Probe)?;
     let (second, _) = probe.look(Look::NoiseFloor).map_err(PressError::Probe)?;
-    let test = ContactTest::with_noise_floor(&reference_image, &second, &protocol.rule)
+    let test = ContactTest::with_noise_floor(
+        &reference_image,
+        &second,
+        &protocol.rule,
+        Some(probe.mm_per_px()),
+    )
         .ok_or_else(|| {
             PressError::Invalid(format!(
                 "a {}x{} frame is smaller than one {} px SSIM tile, or the two no-contact frames differ in size",
@@ -194,6 +201,9 @@ mod tests {
         fn record(&mut self, k: usize) -> Result<usize, String> {
             self.recorded.push(k);
             Ok(k)
+        }
+        fn mm_per_px(&self) -> f64 {
+            0.05
         }
     }
 

@@ -14,6 +14,12 @@
 //! the worst tile's dissimilarity 1 - SSIM is `floor_ratio` (1.3) times the floor's. Measured on
 //! the twin's frames over 12 seeds: noise of 0.5, 1 and 2 grey levels gives floors of
 //! 0.9938, 0.9803 and 0.930, each within +-6% in dissimilarity, so 1.3 is over 4 spreads.
+//!
+//! The tiles and the 7x7 window are in pixels, so the thresholds hold at the pixel size they
+//! were measured at (`ContactRule::pixel_mm`, FOTS's 0.051 mm). A sensor of finer pixels
+//! (R1.5's 0.0295 mm) would see a shallow imprint's slopes over a smaller patch of gel in
+//! each window, against the same camera noise per pixel, and fire late: its frames are read
+//! binned, each grey level the mean of a b x b block, b the nearest whole ratio of the sizes.
 
 use super::markers::{detect_markers, grid_pitch_px, mean_moved_displacement, track};
 use super::ssim::{gray, ssim_map};
@@ -32,6 +38,8 @@ pub struct ContactRule {
     /// With a noise floor measured (two no-contact frames), contact is also called when the
     /// worst tile's dissimilarity (1 - SSIM) exceeds the floor's by this factor.
     pub floor_ratio: f64,
+    /// The pixel size (mm) the tiles and thresholds hold at: finer frames are binned to it.
+    pub pixel_mm: f64,
 }
 
 impl Default for ContactRule {
@@ -41,6 +49,7 @@ impl Default for ContactRule {
             tile_ssim: 0.88,
             marker_px: 2.0,
             floor_ratio: 1.3,
+            pixel_mm: 0.05,
         }
     }
 }
@@ -72,6 +81,10 @@ pub struct ContactEvidence {
 #[derive(Clone, Debug)]
 pub struct ContactTest {
     rule: ContactRule,
+    /// The side of the blocks the grey levels are binned over.
+    bin: usize,
+    /// The frame's size in pixels, and the binned grey levels' size.
+    frame_size: (u32, u32),
     width: usize,
     height: usize,
     reference_gray: Vec<f64>,
@@ -83,9 +96,14 @@ pub struct ContactTest {
 }
 
 impl ContactTest {
-    /// None if the frame is smaller than one tile.
-    pub fn new(reference: &RgbImage, rule: &ContactRule) -> Option<Self> {
-        let (w, h) = (reference.width() as usize, reference.height() as usize);
+    /// The test for frames of `mm_per_px` (None: read at their own pixels, unbinned); None
+    /// if the binned frame is smaller than one tile.
+    pub fn new(reference: &RgbImage, rule: &ContactRule, mm_per_px: Option<f64>) -> Option<Self> {
+        let bin = bin_for(rule.pixel_mm, mm_per_px);
+        let (w, h) = (
+            reference.width() as usize / bin,
+            reference.height() as usize / bin,
+        );
         let t = rule.tile_px.max(1);
         if w < t + 6 || h < t + 6 {
             return None;
@@ -96,9 +114,11 @@ impl ContactTest {
             .flatten();
         Some(Self {
             rule: *rule,
+            bin,
+            frame_size: reference.dimensions(),
             width: w,
             height: h,
-            reference_gray: gray(reference),
+            reference_gray: binned_gray(reference, bin),
             reference_markers: markers,
             pitch_px,
             noise_floor: None,
@@ -115,13 +135,14 @@ impl ContactTest {
         reference: &RgbImage,
         second: &RgbImage,
         rule: &ContactRule,
+        mm_per_px: Option<f64>,
     ) -> Option<Self> {
-        let mut test = Self::new(reference, rule)?;
+        let mut test = Self::new(reference, rule, mm_per_px)?;
         if second.dimensions() != reference.dimensions() {
             return None;
         }
         let map = ssim_map(
-            &gray(second),
+            &binned_gray(second, test.bin),
             &test.reference_gray,
             test.width,
             test.height,
@@ -154,10 +175,10 @@ impl ContactTest {
 
     /// Evidence of `frame`; None if its size differs from the reference's.
     pub fn evidence(&self, frame: &RgbImage) -> Option<ContactEvidence> {
-        if (frame.width() as usize, frame.height() as usize) != (self.width, self.height) {
+        if frame.dimensions() != self.frame_size {
             return None;
         }
-        let frame_gray = gray(frame);
+        let frame_gray = binned_gray(frame, self.bin);
         let map = ssim_map(
             &frame_gray,
             &self.reference_gray,
@@ -199,12 +220,100 @@ impl ContactTest {
     }
 }
 
-/// Contact evidence of `frame` against the no-contact `reference` (fixed threshold); None if
-/// their sizes differ or the frame is smaller than one tile.
+/// Contact evidence of `frame` against the no-contact `reference` (fixed threshold), binned
+/// as `ContactTest::new` bins; None if their sizes differ or the frame is smaller than one
+/// tile.
 pub fn contact_evidence(
     frame: &RgbImage,
     reference: &RgbImage,
     rule: &ContactRule,
+    mm_per_px: Option<f64>,
 ) -> Option<ContactEvidence> {
-    ContactTest::new(reference, rule)?.evidence(frame)
+    ContactTest::new(reference, rule, mm_per_px)?.evidence(frame)
+}
+
+/// The side of the blocks that bring pixels of `mm_per_px` nearest to `pixel_mm`: 1 for
+/// pixels as coarse or coarser, or an unknown size.
+pub fn bin_for(pixel_mm: f64, mm_per_px: Option<f64>) -> usize {
+    match mm_per_px.map(|s| pixel_mm / s) {
+        Some(ratio) if ratio.is_finite() && ratio > 1.0 => ratio.round().min(64.0) as usize,
+        _ => 1,
+    }
+}
+
+/// The image's grey levels, each the mean over a `bin` x `bin` block (a last partial row or
+/// column of blocks is left out).
+fn binned_gray(img: &RgbImage, bin: usize) -> Vec<f64> {
+    let g = gray(img);
+    if bin <= 1 {
+        return g;
+    }
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let (bw, bh) = (w / bin, h / bin);
+    let mut out = vec![0.0; bw * bh];
+    for y in 0..bh * bin {
+        let row = &g[y * w..][..bw * bin];
+        for (o, block) in out[(y / bin) * bw..][..bw]
+            .iter_mut()
+            .zip(row.chunks_exact(bin))
+        {
+            *o += block.iter().sum::<f64>();
+        }
+    }
+    let n = (bin * bin) as f64;
+    out.iter_mut().for_each(|v| *v /= n);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use image::Rgb;
+
+    /// A textured gel (so that SSIM sees structure) with a shallow dark disc of `radius` px.
+    fn frame(scale: u32, radius: f64) -> RgbImage {
+        RgbImage::from_fn(96 * scale, 80 * scale, |x, y| {
+            let (x, y) = (x / scale, y / scale);
+            let r = ((x as f64 - 48.0).powi(2) + (y as f64 - 40.0).powi(2)).sqrt();
+            let base = 120 + ((x * 7 + y * 13) % 17) as u8;
+            let v = if r < radius { base - 6 } else { base };
+            Rgb([v, v, v])
+        })
+    }
+
+    #[test]
+    fn pixels_finer_than_the_rules_are_binned_to_the_nearest_whole_ratio() {
+        assert_eq!(bin_for(0.05, None), 1);
+        assert_eq!(bin_for(0.05, Some(0.0634)), 1);
+        assert_eq!(bin_for(0.05, Some(0.0511)), 1);
+        assert_eq!(bin_for(0.05, Some(0.0295)), 2);
+        assert_eq!(bin_for(0.05, Some(0.0125)), 4);
+        assert_eq!(bin_for(0.05, Some(0.0)), 1);
+        assert_eq!(bin_for(0.05, Some(f64::NAN)), 1);
+        assert_eq!(bin_for(0.05, Some(1e-12)), 64);
+    }
+
+    #[test]
+    fn a_frame_at_twice_the_resolution_reads_as_the_frame_at_the_rules_pixel_size() {
+        let rule = ContactRule::default();
+        for radius in [0.0, 6.0, 12.0] {
+            let coarse = contact_evidence(&frame(1, radius), &frame(1, 0.0), &rule, Some(0.05));
+            let fine = contact_evidence(&frame(2, radius), &frame(2, 0.0), &rule, Some(0.025));
+            assert_eq!(coarse, fine, "radius {radius}");
+            // Read at its own pixels, the fine frame's imprint is the same contrast over
+            // smoother windows: a different reading.
+            let unbinned = contact_evidence(&frame(2, radius), &frame(2, 0.0), &rule, None);
+            if radius > 0.0 {
+                assert_ne!(unbinned.unwrap().min_tile_ssim, fine.unwrap().min_tile_ssim);
+            }
+        }
+    }
+
+    #[test]
+    fn frames_smaller_than_a_tile_once_binned_have_no_test() {
+        let rule = ContactRule::default();
+        let small = RgbImage::new(60, 60);
+        assert!(ContactTest::new(&small, &rule, None).is_some());
+        assert!(ContactTest::new(&small, &rule, Some(0.025)).is_none());
+    }
 }

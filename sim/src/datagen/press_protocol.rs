@@ -172,6 +172,9 @@ impl PressProbe for SolverProbe<'_, '_> {
     fn record(&mut self, k: usize) -> Result<PressedFrame, PressError> {
         self.frame(k)
     }
+    fn mm_per_px(&self) -> f64 {
+        self.setup.optics.mm_per_px
+    }
 }
 
 /// Runs the protocol on the solver (see the module docs); `max_search_steps` counts from
@@ -335,6 +338,7 @@ mod tests {
             &images[0],
             &second,
             &PressProtocol::default().rule,
+            Some(optics.mm_per_px),
         )
         .unwrap();
         assert_eq!(test.evidence(&images[1]).unwrap(), p.contact);
