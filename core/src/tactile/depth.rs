@@ -10,6 +10,9 @@ use rustfft::num_complex::Complex;
 /// Sides of the border whose medians differ by more than this share of the imprint's depth
 /// are not level: the imprint presses one of them in.
 const UNLEVEL_SHARE: f64 = 0.6;
+/// The zero level moves from the border's median to its lowest side across this width of
+/// unlevelness, centred on `UNLEVEL_SHARE`.
+const UNLEVEL_BAND: f64 = 0.2;
 
 /// Indentation (mm, into the gel) per pixel, row-major, zero where the gel is undisturbed
 /// (the median of the frame's border, or of its lowest side where the border is far from
@@ -89,9 +92,13 @@ pub fn integrate_slopes(field: &SlopeField) -> Vec<f64> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
             (lo.min(*s), hi.max(*s))
         });
+    // Blended across a band round the threshold rather than switched: the level of an
+    // imprint running off the frame must not jump with a tenth of a grey level.
     let peak = depth.iter().copied().fold(f64::NEG_INFINITY, f64::max) - zero;
-    if peak > 0.0 && highest - lowest > UNLEVEL_SHARE * peak {
-        zero = lowest;
+    if peak > 0.0 {
+        let unlevel = (highest - lowest) / peak;
+        let t = ((unlevel - UNLEVEL_SHARE) / UNLEVEL_BAND + 0.5).clamp(0.0, 1.0);
+        zero += t * (lowest - zero);
     }
     depth.iter_mut().for_each(|d| *d -= zero);
     depth
@@ -153,5 +160,52 @@ mod tests {
         };
         let err = round_trip(cap, 160, 120, px);
         assert!(err < 0.05 * d, "worst error {err} mm of a {d} mm dimple");
+    }
+
+    /// The peak read from a cap of `d` mm centred at (cx, 60) px of a 160 x 120 frame.
+    fn peak_read(cx: f64, d: f64) -> f64 {
+        let (r, px, w, h) = (20.0, 0.0634, 160, 120);
+        let mut field = SlopeField {
+            width: w,
+            height: h,
+            mm_per_px: px,
+            gx: vec![0.0; w * h],
+            gy: vec![0.0; w * h],
+            valid: vec![true; w * h],
+        };
+        let cap = |x: f64, y: f64| {
+            let q = (x - cx * px).powi(2) + (y - 60.0 * px).powi(2);
+            (d - q / (2.0 * r)).max(0.0)
+        };
+        for y in 0..h {
+            for x in 0..w {
+                let (xf, yf) = (x as f64 * px, y as f64 * px);
+                field.gx[y * w + x] =
+                    ((cap(xf + 0.5 * px, yf) - cap(xf - 0.5 * px, yf)) / px) as f32;
+                field.gy[y * w + x] =
+                    ((cap(xf, yf + 0.5 * px) - cap(xf, yf - 0.5 * px)) / px) as f32;
+            }
+        }
+        integrate_slopes(&field)
+            .into_iter()
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    #[test]
+    fn the_depth_read_moves_smoothly_as_an_imprint_runs_off_the_frame() {
+        // Where the border turns from level to pressed in on one side, the zero level must
+        // not jump: a press read through a real sensor sat on that switch, and a tenth of a
+        // grey level moved its third frame's depth by 14%.
+        let d = 0.6;
+        let peaks: Vec<f64> = (0..=80).map(|i| peak_read(80.0 + i as f64, d)).collect();
+        for (i, pair) in peaks.windows(2).enumerate() {
+            assert!(
+                (pair[1] - pair[0]).abs() < 0.02 * d,
+                "at {} px: {:.4} -> {:.4} mm",
+                80 + i,
+                pair[0],
+                pair[1]
+            );
+        }
     }
 }
