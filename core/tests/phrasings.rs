@@ -3,6 +3,7 @@
 //! means. Every one that reads wrong is listed, not only the first.
 
 use tactex_core::catalog::FruitCatalog;
+use tactex_core::hardness::scale::Hardness;
 use tactex_core::query::{Extreme, Intent, Property, Query, parse};
 
 const PHRASINGS: &str = include_str!("fixtures/phrasings.tsv");
@@ -13,6 +14,7 @@ fn intent(name: &str) -> Intent {
         "extreme" => Intent::Extreme,
         "compare" => Intent::Compare,
         "summarize" => Intent::Summarize,
+        "threshold" => Intent::Threshold,
         other => panic!("phrasings.tsv: intent {other:?}"),
     }
 }
@@ -71,6 +73,7 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     let mut ranked = false;
     let mut unknown = Vec::new();
     let mut categories: Vec<String> = Vec::new();
+    let mut threshold = None;
     for pair in extras.split(' ').filter(|p| !p.is_empty()) {
         // A word without '=' continues a two-word position.
         let Some((key, value)) = pair.split_once('=') else {
@@ -85,6 +88,12 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
             "position" => position = Some(value.to_string()),
             // A group's name may take two words ("stone fruit"), written with '_'.
             "category" => categories.push(value.replace('_', " ")),
+            // harder:2MPa, softer:30A: the direction, and the value as `Hardness` reads it.
+            "threshold" => {
+                let (dir, v) = value.split_once(':').unwrap();
+                let e = Hardness::parse(v).unwrap().modulus_mpa().unwrap();
+                threshold = Some((dir == "harder", e));
+            }
             other => panic!("phrasings.tsv: extra {other:?}"),
         }
     }
@@ -121,6 +130,16 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     if got_categories != categories {
         wrong.push(format!(
             "categories {got_categories:?}, expected {categories:?}"
+        ));
+    }
+    let got_threshold = query.threshold.as_ref().map(|t| (t.harder, t.modulus_mpa));
+    let same = match (got_threshold, threshold) {
+        (Some((a, e)), Some((b, f))) => a == b && (e - f).abs() <= 1e-9 * f,
+        (g, t) => g.is_none() && t.is_none(),
+    };
+    if !same {
+        wrong.push(format!(
+            "threshold {got_threshold:?}, expected {threshold:?}"
         ));
     }
     if query.unknown != unknown {

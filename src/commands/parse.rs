@@ -48,6 +48,18 @@ fn describe(q: &Query) -> String {
         (false, _) => q.targets.join(", "),
     };
     s += &format!("objects:  {over}\n");
+    if !q.categories.is_empty() {
+        let groups: Vec<String> = q
+            .categories
+            .iter()
+            .map(|c| format!("{} ({})", c.name, c.members.join(", ")))
+            .collect();
+        s += &format!("groups:   {}\n", groups.join("; "));
+    }
+    if let Some(t) = &q.threshold {
+        let rel = if t.harder { "harder" } else { "softer" };
+        s += &format!("value:    {rel} than {}\n", t.words());
+    }
     if !q.exclude.is_empty() {
         s += &format!("except:   {}\n", q.exclude.join(", "));
     }

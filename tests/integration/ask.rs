@@ -478,6 +478,43 @@ fn parse_prints_the_query_contract_as_json() {
 }
 
 #[test]
+fn a_value_question_selects_exactly_the_fruit_past_it_hardest_first() {
+    // scenes/demo.toml's truth: mango 3.0, apple 3.25 and avocado 5.0 MPa are over 2 MPa;
+    // tomato 0.45, banana 0.8 and lime 1.5 under it.
+    let a = ask_json("scenes/demo.toml", "Which fruits are harder than 2 MPa?");
+    let mut got = selected_labels(&a);
+    let moduli: Vec<f64> = a["selected"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| modulus(&a["objects"][i.as_u64().unwrap() as usize]))
+        .collect();
+    assert!(moduli.windows(2).all(|w| w[0] >= w[1]), "{moduli:?}");
+    got.sort();
+    assert_eq!(got, ["apple", "avocado", "mango"], "{}", a["answer"]);
+    let answer = a["answer"].as_str().unwrap();
+    assert!(
+        answer.starts_with("Three fruit are harder than 2 MPa ("),
+        "{answer}"
+    );
+    assert!(answer.contains("Not harder: lime"), "{answer}");
+    assert_eq!(a["query"]["intent"], "threshold");
+
+    // A value no fruit passes: said, with the nearest; the question is still answered.
+    let a = ask_json("scenes/demo.toml", "Is anything softer than 0.1 MPa?");
+    assert_eq!(selected_labels(&a), Vec::<String>::new());
+    let answer = a["answer"].as_str().unwrap();
+    assert!(
+        answer.starts_with("No fruit I measured is softer than 0.1 MPa"),
+        "{answer}"
+    );
+    assert!(answer.contains("The softest is the tomato"), "{answer}");
+
+    let e = fails(&["parse", "Which fruits are harder than 2?"]);
+    assert!(e.contains("hardness value '2': has no unit"), "{e}");
+}
+
+#[test]
 fn colour_and_position_filters_choose_the_fruit() {
     let scene = "scenes/demo.toml";
     let a = ask_json(scene, "How hard is the yellow one?");

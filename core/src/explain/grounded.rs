@@ -164,7 +164,13 @@ pub fn check_invented(
             }
         }
     }
-    let hardness: Vec<f64> = facts.objects.iter().flat_map(hardness_values).collect();
+    // The value a threshold question holds the fruit against may be said back.
+    let hardness: Vec<f64> = facts
+        .objects
+        .iter()
+        .flat_map(hardness_values)
+        .chain(facts.query.threshold.iter().flat_map(|t| t.values()))
+        .collect();
     let percents: Vec<f64> = facts.objects.iter().flat_map(percent_values).collect();
     let counts: Vec<f64> = [
         Some(facts.objects.len()),
@@ -290,6 +296,19 @@ mod tests {
     }
 
     #[test]
+    fn a_threshold_may_be_said_back_but_not_another_value() {
+        let (f, c) = facts("Which fruits are harder than 2 MPa?");
+        let reply = "One fruit is harder than 2 MPa (44 Shore A): the lime at the centre, \
+                     4.00 MPa, unripe. The banana at the left front is 0.80 MPa, ripe.";
+        assert_eq!(check(reply, &f, &c), Ok(()), "{reply}");
+        let reply = reply.replace("2 MPa", "2.5 MPa");
+        assert!(matches!(
+            check(&reply, &f, &c),
+            Err(Ungrounded::InventedNumber(_))
+        ));
+    }
+
+    #[test]
     fn numbers_are_read_with_their_decimals_and_units() {
         let n = numbers_with_units("It is 0.80 MPa ± 10 % (21 Shore 00), 3rd of 2.");
         let got: Vec<(f64, i32, &str)> = n
@@ -315,6 +334,10 @@ mod tests {
             "Rank the fruits from softest to hardest",
             "How hard is the banana?",
             "Is the lime harder than the banana?",
+            "Which fruits are harder than 2 MPa?",
+            "Which fruits are softer than 30 Shore A?",
+            "Is anything harder than 10 MPa?",
+            "Which fruit is softer than 0.85 MPa?",
         ] {
             let (f, c) = facts(prompt);
             let text = TemplateExplainer.explain(&f).text;

@@ -88,6 +88,16 @@ pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Ve
             measured.sort_by(|a, b| key(b).total_cmp(&key(a)));
             measured
         }
+        Intent::Threshold => {
+            measured.retain(|&i| {
+                query
+                    .threshold
+                    .as_ref()
+                    .is_some_and(|t| t.holds_for(stiffness(&objects[i])))
+            });
+            measured.sort_by(|a, b| key(b).total_cmp(&key(a)));
+            measured
+        }
         Intent::Extreme => {
             let pick = match query.extreme {
                 Some(Extreme::Least) => measured.iter().min_by(|a, b| key(a).total_cmp(&key(b))),

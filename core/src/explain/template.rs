@@ -3,6 +3,7 @@
 
 use super::{Explainer, Explanation, Facts, Measured, stiffness};
 use crate::hardness::scale::HardnessReport;
+use crate::query::threshold::Threshold;
 use crate::query::{Extreme, Intent, Property, Query};
 
 /// The default explainer: the same facts always give the same words.
@@ -95,6 +96,102 @@ fn describe(m: &Measured) -> String {
     s
 }
 
+/// The sentences of a threshold's answer: the fruit past the value (or that none is, and
+/// the nearest), the others asked about, and any whose likely range holds the value.
+fn past_threshold(
+    query: &Query,
+    t: &Threshold,
+    objects: &[Measured],
+    selected: &[usize],
+) -> Vec<String> {
+    let rel = if t.harder { "harder" } else { "softer" };
+    let value = t.words();
+    let kind = query.asked_kind();
+    let asked: Vec<usize> = (0..objects.len())
+        .filter(|&i| query.wants(&objects[i].label) && objects[i].hardness.is_some())
+        .collect();
+    let mut parts = Vec::new();
+    if selected.is_empty() {
+        if asked.is_empty() {
+            return parts;
+        }
+        parts.push(format!("No {kind} I measured is {rel} than {value}."));
+        let nearest = asked.iter().copied().max_by(|&a, &b| {
+            let (ea, eb) = (stiffness(&objects[a]), stiffness(&objects[b]));
+            if t.harder {
+                ea.total_cmp(&eb)
+            } else {
+                eb.total_cmp(&ea)
+            }
+        });
+        if let Some(i) = nearest {
+            let word = if t.harder { "hardest" } else { "softest" };
+            parts.push(format!("The {word} is {}.", describe(&objects[i])));
+        }
+    } else {
+        let list: Vec<String> = selected.iter().map(|&i| describe(&objects[i])).collect();
+        let (n, verb) = match selected.len() {
+            1 => ("One".to_string(), "is"),
+            n => (count_words(n), "are"),
+        };
+        parts.push(format!(
+            "{n} {kind} {verb} {rel} than {value}: {}.",
+            list.join("; ")
+        ));
+        // The others nearest the value first: the hardest of them after "harder than".
+        let mut others: Vec<usize> = asked
+            .iter()
+            .copied()
+            .filter(|i| !selected.contains(i))
+            .collect();
+        others.sort_by(|&a, &b| {
+            let (ea, eb) = (stiffness(&objects[a]), stiffness(&objects[b]));
+            if t.harder {
+                eb.total_cmp(&ea)
+            } else {
+                ea.total_cmp(&eb)
+            }
+        });
+        let others: Vec<String> = others
+            .iter()
+            .filter_map(|&i| {
+                let m = &objects[i];
+                Some(format!(
+                    "{} ({})",
+                    m.label,
+                    describe_hardness(m.hardness.as_ref()?, None)
+                ))
+            })
+            .collect();
+        if !others.is_empty() {
+            parts.push(format!("Not {rel}: {}.", others.join(", ")));
+        }
+    }
+    for &i in &asked {
+        let m = &objects[i];
+        if let Some([lo, hi]) = likely_range_mpa(m)
+            && lo <= t.modulus_mpa
+            && t.modulus_mpa <= hi
+        {
+            parts.push(format!(
+                "The {}'s likely range holds {}, so it may be on either side.",
+                m.label, t.said
+            ));
+        }
+    }
+    parts
+}
+
+/// A count as an answer opens a sentence with it: "Two", ..., "12".
+fn count_words(n: usize) -> String {
+    const WORDS: [&str; 11] = [
+        "No", "One", "Two", "Three", "Four", "Five", "Six", "Seven", "Eight", "Nine", "Ten",
+    ];
+    WORDS
+        .get(n)
+        .map_or_else(|| n.to_string(), |w| w.to_string())
+}
+
 /// Whether two measured moduli may be equal: their 68% intervals overlap.
 fn within_uncertainty(a: &Measured, b: &Measured) -> bool {
     match (likely_range_mpa(a), likely_range_mpa(b)) {
@@ -181,6 +278,11 @@ pub fn explain(
                 );
             }
         }
+        Intent::Threshold => {
+            if let Some(t) = &query.threshold {
+                parts.extend(past_threshold(query, t, objects, selected));
+            }
+        }
         Intent::Summarize if query.ranked && !selected.is_empty() => {
             let (most, least) = match query.property {
                 Property::Hardness => ("hardest", "softest"),
@@ -245,6 +347,55 @@ mod tests {
             ripeness: Some("ripe".into()),
             not_measured: None,
         }
+    }
+
+    fn with_range(mut m: Measured, lo: f64, hi: f64) -> Measured {
+        m.interval_68_mpa = [Some(lo), Some(hi)];
+        m
+    }
+
+    #[test]
+    fn a_threshold_selects_the_fruit_past_it_in_order_and_says_the_rest() {
+        let c = FruitCatalog::builtin();
+        let objs = [
+            m("apple", 3.25, 0.1, 0.1),
+            m("banana", 0.8, -0.15, -0.1),
+            with_range(m("lime", 1.9, 0.0, 0.0), 1.7, 2.2),
+            m("avocado", 5.0, 0.2, 0.1),
+        ];
+        let q = crate::query::parse("Which fruits are harder than 2 MPa?", &c).unwrap();
+        let sel = select(&q, &objs, &c);
+        assert_eq!(sel, vec![3, 0], "hardest first");
+        let text = explain(&q, &objs, &sel, &[]);
+        assert!(
+            text.starts_with("Two fruit are harder than 2 MPa ("),
+            "{text}"
+        );
+        assert!(text.contains("Not harder: lime"), "{text}");
+        assert!(
+            text.contains("The lime's likely range holds 2 MPa"),
+            "{text}"
+        );
+
+        let q = crate::query::parse("Which fruits are softer than 30 Shore A?", &c).unwrap();
+        let sel = select(&q, &objs, &c);
+        assert_eq!(sel, vec![1], "{q:?}");
+        let text = explain(&q, &objs, &sel, &[]);
+        assert!(
+            text.starts_with("One fruit is softer than 30 Shore A ("),
+            "{text}"
+        );
+
+        // None past it: said, with the nearest.
+        let q = crate::query::parse("Is anything harder than 10 MPa?", &c).unwrap();
+        let sel = select(&q, &objs, &c);
+        assert!(sel.is_empty());
+        let text = explain(&q, &objs, &sel, &[]);
+        assert!(
+            text.starts_with("No fruit I measured is harder than 10 MPa"),
+            "{text}"
+        );
+        assert!(text.contains("The hardest is the avocado"), "{text}");
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Prompt -> `Query`: rule-based, offline. Says clearly when a prompt cannot be grounded.
 
 pub mod lexicon;
+pub mod threshold;
 
 use crate::catalog::FruitCatalog;
 use lexicon::Degree;
@@ -17,6 +18,8 @@ pub enum Intent {
     Summarize,
     /// Two named objects against each other ("Is the mango harder than the avocado?").
     Compare,
+    /// The objects past a value ("Which fruits are harder than 2 MPa?"), in `threshold`.
+    Threshold,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -75,6 +78,9 @@ pub struct Query {
     pub ranked: bool,
     /// Fruits the prompt names that the catalog does not know ("pineapple").
     pub unknown: Vec<String>,
+    /// A value the objects are held against ("harder than 2 MPa"), for `Intent::Threshold`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub threshold: Option<threshold::Threshold>,
 }
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -87,6 +93,8 @@ pub enum QueryError {
     UnknownFruit { name: String, known: String },
     #[error("prompt: over {max} characters")]
     TooLong { max: usize },
+    #[error("prompt: hardness value '{value}': {message}")]
+    BadThreshold { value: String, message: String },
 }
 
 pub const MAX_PROMPT_CHARS: usize = 2000;
@@ -142,6 +150,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             max: MAX_PROMPT_CHARS,
         });
     }
+    let threshold = threshold::find(trimmed)?;
     let (words, breaks) = words_of(trimmed);
     let at = |i: usize| words.get(i).map(String::as_str);
     let is_fruit = |w: &str| catalog.find_word(w).is_some();
@@ -303,7 +312,10 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
 
     let known = || catalog.names().join(", ");
     let filtered = filters.color.is_some() || filters.position.is_some();
-    let all = generic || !exclude.is_empty() || (targets.is_empty() && filtered);
+    // "Is anything harder than 2 MPa?": a value with nothing named is about every fruit.
+    let all = generic
+        || !exclude.is_empty()
+        || (targets.is_empty() && (filtered || (threshold.is_some() && categories.is_empty())));
     if targets.is_empty() && categories.is_empty() && !all {
         return Err(match unknown.first() {
             Some(name) => QueryError::UnknownFruit {
@@ -326,11 +338,18 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         || (superlatives >= 2 && has(&["from"]) && has(&["to"]));
     // The property and direction come from the first property word: "from softest to
     // hardest" ranks by softness.
-    let (property, _, flipped) =
+    let (mut property, _, flipped) =
         properties
             .first()
             .copied()
             .unwrap_or((Property::Hardness, Degree::Base, false));
+    if let Some(t) = &threshold {
+        property = if t.harder {
+            Property::Hardness
+        } else {
+            Property::Softness
+        };
+    }
     let comparative = properties.iter().any(|p| p.1 == Degree::Comparative);
     // "Which avocado is ready to eat?", "which one is soft?": selects one, as the
     // superlative does; "which fruits are ripe?" asks about each.
@@ -338,7 +357,9 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         && !properties.is_empty()
         && !(plural || generic_plural);
     let superlative = superlatives > 0 || selects;
-    let intent = if ranked {
+    let intent = if threshold.is_some() {
+        Intent::Threshold
+    } else if ranked {
         Intent::Summarize
     } else if (comparative || has(lexicon::COMPARING)) && targets.len() >= 2 {
         Intent::Compare
@@ -364,7 +385,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     });
     // Named kinds bound an extreme, a comparison or an identification ("which fruit is
     // softer, the kiwi or the peach"); a summary may add "all other fruits" to named ones.
-    let all = all && (intent == Intent::Summarize || targets.is_empty());
+    let all =
+        all && (matches!(intent, Intent::Summarize | Intent::Threshold) || targets.is_empty());
     Ok(Query {
         intent,
         property,
@@ -376,6 +398,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         filters,
         ranked,
         unknown,
+        threshold,
     })
 }
 

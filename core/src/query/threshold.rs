@@ -1,0 +1,299 @@
+//! A value the question holds the fruit against: "harder than 2 MPa", "softer than 30 Shore
+//! A", "a Shore 00 above 60". The value is read with the hardness scale's own parser (MPa,
+//! kPa, Shore A, Shore 00), and the direction from the words just before it.
+
+use super::QueryError;
+use crate::hardness::scale::{Hardness, modulus_to_shore_00, modulus_to_shore_a};
+use serde::Serialize;
+
+/// How far before the value a direction word may stand ("harder than about 2 MPa").
+const DIRECTION_REACH: usize = 4;
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Threshold {
+    /// The fruit asked for are harder than the value (false: softer).
+    pub harder: bool,
+    /// The value as a modulus (MPa); infinite for "rigid".
+    pub modulus_mpa: f64,
+    /// The value as the prompt gave it, with its unit: "2 MPa", "30 Shore A".
+    pub said: String,
+}
+
+impl Threshold {
+    /// Whether a fruit of this modulus (MPa; infinite: rigid) is past the value.
+    pub fn holds_for(&self, modulus_mpa: f64) -> bool {
+        if self.harder {
+            modulus_mpa > self.modulus_mpa
+        } else {
+            modulus_mpa < self.modulus_mpa
+        }
+    }
+
+    /// The value as said and on the other scales: "2 MPa (57 Shore A)", "30 Shore A (0.97 MPa)".
+    pub fn words(&self) -> String {
+        let e = self.modulus_mpa;
+        if !e.is_finite() {
+            return self.said.clone();
+        }
+        let shore = if modulus_to_shore_a(e) < 10.0 {
+            format!("{:.0} Shore 00", modulus_to_shore_00(e))
+        } else {
+            format!("{:.0} Shore A", modulus_to_shore_a(e))
+        };
+        if self.said.to_lowercase().contains("shore") {
+            format!("{} ({e:.2} MPa)", self.said)
+        } else {
+            format!("{} ({shore})", self.said)
+        }
+    }
+
+    /// The numbers `words` may print, for the groundedness check: the modulus (MPa, kPa)
+    /// and both Shore scales.
+    pub fn values(&self) -> Vec<f64> {
+        let e = self.modulus_mpa;
+        if !e.is_finite() {
+            return Vec::new();
+        }
+        vec![
+            e,
+            e * 1e3,
+            modulus_to_shore_a(e),
+            modulus_to_shore_00(e),
+            said_number(&self.said).unwrap_or(e),
+        ]
+    }
+}
+
+fn said_number(said: &str) -> Option<f64> {
+    said.split_whitespace().find_map(|w| w.parse().ok())
+}
+
+/// Lower-cased words, a decimal point kept inside a number ("2.5").
+fn tokens(prompt: &str) -> Vec<String> {
+    let chars: Vec<char> = prompt.to_lowercase().chars().collect();
+    let mut out = Vec::new();
+    let mut word = String::new();
+    for (i, &c) in chars.iter().enumerate() {
+        let decimal_point = c == '.'
+            && i > 0
+            && chars[i - 1].is_ascii_digit()
+            && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit());
+        if c.is_alphanumeric() || decimal_point {
+            word.push(c);
+        } else if !word.is_empty() {
+            out.push(std::mem::take(&mut word));
+        }
+    }
+    if !word.is_empty() {
+        out.push(word);
+    }
+    out
+}
+
+/// Which way a word before the value points: Some(true) harder, Some(false) softer.
+fn direction(words: &[String], i: usize) -> Option<bool> {
+    let w = words[i].as_str();
+    let prev = i.checked_sub(1).map(|j| words[j].as_str());
+    let next = words.get(i + 1).map(String::as_str);
+    // "more soft", "less soft": the property word after turns the comparison round.
+    let soft_next = next.is_some_and(|n| matches!(n, "soft" | "squishy" | "tender"));
+    match w {
+        "harder" | "firmer" | "stiffer" | "tougher" | "above" | "over" | "exceeding" | "exceed"
+        | "exceeds" | "greater" | "higher" | "beyond" => Some(true),
+        "softer" | "squishier" | "below" | "under" | "lower" | "beneath" => Some(false),
+        "more" => Some(!soft_next),
+        "less" => Some(soft_next),
+        "least" if prev == Some("at") => Some(true),
+        "most" if prev == Some("at") => Some(false),
+        _ => None,
+    }
+}
+
+/// Whether a word before the value compares ("than", a direction word), so that a bare
+/// number after it must have been meant as a hardness.
+fn compares(words: &[String], i: usize) -> bool {
+    words[i] == "than" || direction(words, i).is_some()
+}
+
+/// The threshold the prompt states, if it states one; an error names a value the prompt
+/// compares against without a unit, or off its scale.
+pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
+    let words = tokens(prompt);
+    for i in 0..words.len() {
+        if !words[i].starts_with(|c: char| c.is_ascii_digit()) {
+            continue;
+        }
+        let Some(harder) = (i.saturating_sub(DIRECTION_REACH)..i)
+            .rev()
+            .find_map(|j| direction(&words, j))
+        else {
+            continue;
+        };
+        let (value, said) = match value_at(&words, i) {
+            Some(Ok(found)) => found,
+            Some(Err(message)) => {
+                return Err(QueryError::BadThreshold {
+                    value: words[i].clone(),
+                    message,
+                });
+            }
+            None if i > 0 && compares(&words, i - 1) => {
+                return Err(QueryError::BadThreshold {
+                    value: words[i].clone(),
+                    message: "has no unit; say e.g. 2 MPa, 30 Shore A or 60 Shore 00".into(),
+                });
+            }
+            None => continue,
+        };
+        return Ok(Some(Threshold {
+            harder,
+            modulus_mpa: value.modulus_mpa().unwrap_or(f64::INFINITY),
+            said,
+        }));
+    }
+    Ok(None)
+}
+
+/// The hardness value whose number is word `i`: its unit after it ("2 MPa", "30 Shore A",
+/// "2mpa") or its scale before it ("Shore A above 40"). None: no unit; Err: off its scale.
+fn value_at(words: &[String], i: usize) -> Option<Result<(Hardness, String), String>> {
+    let number = &words[i];
+    let unit_after: Vec<&str> = words[i + 1..].iter().take(2).map(String::as_str).collect();
+    let after = match unit_after.as_slice() {
+        ["shore", s, ..] if matches!(*s, "a" | "00" | "oo") => Some(format!("shore {s}")),
+        [u, ..] if matches!(*u, "mpa" | "kpa" | "a" | "00" | "oo") => Some(u.to_string()),
+        _ => None,
+    };
+    // A scale named before the value: "a Shore A hardness above 40".
+    let before = || {
+        (0..i).rev().take(DIRECTION_REACH + 2).find_map(|j| {
+            (words[j] == "shore")
+                .then(|| words.get(j + 1))
+                .flatten()
+                .filter(|s| matches!(s.as_str(), "a" | "00" | "oo"))
+                .map(|s| format!("shore {s}"))
+        })
+    };
+    let attached = number
+        .trim_start_matches(|c: char| c.is_ascii_digit() || c == '.')
+        .to_string();
+    let (text, said) = if !attached.is_empty() {
+        (number.clone(), unit_said(number, ""))
+    } else if let Some(unit) = after.or_else(before) {
+        (format!("{number} {unit}"), unit_said(number, &unit))
+    } else {
+        return None;
+    };
+    Some(
+        Hardness::parse(&text)
+            .map(|h| (h, said))
+            .map_err(|e| e.to_string()),
+    )
+}
+
+/// The value as an answer says it: "2 MPa", "30 Shore A", "60 Shore 00".
+fn unit_said(number: &str, unit: &str) -> String {
+    let (digits, attached) = number.split_at(
+        number
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .unwrap_or(number.len()),
+    );
+    let unit = if unit.is_empty() { attached } else { unit };
+    let unit = match unit.trim_start_matches("shore").trim() {
+        "mpa" => "MPa",
+        "kpa" => "kPa",
+        "a" => "Shore A",
+        "00" | "oo" => "Shore 00",
+        other => other,
+    };
+    format!("{digits} {unit}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hardness::scale::shore_a_to_modulus_mpa;
+
+    fn read(prompt: &str) -> Threshold {
+        find(prompt)
+            .unwrap()
+            .unwrap_or_else(|| panic!("no threshold in {prompt:?}"))
+    }
+
+    #[test]
+    fn values_and_directions_are_read_in_every_unit() {
+        for (prompt, harder, mpa, said) in [
+            ("Which fruits are harder than 2 MPa?", true, 2.0, "2 MPa"),
+            (
+                "Which fruits are harder than 2.5 mpa?",
+                true,
+                2.5,
+                "2.5 MPa",
+            ),
+            ("Show me fruit firmer than 2MPa", true, 2.0, "2 MPa"),
+            ("anything softer than 800 kPa?", false, 0.8, "800 kPa"),
+            ("fruits with a hardness above 1.5 MPa", true, 1.5, "1.5 MPa"),
+            ("which ones are below 1 MPa", false, 1.0, "1 MPa"),
+            ("Which fruit is less hard than 3 MPa?", false, 3.0, "3 MPa"),
+            ("Is any fruit more than 4 MPa hard?", true, 4.0, "4 MPa"),
+            ("fruit that is less soft than 1 MPa", true, 1.0, "1 MPa"),
+        ] {
+            let t = read(prompt);
+            assert_eq!(t.harder, harder, "{prompt}");
+            assert!((t.modulus_mpa - mpa).abs() < 1e-12, "{prompt}: {t:?}");
+            assert_eq!(t.said, said, "{prompt}");
+        }
+        for (prompt, harder, shore_a) in [
+            ("Which fruits are softer than 30 Shore A?", false, 30.0),
+            ("fruits harder than 45 shore a", true, 45.0),
+            ("any fruit with a Shore A hardness over 40?", true, 40.0),
+            ("softer than 30A please", false, 30.0),
+        ] {
+            let t = read(prompt);
+            assert_eq!(t.harder, harder, "{prompt}");
+            let e = shore_a_to_modulus_mpa(shore_a).unwrap();
+            assert!((t.modulus_mpa - e).abs() < 1e-12, "{prompt}: {t:?}");
+            assert_eq!(t.said, format!("{shore_a:.0} Shore A"), "{prompt}");
+        }
+        let t = read("Which fruits are softer than 60 Shore 00?");
+        assert!(!t.harder && t.said == "60 Shore 00");
+    }
+
+    #[test]
+    fn a_number_without_a_comparison_or_unit_is_no_threshold() {
+        for prompt in [
+            "Which of the 2 bananas is softer?",
+            "Rank the 3 fruits from softest to hardest",
+            "Which fruit is the softest?",
+            "Is the apple harder than the mango?",
+        ] {
+            assert_eq!(find(prompt).unwrap(), None, "{prompt}");
+        }
+    }
+
+    #[test]
+    fn a_compared_value_without_a_unit_or_off_its_scale_is_named() {
+        for (prompt, value) in [
+            ("Which fruits are harder than 2?", "2"),
+            ("fruits softer than 150 Shore A", "150"),
+            ("harder than 0 MPa", "0"),
+        ] {
+            match find(prompt) {
+                Err(QueryError::BadThreshold { value: v, message }) => {
+                    assert_eq!(v, value, "{prompt}: {message}");
+                }
+                other => panic!("{prompt}: {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn the_value_is_said_back_on_the_other_scale_and_tested_strictly() {
+        let t = read("harder than 2 MPa");
+        assert!(t.words().starts_with("2 MPa (") && t.words().ends_with("Shore A)"));
+        assert!(t.holds_for(2.5) && !t.holds_for(2.0) && t.holds_for(f64::INFINITY));
+        let t = read("softer than 30 Shore A");
+        assert!(t.words().starts_with("30 Shore A (") && t.words().ends_with(" MPa)"));
+        assert!(t.holds_for(0.1) && !t.holds_for(f64::INFINITY));
+    }
+}
