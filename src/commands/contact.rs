@@ -57,12 +57,19 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     }
     let rule = ContactRule::default();
     let Some(evidence) = contact_evidence(&image, &reference, &rule, mm_per_px) else {
+        let bin = bin_for(rule.pixel_mm, mm_per_px);
+        if bin > 1 {
+            bail!(
+                "--mm-per-px {:?}: the frame binned {bin} x {bin} to the criterion's {} mm pixels is smaller than one {} px tile",
+                mm_per_px.unwrap_or_default(),
+                rule.pixel_mm,
+                rule.tile_px,
+            );
+        }
         bail!(
-            "{}: too small for the contact test's {} px tiles (binned {}x{} for --mm-per-px)",
+            "{}: too small for the contact test's {} px tiles",
             args.image.display(),
             rule.tile_px,
-            bin_for(rule.pixel_mm, mm_per_px),
-            bin_for(rule.pixel_mm, mm_per_px),
         );
     };
     let circle = evidence
@@ -85,7 +92,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     }
     let e = &report.evidence;
     println!(
-        "{}: {} (worst 32 px tile SSIM {:.3}, contact at <= {:.3}; frame SSIM {:.3}{})",
+        "{}: {} (worst 32 px tile SSIM {:.4}, contact at <= {:.4}; frame SSIM {:.3}{})",
         report.image,
         if e.contact { "contact" } else { "no contact" },
         e.min_tile_ssim,

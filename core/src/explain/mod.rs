@@ -90,10 +90,11 @@ pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Ve
         }
         Intent::Threshold => {
             measured.retain(|&i| {
-                query
-                    .threshold
-                    .as_ref()
-                    .is_some_and(|t| t.holds_for(stiffness(&objects[i])))
+                query.wants(&objects[i].label)
+                    && query
+                        .threshold
+                        .as_ref()
+                        .is_some_and(|t| t.holds_for(stiffness(&objects[i])))
             });
             measured.sort_by(|a, b| key(b).total_cmp(&key(a)));
             measured

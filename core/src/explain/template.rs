@@ -115,6 +115,14 @@ fn past_threshold(
         if asked.is_empty() {
             return parts;
         }
+        if let [only] = asked[..] {
+            // "Is the apple softer than 2 MPa?": answered about the apple.
+            parts.push(capitalise(&format!(
+                "{}, is not {rel} than {value}.",
+                describe(&objects[only])
+            )));
+            return parts;
+        }
         parts.push(format!("No {kind} I measured is {rel} than {value}."));
         let nearest = asked.iter().copied().max_by(|&a, &b| {
             let (ea, eb) = (stiffness(&objects[a]), stiffness(&objects[b]));
@@ -156,11 +164,8 @@ fn past_threshold(
             .iter()
             .filter_map(|&i| {
                 let m = &objects[i];
-                Some(format!(
-                    "{} ({})",
-                    m.label,
-                    describe_hardness(m.hardness.as_ref()?, None)
-                ))
+                let h = m.hardness.as_ref()?;
+                Some(format!("{} at {}", m.label, describe_hardness(h, None)))
             })
             .collect();
         if !others.is_empty() {
@@ -371,7 +376,10 @@ mod tests {
             text.starts_with("Two fruit are harder than 2 MPa ("),
             "{text}"
         );
-        assert!(text.contains("Not harder: lime"), "{text}");
+        assert!(
+            text.contains("Not harder: lime at 43 Shore A (1.90 MPa)"),
+            "{text}"
+        );
         assert!(
             text.contains("The lime's likely range holds 2 MPa"),
             "{text}"
@@ -396,6 +404,14 @@ mod tests {
             "{text}"
         );
         assert!(text.contains("The hardest is the avocado"), "{text}");
+        // One fruit asked about: answered about it.
+        let q = crate::query::parse("Is the apple softer than 2 MPa?", &c).unwrap();
+        let sel = select(&q, &objs, &c);
+        let text = explain(&q, &objs, &sel, &[]);
+        assert!(
+            text.starts_with("The apple at the right back, 57 Shore A (3.25 MPa), ripe, is not softer than 2 MPa ("),
+            "{text}"
+        );
     }
 
     #[test]

@@ -315,7 +315,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     // "Is anything harder than 2 MPa?": a value with nothing named is about every fruit.
     let all = generic
         || !exclude.is_empty()
-        || (targets.is_empty() && (filtered || (threshold.is_some() && categories.is_empty())));
+        || (targets.is_empty()
+            && (filtered || (threshold.is_some() && categories.is_empty() && unknown.is_empty())));
     if targets.is_empty() && categories.is_empty() && !all {
         return Err(match unknown.first() {
             Some(name) => QueryError::UnknownFruit {

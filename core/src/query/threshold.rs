@@ -68,26 +68,78 @@ fn said_number(said: &str) -> Option<f64> {
     said.split_whitespace().find_map(|w| w.parse().ok())
 }
 
-/// Lower-cased words, a decimal point kept inside a number ("2.5").
+/// Lower-cased words, a number kept whole with its sign and decimal point ("-2", ".5",
+/// "2.5"; "2,5" too, to be refused by name), and ">", "<" read as "above", "below".
 fn tokens(prompt: &str) -> Vec<String> {
     let chars: Vec<char> = prompt.to_lowercase().chars().collect();
     let mut out = Vec::new();
     let mut word = String::new();
     for (i, &c) in chars.iter().enumerate() {
-        let decimal_point = c == '.'
-            && i > 0
-            && chars[i - 1].is_ascii_digit()
-            && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit());
-        if c.is_alphanumeric() || decimal_point {
+        let prev = i.checked_sub(1).map(|k| chars[k]);
+        let next_digit = chars.get(i + 1).is_some_and(|d| d.is_ascii_digit());
+        let prev_digit = prev.is_some_and(|d| d.is_ascii_digit());
+        let sign = matches!(c, '-' | '\u{2212}')
+            && next_digit
+            && word.is_empty()
+            && !prev.is_some_and(char::is_alphanumeric);
+        if c.is_alphanumeric() || (c == '.' && next_digit) || (c == ',' && prev_digit && next_digit)
+        {
             word.push(c);
-        } else if !word.is_empty() {
-            out.push(std::mem::take(&mut word));
+        } else if sign {
+            word.push('-');
+        } else {
+            if !word.is_empty() {
+                out.push(std::mem::take(&mut word));
+            }
+            match c {
+                '>' | '\u{2265}' => out.push("above".into()),
+                '<' | '\u{2264}' => out.push("below".into()),
+                _ => {}
+            }
         }
     }
     if !word.is_empty() {
         out.push(word);
     }
     out
+}
+
+/// Whether a word is a number as written: "2", "2.5", ".5", "-2".
+fn is_number(w: &str) -> bool {
+    let w = w.strip_prefix('-').unwrap_or(w);
+    let w = w.strip_prefix('.').unwrap_or(w);
+    w.starts_with(|c: char| c.is_ascii_digit())
+}
+
+/// Units of hardness or pressure the answer does not read, as they follow a number.
+const OTHER_UNITS: &[&str] = &[
+    "pa",
+    "gpa",
+    "psi",
+    "ksi",
+    "bar",
+    "pascal",
+    "pascals",
+    "kilopascal",
+    "kilopascals",
+    "megapascal",
+    "megapascals",
+    "n",
+    "newton",
+    "newtons",
+];
+
+/// The direction said after a value: "3 MPa or more", "1 MPa and below".
+fn direction_after(words: &[String], end: usize) -> Option<bool> {
+    let link = words.get(end + 1).map(String::as_str);
+    if !matches!(link, Some("or" | "and")) {
+        return None;
+    }
+    match words.get(end + 2).map(String::as_str)? {
+        "more" | "above" | "over" | "higher" | "harder" | "firmer" | "greater" | "up" => Some(true),
+        "less" | "below" | "under" | "lower" | "softer" | "fewer" | "down" => Some(false),
+        _ => None,
+    }
 }
 
 /// Which way a word before the value points: Some(true) harder, Some(false) softer.
@@ -115,53 +167,96 @@ fn compares(words: &[String], i: usize) -> bool {
     words[i] == "than" || direction(words, i).is_some()
 }
 
-/// The threshold the prompt states, if it states one; an error names a value the prompt
-/// compares against without a unit, or off its scale.
+/// The threshold the prompt states, if it states one. An error names a value the prompt
+/// compares against without a unit, in a unit not read, off its scale, without saying which
+/// way, or beside a second value.
 pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
     let words = tokens(prompt);
+    let mut found: Option<Threshold> = None;
+    // Words read as a value's unit ("60 Shore 00": the "00" is not a second number).
+    let mut read_until = 0;
     for i in 0..words.len() {
-        if !words[i].starts_with(|c: char| c.is_ascii_digit()) {
+        let names_scale = i > 0 && words[i - 1] == "shore";
+        if i < read_until || names_scale || !is_number(&words[i]) {
             continue;
         }
-        let Some(harder) = (i.saturating_sub(DIRECTION_REACH)..i)
+        let bad = |message: String| QueryError::BadThreshold {
+            value: words[i].clone(),
+            message,
+        };
+        let before = (i.saturating_sub(DIRECTION_REACH)..i)
             .rev()
-            .find_map(|j| direction(&words, j))
-        else {
-            continue;
-        };
-        let (value, said) = match value_at(&words, i) {
+            .find_map(|j| direction(&words, j).map(|d| (j, d)))
+            .map(|(j, harder)| {
+                // "not harder than 2 MPa", "no softer than", "isn't firmer than".
+                let negated =
+                    j > 0 && matches!(words[j - 1].as_str(), "not" | "no" | "never" | "t");
+                harder != negated
+            });
+        if words[i].contains(',') {
+            return Err(bad("write the number with a decimal point (2.5 MPa)".into()));
+        }
+        let (value, said, end) = match value_at(&words, i) {
             Some(Ok(found)) => found,
-            Some(Err(message)) => {
-                return Err(QueryError::BadThreshold {
-                    value: words[i].clone(),
-                    message,
-                });
+            Some(Err(message)) => return Err(bad(message)),
+            None => {
+                if let Some(unit) = words
+                    .get(i + 1)
+                    .filter(|u| OTHER_UNITS.contains(&u.as_str()))
+                {
+                    return Err(bad(format!(
+                        "the unit '{unit}' is not one I read; say MPa, kPa, Shore A or Shore 00"
+                    )));
+                }
+                if words.get(i + 1).is_some_and(|w| w == "shore") {
+                    return Err(bad(
+                        "the Shore scale is not one I read; say Shore A or Shore 00".into(),
+                    ));
+                }
+                if before.is_some() && i > 0 && compares(&words, i - 1) {
+                    return Err(bad(
+                        "has no unit; say e.g. 2 MPa, 30 Shore A or 60 Shore 00".into(),
+                    ));
+                }
+                continue;
             }
-            None if i > 0 && compares(&words, i - 1) => {
-                return Err(QueryError::BadThreshold {
-                    value: words[i].clone(),
-                    message: "has no unit; say e.g. 2 MPa, 30 Shore A or 60 Shore 00".into(),
-                });
-            }
-            None => continue,
         };
-        return Ok(Some(Threshold {
+        read_until = end + 1;
+        let Some(harder) = before.or_else(|| direction_after(&words, end)) else {
+            return Err(QueryError::BadThreshold {
+                value: said.clone(),
+                message: format!("say which way: harder than {said}, or softer than {said}"),
+            });
+        };
+        if let Some(first) = &found {
+            return Err(QueryError::BadThreshold {
+                value: said,
+                message: format!(
+                    "a second value beside {}: ask about one at a time",
+                    first.said
+                ),
+            });
+        }
+        found = Some(Threshold {
             harder,
             modulus_mpa: value.modulus_mpa().unwrap_or(f64::INFINITY),
             said,
-        }));
+        });
     }
-    Ok(None)
+    Ok(found)
 }
 
-/// The hardness value whose number is word `i`: its unit after it ("2 MPa", "30 Shore A",
-/// "2mpa") or its scale before it ("Shore A above 40"). None: no unit; Err: off its scale.
-fn value_at(words: &[String], i: usize) -> Option<Result<(Hardness, String), String>> {
+/// The hardness value whose number is word `i`, as said, and the index of its last word:
+/// its unit after it ("2 MPa", "30 Shore A", "2mpa", "30 ShoreA") or its scale before it
+/// ("Shore A above 40"). None: no unit; Err: not a hardness, or off its scale.
+fn value_at(words: &[String], i: usize) -> Option<Result<(Hardness, String, usize), String>> {
     let number = &words[i];
     let unit_after: Vec<&str> = words[i + 1..].iter().take(2).map(String::as_str).collect();
     let after = match unit_after.as_slice() {
-        ["shore", s, ..] if matches!(*s, "a" | "00" | "oo") => Some(format!("shore {s}")),
-        [u, ..] if matches!(*u, "mpa" | "kpa" | "a" | "00" | "oo") => Some(u.to_string()),
+        ["shore", s, ..] if matches!(*s, "a" | "00" | "oo") => Some((format!("shore {s}"), i + 2)),
+        ["shorea", ..] => Some(("shore a".to_string(), i + 1)),
+        ["shore00" | "shoreoo", ..] => Some(("shore 00".to_string(), i + 1)),
+        [u, ..] if matches!(*u, "mpa" | "kpa" | "a" | "00" | "oo") => Some((u.to_string(), i + 1)),
         _ => None,
     };
     // A scale named before the value: "a Shore A hardness above 40".
@@ -171,22 +266,22 @@ fn value_at(words: &[String], i: usize) -> Option<Result<(Hardness, String), Str
                 .then(|| words.get(j + 1))
                 .flatten()
                 .filter(|s| matches!(s.as_str(), "a" | "00" | "oo"))
-                .map(|s| format!("shore {s}"))
+                .map(|s| (format!("shore {s}"), i))
         })
     };
-    let attached = number
-        .trim_start_matches(|c: char| c.is_ascii_digit() || c == '.')
-        .to_string();
-    let (text, said) = if !attached.is_empty() {
-        (number.clone(), unit_said(number, ""))
-    } else if let Some(unit) = after.or_else(before) {
-        (format!("{number} {unit}"), unit_said(number, &unit))
+    let attached = number.trim_start_matches(|c: char| c.is_ascii_digit() || c == '.' || c == '-');
+    let (text, said, end) = if !attached.is_empty() {
+        // "2mpa", "30a"; "2j", "3rd" are no values at all.
+        Hardness::parse(number).ok()?;
+        (number.clone(), unit_said(number, ""), i)
+    } else if let Some((unit, end)) = after.or_else(before) {
+        (format!("{number} {unit}"), unit_said(number, &unit), end)
     } else {
         return None;
     };
     Some(
         Hardness::parse(&text)
-            .map(|h| (h, said))
+            .map(|h| (h, said, end))
             .map_err(|e| e.to_string()),
     )
 }
@@ -195,7 +290,7 @@ fn value_at(words: &[String], i: usize) -> Option<Result<(Hardness, String), Str
 fn unit_said(number: &str, unit: &str) -> String {
     let (digits, attached) = number.split_at(
         number
-            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
             .unwrap_or(number.len()),
     );
     let unit = if unit.is_empty() { attached } else { unit };
@@ -237,10 +332,23 @@ mod tests {
             ("Which fruit is less hard than 3 MPa?", false, 3.0, "3 MPa"),
             ("Is any fruit more than 4 MPa hard?", true, 4.0, "4 MPa"),
             ("fruit that is less soft than 1 MPa", true, 1.0, "1 MPa"),
+            (
+                "Which fruits are not harder than 2 MPa?",
+                false,
+                2.0,
+                "2 MPa",
+            ),
+            ("Which fruit is no softer than 1 MPa?", true, 1.0, "1 MPa"),
+            ("Which one isn't firmer than 3 MPa?", false, 3.0, "3 MPa"),
+            ("Which fruits are harder than .5 MPa?", true, 0.5, ".5 MPa"),
+            ("Which fruits are 3 MPa or more?", true, 3.0, "3 MPa"),
+            ("fruits of 1 MPa or less", false, 1.0, "1 MPa"),
+            ("Which fruits are > 2 MPa?", true, 2.0, "2 MPa"),
+            ("Which fruits are < 2 MPa?", false, 2.0, "2 MPa"),
         ] {
             let t = read(prompt);
             assert_eq!(t.harder, harder, "{prompt}");
-            assert!((t.modulus_mpa - mpa).abs() < 1e-12, "{prompt}: {t:?}");
+            assert!((t.modulus_mpa - mpa).abs() < 1e-4 * mpa, "{prompt}: {t:?}");
             assert_eq!(t.said, said, "{prompt}");
         }
         for (prompt, harder, shore_a) in [
@@ -248,6 +356,7 @@ mod tests {
             ("fruits harder than 45 shore a", true, 45.0),
             ("any fruit with a Shore A hardness over 40?", true, 40.0),
             ("softer than 30A please", false, 30.0),
+            ("fruits harder than 30 ShoreA", true, 30.0),
         ] {
             let t = read(prompt);
             assert_eq!(t.harder, harder, "{prompt}");
@@ -262,6 +371,8 @@ mod tests {
     #[test]
     fn a_number_without_a_comparison_or_unit_is_no_threshold() {
         for prompt in [
+            "hello \u{1b}[2J there",
+            "Which is the 3rd fruit from the left?",
             "Which of the 2 bananas is softer?",
             "Rank the 3 fruits from softest to hardest",
             "Which fruit is the softest?",
@@ -277,6 +388,13 @@ mod tests {
             ("Which fruits are harder than 2?", "2"),
             ("fruits softer than 150 Shore A", "150"),
             ("harder than 0 MPa", "0"),
+            ("harder than -2 MPa", "-2"),
+            ("softer than 2,5 MPa", "2,5"),
+            ("harder than 300 psi", "300"),
+            ("harder than 30 Shore D", "30"),
+            ("Is the apple 2 MPa?", "2 MPa"),
+            ("harder than 1 MPa and softer than 2 MPa", "2 MPa"),
+            ("between 1 and 2 MPa", "2 MPa"),
         ] {
             match find(prompt) {
                 Err(QueryError::BadThreshold { value: v, message }) => {

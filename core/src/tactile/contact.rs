@@ -235,8 +235,9 @@ pub fn contact_evidence(
 /// The side of the blocks that bring pixels of `mm_per_px` nearest to `pixel_mm`: 1 for
 /// pixels as coarse or coarser, or an unknown size.
 pub fn bin_for(pixel_mm: f64, mm_per_px: Option<f64>) -> usize {
-    match mm_per_px.map(|s| pixel_mm / s) {
-        Some(ratio) if ratio.is_finite() && ratio > 1.0 => ratio.round().min(64.0) as usize,
+    match mm_per_px.filter(|&s| s > 0.0).map(|s| pixel_mm / s) {
+        // A pixel size so small that the ratio overflows bins as coarsely as any.
+        Some(ratio) if ratio > 1.0 => ratio.round().min(64.0) as usize,
         _ => 1,
     }
 }
@@ -291,6 +292,7 @@ mod tests {
         assert_eq!(bin_for(0.05, Some(0.0)), 1);
         assert_eq!(bin_for(0.05, Some(f64::NAN)), 1);
         assert_eq!(bin_for(0.05, Some(1e-12)), 64);
+        assert_eq!(bin_for(0.05, Some(5e-324)), 64);
     }
 
     #[test]
