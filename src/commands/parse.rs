@@ -57,8 +57,7 @@ fn describe(q: &Query) -> String {
         s += &format!("groups:   {}\n", groups.join("; "));
     }
     if let Some(t) = &q.threshold {
-        let rel = if t.harder { "harder" } else { "softer" };
-        s += &format!("value:    {rel} than {}\n", t.words());
+        s += &format!("value:    {} than {}\n", t.relation(), t.words());
     }
     if !q.exclude.is_empty() {
         s += &format!("except:   {}\n", q.exclude.join(", "));

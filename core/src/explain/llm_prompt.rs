@@ -2,7 +2,7 @@
 //! reply checkable by `grounded::check`, and the facts as JSON. Pure text; the client that
 //! sends them is the binary's.
 
-use super::template::{likely_range_mpa, range_words, shore_words};
+use super::template::{likely_range_mpa, range_words};
 use super::{Facts, Measured};
 use serde_json::{Value, json};
 
@@ -22,7 +22,7 @@ fn object(i: usize, m: &Measured, facts: &Facts) -> Value {
         None => json!({ "rigid": true }),
         Some(e) => {
             json!({
-                "shore": shore_words(&h),
+                "shore": h.shore_words(),
                 "modulus": format!("{e:.2} MPa"),
                 "likely_range_68_percent": likely_range_mpa(m).map(range_words),
             })

@@ -60,17 +60,7 @@ fn describe_hardness(h: &HardnessReport, likely: Option<[f64; 2]>) -> String {
         }
         None => format!("{e:.2} MPa"),
     };
-    format!("{} ({modulus})", shore_words(h))
-}
-
-/// The Shore reading on the scale that resolves it: "36 Shore A", or "55 Shore 00" for
-/// objects too soft for Shore A.
-pub fn shore_words(h: &HardnessReport) -> String {
-    if h.shore_a < 10.0 {
-        format!("{:.0} Shore 00", h.shore_00)
-    } else {
-        format!("{:.0} Shore A", h.shore_a)
-    }
+    format!("{} ({modulus})", h.shore_words())
 }
 
 fn hardness_of(m: &Measured) -> Option<String> {
@@ -104,8 +94,13 @@ fn past_threshold(
     objects: &[Measured],
     selected: &[usize],
 ) -> Vec<String> {
-    let rel = if t.harder { "harder" } else { "softer" };
+    let rel = t.relation();
     let value = t.words();
+    // How far past the value a fruit lies: the hardest first after "harder than".
+    let past = |i: usize| {
+        let e = stiffness(&objects[i]);
+        if t.harder { e } else { -e }
+    };
     let kind = query.asked_kind();
     let asked: Vec<usize> = (0..objects.len())
         .filter(|&i| query.wants(&objects[i].label) && objects[i].hardness.is_some())
@@ -124,42 +119,29 @@ fn past_threshold(
             return parts;
         }
         parts.push(format!("No {kind} I measured is {rel} than {value}."));
-        let nearest = asked.iter().copied().max_by(|&a, &b| {
-            let (ea, eb) = (stiffness(&objects[a]), stiffness(&objects[b]));
-            if t.harder {
-                ea.total_cmp(&eb)
-            } else {
-                eb.total_cmp(&ea)
-            }
-        });
+        let nearest = asked
+            .iter()
+            .copied()
+            .max_by(|&a, &b| past(a).total_cmp(&past(b)));
         if let Some(i) = nearest {
             let word = if t.harder { "hardest" } else { "softest" };
             parts.push(format!("The {word} is {}.", describe(&objects[i])));
         }
     } else {
         let list: Vec<String> = selected.iter().map(|&i| describe(&objects[i])).collect();
-        let (n, verb) = match selected.len() {
-            1 => ("One".to_string(), "is"),
-            n => (count_words(n), "are"),
-        };
+        let verb = if selected.len() == 1 { "is" } else { "are" };
         parts.push(format!(
-            "{n} {kind} {verb} {rel} than {value}: {}.",
+            "{} {kind} {verb} {rel} than {value}: {}.",
+            count_words(selected.len()),
             list.join("; ")
         ));
-        // The others nearest the value first: the hardest of them after "harder than".
+        // The others nearest the value first.
         let mut others: Vec<usize> = asked
             .iter()
             .copied()
             .filter(|i| !selected.contains(i))
             .collect();
-        others.sort_by(|&a, &b| {
-            let (ea, eb) = (stiffness(&objects[a]), stiffness(&objects[b]));
-            if t.harder {
-                eb.total_cmp(&ea)
-            } else {
-                ea.total_cmp(&eb)
-            }
-        });
+        others.sort_by(|&a, &b| past(b).total_cmp(&past(a)));
         let others: Vec<String> = others
             .iter()
             .filter_map(|&i| {
@@ -187,7 +169,7 @@ fn past_threshold(
     parts
 }
 
-/// A count as an answer opens a sentence with it: "Two", ..., "12".
+/// A count as an answer opens a sentence with it: "One", ..., "Ten", "12".
 fn count_words(n: usize) -> String {
     const WORDS: [&str; 11] = [
         "No", "One", "Two", "Three", "Four", "Five", "Six", "Seven", "Eight", "Nine", "Ten",

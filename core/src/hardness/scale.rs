@@ -219,6 +219,18 @@ pub struct HardnessReport {
     pub modulus_mpa: Option<f64>,
 }
 
+impl HardnessReport {
+    /// The Shore reading on the scale that resolves it: "36 Shore A", or "55 Shore 00" for
+    /// objects too soft for Shore A.
+    pub fn shore_words(&self) -> String {
+        if self.shore_a < 10.0 {
+            format!("{:.0} Shore 00", self.shore_00)
+        } else {
+            format!("{:.0} Shore A", self.shore_a)
+        }
+    }
+}
+
 impl From<Hardness> for HardnessReport {
     fn from(h: Hardness) -> Self {
         HardnessReport {

@@ -3,7 +3,7 @@
 //! kPa, Shore A, Shore 00), and the direction from the words just before it.
 
 use super::QueryError;
-use crate::hardness::scale::{Hardness, modulus_to_shore_00, modulus_to_shore_a};
+use crate::hardness::scale::{Hardness, HardnessReport};
 use serde::Serialize;
 
 /// How far before the value a direction word may stand ("harder than about 2 MPa").
@@ -29,43 +29,41 @@ impl Threshold {
         }
     }
 
-    /// The value as said and on the other scales: "2 MPa (57 Shore A)", "30 Shore A (0.97 MPa)".
+    /// "harder" or "softer", as the answer words the relation.
+    pub fn relation(&self) -> &'static str {
+        if self.harder { "harder" } else { "softer" }
+    }
+
+    /// The value on every scale; None for "rigid".
+    fn report(&self) -> Option<HardnessReport> {
+        Hardness::from_modulus_mpa(self.modulus_mpa)
+            .ok()
+            .map(HardnessReport::from)
+    }
+
+    /// The value as said and on the other scale: "2 MPa (57 Shore A)", "30 Shore A (0.97 MPa)".
     pub fn words(&self) -> String {
-        let e = self.modulus_mpa;
-        if !e.is_finite() {
-            return self.said.clone();
-        }
-        let shore = if modulus_to_shore_a(e) < 10.0 {
-            format!("{:.0} Shore 00", modulus_to_shore_00(e))
-        } else {
-            format!("{:.0} Shore A", modulus_to_shore_a(e))
-        };
-        if self.said.to_lowercase().contains("shore") {
-            format!("{} ({e:.2} MPa)", self.said)
-        } else {
-            format!("{} ({shore})", self.said)
+        match self.report() {
+            None => self.said.clone(),
+            Some(_) if self.said.contains("Shore") => {
+                format!("{} ({:.2} MPa)", self.said, self.modulus_mpa)
+            }
+            Some(r) => format!("{} ({})", self.said, r.shore_words()),
         }
     }
 
     /// The numbers `words` may print, for the groundedness check: the modulus (MPa, kPa)
     /// and both Shore scales.
     pub fn values(&self) -> Vec<f64> {
-        let e = self.modulus_mpa;
-        if !e.is_finite() {
-            return Vec::new();
-        }
-        vec![
-            e,
-            e * 1e3,
-            modulus_to_shore_a(e),
-            modulus_to_shore_00(e),
-            said_number(&self.said).unwrap_or(e),
-        ]
+        self.report().map_or_else(Vec::new, |r| {
+            vec![
+                self.modulus_mpa,
+                self.modulus_mpa * 1e3,
+                r.shore_a,
+                r.shore_00,
+            ]
+        })
     }
-}
-
-fn said_number(said: &str) -> Option<f64> {
-    said.split_whitespace().find_map(|w| w.parse().ok())
 }
 
 /// Lower-cased words, a number kept whole with its sign and decimal point ("-2", ".5",
@@ -270,11 +268,12 @@ fn value_at(words: &[String], i: usize) -> Option<Result<(Hardness, String, usiz
         })
     };
     let attached = number.trim_start_matches(|c: char| c.is_ascii_digit() || c == '.' || c == '-');
-    let (text, said, end) = if !attached.is_empty() {
+    if !attached.is_empty() {
         // "2mpa", "30a"; "2j", "3rd" are no values at all.
-        Hardness::parse(number).ok()?;
-        (number.clone(), unit_said(number, ""), i)
-    } else if let Some((unit, end)) = after.or_else(before) {
+        let h = Hardness::parse(number).ok()?;
+        return Some(Ok((h, unit_said(number, ""), i)));
+    }
+    let (text, said, end) = if let Some((unit, end)) = after.or_else(before) {
         (format!("{number} {unit}"), unit_said(number, &unit), end)
     } else {
         return None;
