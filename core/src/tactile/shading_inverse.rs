@@ -15,6 +15,10 @@ pub struct ShadingRow<'a> {
     ring: Vec<((f32, f32), ChangeAlongRow)>,
 }
 
+/// A lookup of the descent: the cost, the residual and the change's derivatives along gx
+/// and gy.
+type Local = (f32, [f32; 3], [f32; 3], [f32; 3]);
+
 /// A change as quadratics in u, per channel: [a0, a1, a2] for a0 + u (a1 + u a2).
 type ChangeAlongRow = [[f32; 3]; 3];
 
@@ -188,23 +192,17 @@ impl ShadingRow<'_> {
         };
         let norm2 = |r: [f32; 3]| r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
         let cost = |gx: f32, gy: f32| norm2(residual(gx, gy)) + prior * (gx * gx + gy * gy);
-        let mut start = (0.0f32, 0.0f32, cost(0.0, 0.0));
+        let flat = cost(0.0, 0.0);
         // A flat gel shows no change: most of a stock-sensor press frame ends here.
-        if start.2 <= 3.0 * 0.25 {
+        if flat <= 3.0 * 0.25 {
             return Some((0.0, 0.0));
-        }
-        if let Some((nx, ny)) = near {
-            let e = cost(nx, ny);
-            if e < start.2 {
-                start = (nx, ny, e);
-            }
         }
         let h = 1e-3f32 * mag_max;
         // The change, the cost and the change's derivatives at a slope: analytic derivatives
         // of the bilinear lookup, except at the flat gel, where the table is a cone with no
         // gradient: there central differences average the directions, which is what lets the
         // descent leave the apex.
-        let local = |gx: f32, gy: f32| {
+        let local = |gx: f32, gy: f32| -> Local {
             let (c, jx, jy) = if gx * gx + gy * gy > h * h {
                 self.change_with_derivatives(gx, gy, u)
             } else {
@@ -221,9 +219,11 @@ impl ShadingRow<'_> {
             let r: [f32; 3] = [c[0] - change[0], c[1] - change[1], c[2] - change[2]];
             (norm2(r) + prior * (gx * gx + gy * gy), r, jx, jy)
         };
-        let descend = |(mut gx, mut gy, _): (f32, f32, f32)| {
+        // From a start and its lookup to the slope, its cost and its residual (which the
+        // final check reuses: every lookup is kept, none made twice).
+        let descend = |(mut gx, mut gy): (f32, f32), at_start: Local| {
             let mut damping = 1e-2f32;
-            let (mut err, mut r, mut jx, mut jy) = local(gx, gy);
+            let (mut err, mut r, mut jx, mut jy) = at_start;
             for _ in 0..20 {
                 let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
                 let (a, b, d) = (dot(jx, jx) + prior, dot(jx, jy), dot(jy, jy) + prior);
@@ -256,9 +256,14 @@ impl ShadingRow<'_> {
                     break;
                 }
             }
-            (gx, gy, err)
+            (gx, gy, err, r)
         };
-        let mut best = descend(start);
+        // The better start of the flat gel and `near`, whose lookup the descent begins with.
+        let from_near = near.map(|(nx, ny)| ((nx, ny), local(nx, ny)));
+        let mut best = match from_near {
+            Some((g, at)) if at.0 < flat => descend(g, at),
+            _ => descend((0.0, 0.0), local(0.0, 0.0)),
+        };
         // Left over after the descent: more than a camera's noise (4 grey levels a channel)
         // may be a local minimum, so the ring's global start gets its chance.
         if best.2 > 3.0 * 4.0 * 4.0 {
@@ -274,14 +279,14 @@ impl ShadingRow<'_> {
                 }
             }
             if ring.2 < best.2 {
-                let again = descend(ring);
+                let again = descend((ring.0, ring.1), local(ring.0, ring.1));
                 if again.2 < best.2 {
                     best = again;
                 }
             }
         }
-        let (gx, gy, _) = best;
-        ((norm2(residual(gx, gy)) / 3.0).sqrt() <= max_rms).then_some((gx, gy))
+        let (gx, gy, _, r) = best;
+        ((norm2(r) / 3.0).sqrt() <= max_rms).then_some((gx, gy))
     }
 }
 
