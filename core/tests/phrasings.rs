@@ -74,6 +74,7 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     let mut unknown = Vec::new();
     let mut categories: Vec<String> = Vec::new();
     let mut threshold = None;
+    let mut relation = None;
     for pair in extras.split(' ').filter(|p| !p.is_empty()) {
         // A word without '=' continues a two-word position.
         let Some((key, value)) = pair.split_once('=') else {
@@ -93,6 +94,11 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
                 let (dir, v) = value.split_once(':').unwrap();
                 let e = Hardness::parse(v).unwrap().modulus_mpa().unwrap();
                 threshold = Some((dir == "harder", e));
+            }
+            // softer:apple: the direction and the fruit held against.
+            "relation" => {
+                let (dir, name) = value.split_once(':').unwrap();
+                relation = Some((dir == "harder", name.to_string()));
             }
             other => panic!("phrasings.tsv: extra {other:?}"),
         }
@@ -141,6 +147,13 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
         wrong.push(format!(
             "threshold {got_threshold:?}, expected {threshold:?}"
         ));
+    }
+    let got_relation = query
+        .relation
+        .as_ref()
+        .map(|r| (r.harder, r.reference.clone()));
+    if got_relation != relation {
+        wrong.push(format!("relation {got_relation:?}, expected {relation:?}"));
     }
     if query.unknown != unknown {
         wrong.push(format!("unknown {:?}, expected {unknown:?}", query.unknown));

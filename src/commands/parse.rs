@@ -59,6 +59,13 @@ fn describe(q: &Query) -> String {
     if let Some(t) = &q.threshold {
         s += &format!("value:    {} than {}\n", t.relation(), t.words());
     }
+    if let Some(r) = &q.relation {
+        s += &format!(
+            "value:    {} than the {} (as measured)\n",
+            r.relation(),
+            r.reference
+        );
+    }
     if !q.exclude.is_empty() {
         s += &format!("except:   {}\n", q.exclude.join(", "));
     }

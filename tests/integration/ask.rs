@@ -515,6 +515,42 @@ fn a_value_question_selects_exactly_the_fruit_past_it_hardest_first() {
 }
 
 #[test]
+fn a_question_against_another_fruit_presses_it_and_selects_the_fruit_past_its_reading() {
+    // scenes/demo.toml's truth: the lime is 1.5 MPa; mango 3.0, apple 3.25, avocado 5.0.
+    let a = ask_json("scenes/demo.toml", "Which fruits are harder than the lime?");
+    let mut got = selected_labels(&a);
+    got.sort();
+    assert_eq!(got, ["apple", "avocado", "mango"], "{}", a["answer"]);
+    let answer = a["answer"].as_str().unwrap();
+    assert!(
+        answer.starts_with("Three fruit are harder than the lime at "),
+        "{answer}"
+    );
+    assert_eq!(a["query"]["relation"]["reference"], "lime");
+
+    // A group against a fruit outside it: only the group and the reference are pressed.
+    let a = ask_json(
+        "scenes/demo.toml",
+        "Which citrus fruit is softer than the apple?",
+    );
+    assert_eq!(selected_labels(&a), ["lime"], "{}", a["answer"]);
+    let mut pressed: Vec<&str> = a["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| o["label"].as_str().unwrap())
+        .collect();
+    pressed.sort();
+    assert_eq!(pressed, ["apple", "lime"]);
+
+    // A reference not on the table is said, and nothing is selected.
+    let a = ask_json("scenes/demo.toml", "Which fruit is softer than the peach?");
+    assert_eq!(selected_labels(&a), Vec::<String>::new());
+    let answer = a["answer"].as_str().unwrap();
+    assert!(answer.contains("I found no peach"), "{answer}");
+}
+
+#[test]
 fn colour_and_position_filters_choose_the_fruit() {
     let scene = "scenes/demo.toml";
     let a = ask_json(scene, "How hard is the yellow one?");

@@ -169,7 +169,11 @@ pub fn check_invented(
         .objects
         .iter()
         .flat_map(hardness_values)
-        .chain(facts.query.threshold.iter().flat_map(|t| t.values()))
+        .chain(
+            super::held_against(&facts.query, &facts.objects)
+                .iter()
+                .flat_map(|t| t.values()),
+        )
         .collect();
     let percents: Vec<f64> = facts.objects.iter().flat_map(percent_values).collect();
     let counts: Vec<f64> = [

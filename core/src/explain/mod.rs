@@ -13,6 +13,7 @@ pub use template::TemplateExplainer;
 
 use crate::catalog::FruitCatalog;
 use crate::hardness::scale::HardnessReport;
+use crate::query::threshold::Threshold;
 use crate::query::{Extreme, Intent, Property, Query};
 use serde::Serialize;
 
@@ -65,6 +66,20 @@ pub(crate) fn stiffness(m: &Measured) -> f64 {
         .map_or(f64::NAN, |h| h.modulus_mpa.unwrap_or(f64::INFINITY))
 }
 
+/// What a threshold question holds the fruit against: its value, or the measured hardness
+/// of the object it names ("softer than the apple"); None when that object was not measured.
+pub fn held_against(query: &Query, objects: &[Measured]) -> Option<Threshold> {
+    query.threshold.clone().or_else(|| {
+        let r = query.relation.as_ref()?;
+        let moduli: Vec<f64> = objects
+            .iter()
+            .filter(|m| m.label == r.reference && m.hardness.is_some())
+            .map(stiffness)
+            .collect();
+        r.resolve(&moduli)
+    })
+}
+
 /// Indices of `objects` that answer the query, in answer order.
 pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Vec<usize> {
     let mut measured: Vec<usize> = (0..objects.len())
@@ -89,10 +104,10 @@ pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Ve
             measured
         }
         Intent::Threshold => {
+            let against = held_against(query, objects);
             measured.retain(|&i| {
                 query.wants(&objects[i].label)
-                    && query
-                        .threshold
+                    && against
                         .as_ref()
                         .is_some_and(|t| t.holds_for(stiffness(&objects[i])))
             });

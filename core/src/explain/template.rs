@@ -265,11 +265,22 @@ pub fn explain(
                 );
             }
         }
-        Intent::Threshold => {
-            if let Some(t) = &query.threshold {
-                parts.extend(past_threshold(query, t, objects, selected));
+        Intent::Threshold => match (super::held_against(query, objects), &query.relation) {
+            (Some(t), _) => parts.extend(past_threshold(query, &t, objects, selected)),
+            (None, Some(r)) => {
+                let why = if objects.iter().any(|m| m.label == r.reference) {
+                    format!("I could not measure the {}", r.reference)
+                } else {
+                    format!("I found no {} on the table", r.reference)
+                };
+                parts.push(format!(
+                    "{why}, so I cannot say which {} is {} than it.",
+                    query.asked_kind(),
+                    r.relation()
+                ))
             }
-        }
+            (None, None) => {}
+        },
         Intent::Summarize if query.ranked && !selected.is_empty() => {
             let (most, least) = match query.property {
                 Property::Hardness => ("hardest", "softest"),

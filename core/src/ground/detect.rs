@@ -51,8 +51,8 @@ pub trait Detector {
     /// Every object it finds, best first or in any order.
     fn detect(&self, view: &RgbdView<'_>) -> Result<Vec<Detection>, DetectError>;
 
-    /// The detections of the kinds a query asks for (prompt-conditioned, as in the paper:
-    /// the parsed targets filter what the detector returns).
+    /// The detections of the kinds a query needs (prompt-conditioned, as in the paper: the
+    /// parsed targets, and what they are held against, filter what the detector returns).
     fn detect_for(
         &self,
         view: &RgbdView<'_>,
@@ -61,7 +61,7 @@ pub trait Detector {
         Ok(self
             .detect(view)?
             .into_iter()
-            .filter(|d| query.wants(&d.label))
+            .filter(|d| query.needs(&d.label))
             .collect())
     }
 }

@@ -81,6 +81,10 @@ pub struct Query {
     /// A value the objects are held against ("harder than 2 MPa"), for `Intent::Threshold`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub threshold: Option<threshold::Threshold>,
+    /// Another object the objects are held against ("softer than the apple"), for
+    /// `Intent::Threshold`: its value is its measured hardness.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub relation: Option<threshold::Relation>,
 }
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -179,6 +183,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let mut filters = Filters::default();
     let mut positions: Vec<&str> = Vec::new();
     let mut excluding = false;
+    let mut relation: Option<threshold::Relation> = None;
     let mut generic = false;
     // "all", "every", "fruits": a summary; "the fruit on the left", "the yellow one": one.
     let mut generic_plural = false;
@@ -247,6 +252,18 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             }
         }
         if let Some(f) = catalog.find_word(w) {
+            // "softer than the apple": the apple is what the others are held against.
+            if !excluding
+                && relation.is_none()
+                && threshold.is_none()
+                && let Some(harder) = threshold::comparison_before(&words, i)
+            {
+                relation = Some(threshold::Relation {
+                    harder,
+                    reference: f.name.clone(),
+                });
+                continue;
+            }
             let list = if excluding {
                 &mut exclude
             } else {
@@ -307,6 +324,11 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             properties.push((pw.property, degree, pw.inverted ^ flipped));
         }
     }
+    // "Is the mango harder than the avocado?" compares two named fruit: the reference is
+    // one of them. A relation stands alone only against the fruit not named.
+    if let Some(r) = relation.take_if(|_| !targets.is_empty()) {
+        targets.push(r.reference);
+    }
     targets.retain(|t| !exclude.contains(t));
     filters.position = position_phrase(&positions);
 
@@ -316,7 +338,10 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let all = generic
         || !exclude.is_empty()
         || (targets.is_empty()
-            && (filtered || (threshold.is_some() && categories.is_empty() && unknown.is_empty())));
+            && (filtered
+                || ((threshold.is_some() || relation.is_some())
+                    && categories.is_empty()
+                    && unknown.is_empty())));
     if targets.is_empty() && categories.is_empty() && !all {
         return Err(match unknown.first() {
             Some(name) => QueryError::UnknownFruit {
@@ -344,8 +369,12 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             .first()
             .copied()
             .unwrap_or((Property::Hardness, Degree::Base, false));
-    if let Some(t) = &threshold {
-        property = if t.harder {
+    if let Some(harder) = threshold
+        .as_ref()
+        .map(|t| t.harder)
+        .or(relation.as_ref().map(|r| r.harder))
+    {
+        property = if harder {
             Property::Hardness
         } else {
             Property::Softness
@@ -358,7 +387,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         && !properties.is_empty()
         && !(plural || generic_plural);
     let superlative = superlatives > 0 || selects;
-    let intent = if threshold.is_some() {
+    let intent = if threshold.is_some() || relation.is_some() {
         Intent::Threshold
     } else if ranked {
         Intent::Summarize
@@ -400,6 +429,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         ranked,
         unknown,
         threshold,
+        relation,
     })
 }
 
@@ -430,7 +460,20 @@ impl Query {
             .any(|c| c.members.iter().any(|m| m == label));
         // A group bounds "all": "of all the fruit, which citrus is softest" is about the citrus.
         let every = self.all && self.categories.is_empty();
-        !self.exclude.iter().any(|e| e == label) && (every || named || grouped)
+        !self.exclude.iter().any(|e| e == label)
+            && !self.is_reference(label)
+            && (every || named || grouped)
+    }
+
+    /// Whether the answer needs this object pressed: it is asked about, or it is what the
+    /// others are held against.
+    pub fn needs(&self, label: &str) -> bool {
+        self.wants(label) || self.is_reference(label)
+    }
+
+    /// Whether objects with this label are the relation's reference ("than the apple").
+    pub fn is_reference(&self, label: &str) -> bool {
+        self.relation.as_ref().is_some_and(|r| r.reference == label)
     }
 
     /// How the answer names what was asked about: "fruit", "citrus fruit", "lime or lemon".

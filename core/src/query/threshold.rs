@@ -66,6 +66,80 @@ impl Threshold {
     }
 }
 
+/// Another object the question holds the fruit against ("softer than the apple"): its
+/// value is the reference's measured hardness, known once it is pressed.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Relation {
+    /// The fruit asked for are harder than the reference (false: softer).
+    pub harder: bool,
+    /// The reference's catalog name.
+    pub reference: String,
+}
+
+impl Relation {
+    /// "harder" or "softer", as the answer words the relation.
+    pub fn relation(&self) -> &'static str {
+        if self.harder { "harder" } else { "softer" }
+    }
+
+    /// The value of the reference's measured moduli (MPa; infinite: rigid) as a threshold:
+    /// with several of its kind, past every one of them ("softer than the apples" is
+    /// softer than the softest apple). None when none of them was measured.
+    pub fn resolve(&self, moduli: &[f64]) -> Option<Threshold> {
+        let (&first, rest) = moduli.split_first()?;
+        let bound = rest
+            .iter()
+            .fold(first, |b, &e| if self.harder { b.max(e) } else { b.min(e) });
+        let which = match (moduli.len(), self.harder) {
+            (1, _) => "the",
+            (_, true) => "the hardest",
+            (_, false) => "the softest",
+        };
+        let said = if bound.is_finite() {
+            format!("{which} {} at {bound:.2} MPa", self.reference)
+        } else {
+            format!("{which} {}, which is rigid", self.reference)
+        };
+        Some(Threshold {
+            harder: self.harder,
+            modulus_mpa: bound,
+            said,
+        })
+    }
+}
+
+/// Which way the words just before word `i` compare it, when they do: "softer than (the)
+/// X", "not harder than X", "less firm than X". Some(true): harder than X.
+pub fn comparison_before(words: &[String], i: usize) -> Option<bool> {
+    let mut j = i.checked_sub(1)?;
+    while matches!(
+        words[j].as_str(),
+        "the" | "a" | "an" | "that" | "this" | "my" | "your"
+    ) {
+        j = j.checked_sub(1)?;
+    }
+    if words[j] != "than" {
+        return None;
+    }
+    let k = j.checked_sub(1)?;
+    // "less firm than", "more soft than": a base property word after "more" or "less".
+    let before_k = k.checked_sub(1).map(|m| words[m].as_str());
+    let (harder, at) = match (before_k, words[k].as_str()) {
+        (Some(more @ ("more" | "less")), base) => {
+            let soft = matches!(base, "soft" | "squishy" | "tender" | "mushy");
+            let hard = matches!(base, "hard" | "firm" | "stiff" | "solid" | "tough");
+            if !(soft || hard) {
+                return None;
+            }
+            ((more == "more") == hard, k - 1)
+        }
+        (_, "more" | "less") => return None,
+        _ => (direction(words, k)?, k),
+    };
+    let negated = at > 0 && matches!(words[at - 1].as_str(), "not" | "no" | "never" | "t");
+    Some(harder != negated)
+}
+
 /// Lower-cased words, a number kept whole with its sign and decimal point ("-2", ".5",
 /// "2.5"; "2,5" too, to be refused by name), and ">", "<" read as "above", "below".
 fn tokens(prompt: &str) -> Vec<String> {
@@ -305,6 +379,54 @@ fn unit_said(number: &str, unit: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+    fn words(text: &str) -> Vec<String> {
+        text.split(' ').map(str::to_string).collect()
+    }
+
+    #[test]
+    fn a_comparison_before_a_name_says_which_way() {
+        let at_end = |t: &str| {
+            let w = words(t);
+            comparison_before(&w, w.len() - 1)
+        };
+        assert_eq!(at_end("softer than the apple"), Some(false));
+        assert_eq!(at_end("harder than apple"), Some(true));
+        assert_eq!(at_end("not harder than the apple"), Some(false));
+        assert_eq!(at_end("less firm than the apple"), Some(false));
+        assert_eq!(at_end("more soft than the apple"), Some(false));
+        assert_eq!(at_end("less soft than my apple"), Some(true));
+        assert_eq!(at_end("bigger than the apple"), None);
+        assert_eq!(at_end("the apple"), None);
+        assert_eq!(at_end("than the apple"), None);
+        assert_eq!(at_end("more than the apple"), None);
+    }
+
+    #[test]
+    fn a_relation_holds_the_fruit_past_every_measured_reference() {
+        let softer = Relation {
+            harder: false,
+            reference: "apple".into(),
+        };
+        assert_eq!(softer.resolve(&[]), None);
+        let one = softer.resolve(&[3.25]).unwrap();
+        assert_eq!(one.said, "the apple at 3.25 MPa");
+        assert!(one.holds_for(3.0) && !one.holds_for(3.25));
+        let two = softer.resolve(&[3.25, 2.0]).unwrap();
+        assert_eq!(
+            (two.modulus_mpa, two.said.as_str()),
+            (2.0, "the softest apple at 2.00 MPa")
+        );
+        let harder = Relation {
+            harder: true,
+            ..softer
+        };
+        assert_eq!(harder.resolve(&[3.25, 2.0]).unwrap().modulus_mpa, 3.25);
+        assert_eq!(
+            harder.resolve(&[f64::INFINITY]).unwrap().said,
+            "the apple, which is rigid"
+        );
+    }
+
     use super::*;
     use crate::hardness::scale::shore_a_to_modulus_mpa;
 
