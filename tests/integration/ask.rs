@@ -510,6 +510,21 @@ fn a_value_question_selects_exactly_the_fruit_past_it_hardest_first() {
     );
     assert!(answer.contains("The softest is the tomato"), "{answer}");
 
+    // A superlative beside the value picks one of the fruit past it: of tomato 0.45,
+    // banana 0.8 and lime 1.5 MPa, the hardest is the lime.
+    let a = ask_json(
+        "scenes/demo.toml",
+        "Which is the hardest fruit softer than 2 MPa?",
+    );
+    assert_eq!(selected_labels(&a), ["lime"], "{}", a["answer"]);
+    let answer = a["answer"].as_str().unwrap();
+    assert!(
+        answer.starts_with(
+            "Of the three fruit softer than 2 MPa (44 Shore A), the hardest is the lime"
+        ),
+        "{answer}"
+    );
+
     let e = fails(&["parse", "Which fruits are harder than 2?"]);
     assert!(e.contains("hardness value '2': has no unit"), "{e}");
 }

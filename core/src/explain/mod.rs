@@ -112,6 +112,12 @@ pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Ve
                         .is_some_and(|t| t.holds_for(stiffness(&objects[i])))
             });
             measured.sort_by(|a, b| key(b).total_cmp(&key(a)));
+            // A superlative beside the value picks one of them.
+            match query.extreme {
+                Some(Extreme::Most) => measured.truncate(1),
+                Some(Extreme::Least) => measured = measured.pop().into_iter().collect(),
+                None => {}
+            }
             measured
         }
         Intent::Extreme => {

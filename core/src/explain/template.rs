@@ -128,18 +128,48 @@ fn past_threshold(
             parts.push(format!("The {word} is {}.", describe(&objects[i])));
         }
     } else {
-        let list: Vec<String> = selected.iter().map(|&i| describe(&objects[i])).collect();
-        let verb = if selected.len() == 1 { "is" } else { "are" };
-        parts.push(format!(
-            "{} {kind} {verb} {rel} than {value}: {}.",
-            count_words(selected.len()),
-            list.join("; ")
-        ));
+        let all_past: Vec<usize> = asked
+            .iter()
+            .copied()
+            .filter(|&i| t.holds_for(stiffness(&objects[i])))
+            .collect();
+        match query.extreme {
+            // "the softest fruit harder than 2 MPa": the one picked, then the rest past it.
+            Some(extreme) => {
+                let word = superlative(query.property, Some(extreme));
+                parts.push(format!(
+                    "Of the {} {kind} {rel} than {value}, the {word} is {}.",
+                    count_words(all_past.len()).to_lowercase(),
+                    describe(&objects[selected[0]])
+                ));
+                let rest: Vec<String> = all_past
+                    .iter()
+                    .filter(|i| !selected.contains(i))
+                    .filter_map(|&i| {
+                        let m = &objects[i];
+                        let h = m.hardness.as_ref()?;
+                        Some(format!("{} at {}", m.label, describe_hardness(h, None)))
+                    })
+                    .collect();
+                if !rest.is_empty() {
+                    parts.push(format!("Also {rel}: {}.", rest.join(", ")));
+                }
+            }
+            None => {
+                let list: Vec<String> = selected.iter().map(|&i| describe(&objects[i])).collect();
+                let verb = if selected.len() == 1 { "is" } else { "are" };
+                parts.push(format!(
+                    "{} {kind} {verb} {rel} than {value}: {}.",
+                    count_words(selected.len()),
+                    list.join("; ")
+                ));
+            }
+        }
         // The others nearest the value first.
         let mut others: Vec<usize> = asked
             .iter()
             .copied()
-            .filter(|i| !selected.contains(i))
+            .filter(|i| !all_past.contains(i))
             .collect();
         others.sort_by(|&a, &b| past(b).total_cmp(&past(a)));
         let others: Vec<String> = others
@@ -167,6 +197,18 @@ fn past_threshold(
         }
     }
     parts
+}
+
+/// The superlative an answer names its pick with: "softest", "least hard", "ripest".
+fn superlative(property: Property, extreme: Option<Extreme>) -> &'static str {
+    match (property, extreme) {
+        (Property::Softness, Some(Extreme::Least)) => "least soft",
+        (Property::Softness, _) => "softest",
+        (Property::Hardness, Some(Extreme::Least)) => "least hard",
+        (Property::Hardness, _) => "hardest",
+        (Property::Ripeness, Some(Extreme::Least)) => "least ripe",
+        (Property::Ripeness, _) => "ripest",
+    }
 }
 
 /// A count as an answer opens a sentence with it: "One", ..., "Ten", "12".
@@ -217,14 +259,7 @@ pub fn explain(
     }
     match query.intent {
         Intent::Extreme if !selected.is_empty() => {
-            let word = match (query.property, query.extreme) {
-                (Property::Softness, Some(Extreme::Least)) => "least soft",
-                (Property::Softness, _) => "softest",
-                (Property::Hardness, Some(Extreme::Least)) => "least hard",
-                (Property::Hardness, _) => "hardest",
-                (Property::Ripeness, Some(Extreme::Least)) => "least ripe",
-                (Property::Ripeness, _) => "ripest",
-            };
+            let word = superlative(query.property, query.extreme);
             let kind = query.asked_kind();
             parts.push(format!(
                 "The {word} {kind} is {}.",

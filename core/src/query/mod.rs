@@ -408,11 +408,18 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     } else {
         Intent::Identify
     };
-    let extreme = (intent == Intent::Extreme).then_some(if flipped {
+    let mut extreme = (intent == Intent::Extreme).then_some(if flipped {
         Extreme::Least
     } else {
         Extreme::Most
     });
+    // "the softest fruit harder than 2 MPa": the value narrows, the superlative picks one.
+    if intent == Intent::Threshold
+        && let Some(&(p, _, low)) = properties.iter().find(|p| p.1 == Degree::Superlative)
+    {
+        property = p;
+        extreme = Some(if low { Extreme::Least } else { Extreme::Most });
+    }
     // Named kinds bound an extreme, a comparison or an identification ("which fruit is
     // softer, the kiwi or the peach"); a summary may add "all other fruits" to named ones.
     let all =
