@@ -413,9 +413,10 @@ fn calibrate_rejects_bad_input_in_one_line_and_writes_nothing() {
 /// The real presses read through the fixture profile's table and glow, as the indentation
 /// estimator reads frames: the glow undone, the contact is the ball's and not a bowl of
 /// scattered light. Before the glow was read backwards the radius read +72% over the marked
-/// one (30 FOTS presses through fots-9) and the depth +23% over the layer model's; on these
-/// nine, through a profile fitted to six of them, now +16% and +16% (a profile from 20
-/// presses reads the 30 at +14% and +7%).
+/// one (30 FOTS presses through fots-9) and the depth +23% over the layer model's. The
+/// half-depth region still read the radius +14% (a blurred real imprint is wider at half
+/// its depth); the contact's edge where the slope peaks reads it within 3% on these nine
+/// (issue 46 asks within 10%).
 #[test]
 fn real_presses_read_through_the_glow_give_the_balls_depth() {
     let f = fixtures();
@@ -439,7 +440,7 @@ fn real_presses_read_through_the_glow_give_the_balls_depth() {
     let v = |s: &serde_json::Value, k: &str| s[k].as_f64().unwrap();
     assert_eq!(v(real, "presses"), 9.0);
     assert!(v(real, "depth_error_median_abs") < 0.25, "{real}");
-    assert!(v(real, "radius_error_median") < 0.25, "{real}");
+    assert!(v(real, "radius_error_median").abs() < 0.1, "{real}");
     // The twin's own renders through the profile read as the stock Mini's do.
     assert!(v(rendered, "depth_error_median_abs") < 0.2, "{rendered}");
     assert!(v(rendered, "radius_error_median_abs") < 0.12, "{rendered}");

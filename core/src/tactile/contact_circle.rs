@@ -57,17 +57,40 @@ pub struct ContactCircle {
 /// differ in size or no plausible circle comes out (run the contact test first: a frame
 /// without contact has no circle to find).
 pub fn estimate_contact_circle(frame: &RgbImage, reference: &RgbImage) -> Option<ContactCircle> {
-    if frame.dimensions() != reference.dimensions() || frame.width() < 16 || frame.height() < 16 {
+    if !readable(frame, reference) {
         return None;
     }
     let change = colour_change(frame, reference);
-    let magnitude = channel_norm(&change);
-    let (w, h) = (frame.width() as f64, frame.height() as f64);
+    circle_of(&channel_norm(&change), imprint_starts(&change))
+}
+
+/// The contact circle found from a known middle of the imprint (px), as a reader that has
+/// already located it asks: the start search's texture and its wide blur are skipped.
+pub fn contact_circle_around(
+    frame: &RgbImage,
+    reference: &RgbImage,
+    middle_px: (f64, f64),
+) -> Option<ContactCircle> {
+    if !readable(frame, reference) {
+        return None;
+    }
+    circle_of(
+        &channel_norm(&colour_change(frame, reference)),
+        vec![middle_px],
+    )
+}
+
+fn readable(frame: &RgbImage, reference: &RgbImage) -> bool {
+    frame.dimensions() == reference.dimensions() && frame.width() >= 16 && frame.height() >= 16
+}
+
+/// From each start, fit and re-centre; the circle that most rays agree with.
+fn circle_of(magnitude: &FloatImage, starts: Vec<(f64, f64)>) -> Option<ContactCircle> {
+    let (w, h) = (magnitude.width() as f64, magnitude.height() as f64);
     let reach = 0.45 * w.min(h);
-    // From each start, fit and re-centre; keep the circle that most rays agree with.
-    let (centre, radius, edge) = imprint_starts(&change)
+    let (centre, radius, edge) = starts
         .into_iter()
-        .filter_map(|start| circle_from(&magnitude, start, reach))
+        .filter_map(|start| circle_from(magnitude, start, reach))
         .filter(|(_, radius, _)| (3.0..=reach).contains(radius))
         .max_by_key(|(_, _, edge)| edge.len())?;
     let rms = (edge
@@ -267,6 +290,38 @@ fn fit_without_outliers(points: &[[f64; 2]]) -> Option<Circle> {
 
 /// Area of the outline (shoelace). Its points come in ray order, so in angle order about
 /// the last ray origin, about which the outline is star-shaped.
+impl ContactCircle {
+    /// The contact region's semi-axes (px, wide then narrow): the ellipse of the outline's
+    /// area with the aspect of its second moments (a uniform ellipse of semi-axes a, b has
+    /// moments a^2/4 and b^2/4), so an elongated contact keeps its narrow side.
+    pub fn semi_axes_px(&self) -> [f64; 2] {
+        let p = &self.edge_px;
+        let n = p.len();
+        // Green's theorem over the outline: signed area, first and second moments.
+        let (mut a, mut mx, mut my, mut ixx, mut iyy, mut ixy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for i in 0..n {
+            let ([x0, y0], [x1, y1]) = (p[i], p[(i + 1) % n]);
+            let cross = x0 * y1 - x1 * y0;
+            a += cross / 2.0;
+            mx += cross * (x0 + x1) / 6.0;
+            my += cross * (y0 + y1) / 6.0;
+            ixx += cross * (x0 * x0 + x0 * x1 + x1 * x1) / 12.0;
+            iyy += cross * (y0 * y0 + y0 * y1 + y1 * y1) / 12.0;
+            ixy += cross * (x0 * y1 + 2.0 * x0 * y0 + 2.0 * x1 * y1 + x1 * y0) / 24.0;
+        }
+        if n < 3 || a.abs() < 1e-9 {
+            return [self.radius_px, self.radius_px];
+        }
+        let (cx, cy) = (mx / a, my / a);
+        let (cxx, cyy, cxy) = (ixx / a - cx * cx, iyy / a - cy * cy, ixy / a - cx * cy);
+        let mean = 0.5 * (cxx + cyy);
+        let spread = (0.25 * (cxx - cyy).powi(2) + cxy * cxy).sqrt();
+        let aspect = ((mean + spread) / (mean - spread).max(1e-12)).sqrt();
+        let equal_area = (a.abs() / std::f64::consts::PI).sqrt();
+        [equal_area * aspect.sqrt(), equal_area / aspect.sqrt()]
+    }
+}
+
 fn polygon_area(points: &[[f64; 2]]) -> f64 {
     let twice: f64 = (0..points.len())
         .map(|i| {
@@ -280,6 +335,32 @@ fn polygon_area(points: &[[f64; 2]]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_elliptic_outline_gives_its_semi_axes() {
+        // An ellipse of semi-axes 30 and 12 px turned 30 degrees, outlined by 90 points.
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let edge_px: Vec<[f64; 2]> = (0..90)
+            .map(|k| {
+                let t = std::f64::consts::TAU * k as f64 / 90.0;
+                let (x, y) = (30.0 * t.cos(), 12.0 * t.sin());
+                [100.0 + c * x - s * y, 80.0 + s * x + c * y]
+            })
+            .collect();
+        let circle = ContactCircle {
+            centre_px: [100.0, 80.0],
+            radius_px: 19.0,
+            region_area_px2: polygon_area(&edge_px),
+            edge_px,
+            rms_residual_px: 0.0,
+        };
+        let [a, b] = circle.semi_axes_px();
+        // A 90-gon inscribed in the ellipse holds 0.08% less area.
+        assert!(
+            (a - 30.0).abs() < 0.05 && (b - 12.0).abs() < 0.05,
+            "{a} {b}"
+        );
+    }
 
     /// Surface depth of a rigid sphere (radius `r_sphere`) pressed into an elastic half-space
     /// to contact radius `a` (Johnson, Contact Mechanics, eq. 3.42): inside the contact the

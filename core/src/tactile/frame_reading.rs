@@ -1,14 +1,19 @@
 //! What one tactile frame says about the gel: its indentation map (slopes read through the
 //! sensor's optics against the no-contact frame, integrated), the imprint's peak depth, the
-//! contact's semi-axes from the half-depth region, and whether the imprint lies within the
-//! frame. The indentation estimator reads every frame of a press this way; `tactex read`
+//! contact's semi-axes (from the contact circle's outline where the frame shows a round
+//! contact, else from the half-depth region), and whether the imprint lies within the frame. The indentation estimator reads every frame of a press this way; `tactex read`
 //! shows one.
 
+use crate::tactile::contact_circle::contact_circle_around;
 use crate::tactile::depth::integrate_slopes;
 use crate::tactile::slopes::recover_slopes;
 use crate::tactile::spec::TactileSpec;
 use image::RgbImage;
 use std::f64::consts::PI;
+
+/// An outline further from its circle than this share of the radius (rms) is not a round
+/// contact's edge: real ball presses lie within 0.14, a contact cut by the frame 0.3 and more.
+const MAX_OUTLINE_RMS_SHARE: f64 = 0.2;
 
 /// One frame read.
 #[derive(Clone, Debug)]
@@ -21,8 +26,11 @@ pub struct FrameReading {
     pub valid: Vec<bool>,
     /// The imprint's depth: the mean of its 20 deepest pixels.
     pub peak_mm: f64,
-    /// The contact's semi-axes (mm, wide then narrow), from the half-depth region.
+    /// The contact's semi-axes (mm, wide then narrow): the outline of where the slope peaks
+    /// (`contact_circle`), or the half-depth region where that outline is not round.
     pub contact_axes_mm: [f64; 2],
+    /// That outline (px of this reading) where the frame shows a round contact.
+    pub contact_outline_px: Option<Vec<[f64; 2]>>,
     /// The imprint's half-depth region stays off the frame's border and the border is level.
     pub within_frame: bool,
 }
@@ -33,10 +41,29 @@ impl FrameReading {
         (self.contact_axes_mm[0] * self.contact_axes_mm[1]).sqrt()
     }
 
-    /// Whether a pixel lies in the half-depth region the contact's size is taken from.
+    /// Whether a pixel lies in the contact region its size is taken from: inside the
+    /// outline, or in the half-depth region.
     pub fn in_contact(&self, i: usize) -> bool {
-        self.peak_mm > 0.0 && self.indentation_mm[i] > 0.5 * self.peak_mm
+        match &self.contact_outline_px {
+            Some(outline) => {
+                let (x, y) = ((i % self.width) as f64, (i / self.width) as f64);
+                inside_polygon(outline, x, y)
+            }
+            None => self.peak_mm > 0.0 && self.indentation_mm[i] > 0.5 * self.peak_mm,
+        }
     }
+}
+
+/// Whether (x, y) lies inside the polygon (even-odd crossings of a ray along +x).
+fn inside_polygon(points: &[[f64; 2]], x: f64, y: f64) -> bool {
+    let mut inside = false;
+    for (k, &[x0, y0]) in points.iter().enumerate() {
+        let [x1, y1] = points[(k + 1) % points.len()];
+        if (y0 > y) != (y1 > y) && x < x0 + (y - y0) / (y1 - y0) * (x1 - x0) {
+            inside = !inside;
+        }
+    }
+    inside
 }
 
 /// Reads `frame` against the no-contact `reference` through the sensor's optics. None when
@@ -50,7 +77,35 @@ pub fn read_frame(
     let depth = integrate_slopes(&slopes);
     let p = peak(&depth);
     let deep = |d: f64| d > 0.5 * p;
-    let contact_axes_mm = contact_ellipse(&depth, slopes.width, deep, slopes.mm_per_px);
+    // The contact's edge is where the gel's slope peaks, which the colour change shows
+    // directly (`contact_circle`); the half-depth region where the frame shows no round
+    // contact (a first touch of a few pixels, an imprint cut by the frame's edge).
+    // The circle is in the frame's pixels; a fine frame's slopes are read on blocks.
+    let frame_px = slopes.width as f64 / frame.width() as f64;
+    let circle = region_middle(&depth, slopes.width, deep)
+        .and_then(|(x, y)| {
+            let middle = ((x + 0.5) / frame_px - 0.5, (y + 0.5) / frame_px - 0.5);
+            contact_circle_around(frame, reference, middle)
+        })
+        .filter(|c| c.rms_residual_px <= MAX_OUTLINE_RMS_SHARE * c.radius_px);
+    let (contact_axes_mm, contact_outline_px) = match circle {
+        Some(circle) => (
+            circle
+                .semi_axes_px()
+                .map(|a| a * slopes.mm_per_px * frame_px),
+            Some(
+                circle
+                    .edge_px
+                    .iter()
+                    .map(|p| p.map(|v| (v + 0.5) * frame_px - 0.5))
+                    .collect(),
+            ),
+        ),
+        None => (
+            contact_ellipse(&depth, slopes.width, deep, slopes.mm_per_px),
+            None,
+        ),
+    };
     let within_frame = imprint_within_frame(&depth, &slopes.valid, slopes.width, slopes.height, p);
     Some(FrameReading {
         width: slopes.width,
@@ -59,6 +114,7 @@ pub fn read_frame(
         valid: slopes.valid,
         peak_mm: p,
         contact_axes_mm,
+        contact_outline_px,
         within_frame,
     })
 }
@@ -71,6 +127,19 @@ fn peak(depth: &[f64]) -> f64 {
     let k = sorted.len() - n;
     sorted.select_nth_unstable_by(k, f64::total_cmp);
     sorted[k..].iter().sum::<f64>() / n as f64
+}
+
+/// The middle (px) of the region where `inside` holds; None when it is empty.
+fn region_middle(depth: &[f64], w: usize, inside: impl Fn(f64) -> bool) -> Option<(f64, f64)> {
+    let (mut n, mut sx, mut sy) = (0.0, 0.0, 0.0);
+    for (i, d) in depth.iter().enumerate() {
+        if inside(*d) {
+            n += 1.0;
+            sx += (i % w) as f64;
+            sy += (i / w) as f64;
+        }
+    }
+    (n > 0.0).then(|| (sx / n, sy / n))
 }
 
 /// The contact's semi-axes (mm, wide then narrow) from the imprint's half-depth region (where
