@@ -558,6 +558,19 @@ fn a_question_against_another_fruit_presses_it_and_selects_the_fruit_past_its_re
     pressed.sort();
     assert_eq!(pressed, ["apple", "lime"]);
 
+    // A place chooses the fruit asked about, not the reference (the mango is at the left).
+    let a = ask_json(
+        "scenes/demo.toml",
+        "Which fruit on the right is softer than the mango?",
+    );
+    assert_eq!(selected_labels(&a), ["tomato"], "{}", a["answer"]);
+    // Two bounds are refused, as two values are.
+    let e = fails(&[
+        "parse",
+        "Is anything softer than the mango but harder than the banana?",
+    ]);
+    assert!(e.contains("ask about one at a time"), "{e}");
+
     // A reference not on the table is said, and nothing is selected.
     let a = ask_json("scenes/demo.toml", "Which fruit is softer than the peach?");
     assert_eq!(selected_labels(&a), Vec::<String>::new());

@@ -108,6 +108,10 @@ fn past_threshold(
     let mut parts = Vec::new();
     if selected.is_empty() {
         if asked.is_empty() {
+            // The reference alone was on the table (or none of the group asked about).
+            if query.relation.is_some() {
+                parts.push(format!("I found no {kind} to hold against {value}."));
+            }
             return parts;
         }
         if let [only] = asked[..] {
@@ -125,7 +129,13 @@ fn past_threshold(
             .max_by(|&a, &b| past(a).total_cmp(&past(b)));
         if let Some(i) = nearest {
             let word = if t.harder { "hardest" } else { "softest" };
-            parts.push(format!("The {word} is {}.", describe(&objects[i])));
+            // Against another fruit, that fruit is past every other: the nearest is of them.
+            let of = if query.relation.is_some() {
+                " of the others"
+            } else {
+                ""
+            };
+            parts.push(format!("The {word}{of} is {}.", describe(&objects[i])));
         }
     } else {
         let all_past: Vec<usize> = asked
@@ -138,8 +148,9 @@ fn past_threshold(
             Some(extreme) => {
                 let word = superlative(query.property, Some(extreme));
                 parts.push(format!(
-                    "Of the {} {kind} {rel} than {value}, the {word} is {}.",
+                    "Of the {} {} {rel} than {value}, the {word} is {}.",
                     count_words(all_past.len()).to_lowercase(),
+                    counted(&kind, all_past.len()),
                     describe(&objects[selected[0]])
                 ));
                 let rest: Vec<String> = all_past
@@ -159,8 +170,9 @@ fn past_threshold(
                 let list: Vec<String> = selected.iter().map(|&i| describe(&objects[i])).collect();
                 let verb = if selected.len() == 1 { "is" } else { "are" };
                 parts.push(format!(
-                    "{} {kind} {verb} {rel} than {value}: {}.",
+                    "{} {} {verb} {rel} than {value}: {}.",
                     count_words(selected.len()),
+                    counted(&kind, selected.len()),
                     list.join("; ")
                 ));
             }
@@ -209,6 +221,29 @@ fn superlative(property: Property, extreme: Option<Extreme>) -> &'static str {
         (Property::Ripeness, Some(Extreme::Least)) => "least ripe",
         (Property::Ripeness, _) => "ripest",
     }
+}
+
+/// A kind as a count of it reads: "one banana", "two bananas or tomatoes", "three citrus
+/// fruit", "two berries".
+fn counted(kind: &str, n: usize) -> String {
+    if n == 1 {
+        return kind.to_string();
+    }
+    let plural = |k: &str| -> String {
+        if k.ends_with("fruit") {
+            k.to_string()
+        } else if let Some(stem) = k.strip_suffix('y') {
+            format!("{stem}ies")
+        } else if k.ends_with("ch") || k.ends_with("tomato") || k.ends_with("mango") {
+            format!("{k}es")
+        } else {
+            format!("{k}s")
+        }
+    };
+    kind.split(" or ")
+        .map(plural)
+        .collect::<Vec<_>>()
+        .join(" or ")
 }
 
 /// A count as an answer opens a sentence with it: "One", ..., "Ten", "12".
@@ -288,7 +323,7 @@ pub fn explain(
                 "softer"
             };
             parts.push(capitalise(&format!(
-                "{} is {rel} than {}.",
+                "{}, is {rel} than {}.",
                 describe(a),
                 describe(b)
             )));
@@ -366,6 +401,17 @@ pub fn explain(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_counted_kind_takes_its_plural() {
+        assert_eq!(counted("banana", 1), "banana");
+        assert_eq!(counted("banana or tomato", 2), "bananas or tomatoes");
+        assert_eq!(counted("citrus fruit", 3), "citrus fruit");
+        assert_eq!(counted("berry", 2), "berries");
+        assert_eq!(counted("peach", 2), "peaches");
+        assert_eq!(counted("avocado", 2), "avocados");
+        assert_eq!(counted("fruit", 0), "fruit");
+    }
     use crate::catalog::FruitCatalog;
     use crate::explain::{location_words, select};
     use crate::hardness::scale::Hardness;

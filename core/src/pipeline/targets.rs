@@ -64,7 +64,8 @@ pub(super) fn ground<C: RgbdCamera>(
         .enumerate()
         .filter_map(|(i, d)| {
             let at = locate(&d.mask, true, &depth, &k, &pose)?;
-            if query.filters.color.is_some() {
+            // The filters choose the fruit asked about, not the one they are held against.
+            if query.filters.color.is_some() && !query.is_reference(&d.label) {
                 let colour = mean_colour(&frames[0].color, &at.mask).map_or("grey", colour_name);
                 if !query.filters.colour_matches(colour) {
                     return None;
@@ -170,6 +171,17 @@ pub(super) fn apply_position(query: &Query, targets: Vec<Target>) -> Vec<Target>
     let Some(filter) = query.filters.position.as_deref() else {
         return targets;
     };
+    // The fruit the others are held against stays wherever it stands.
+    let (references, targets): (Vec<Target>, Vec<Target>) = targets
+        .into_iter()
+        .partition(|t| query.is_reference(&t.label));
+    let mut kept = placed(filter, query, targets);
+    kept.extend(references);
+    kept
+}
+
+/// The targets at the filter's place, or the one furthest that way.
+fn placed(filter: &str, query: &Query, targets: Vec<Target>) -> Vec<Target> {
     let located = |t: &Target| location_words(t.centre.x, t.centre.y);
     let matches = |t: &Target| query.filters.position_matches(&located(t));
     if targets.iter().any(matches) {

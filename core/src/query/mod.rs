@@ -253,11 +253,15 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         }
         if let Some(f) = catalog.find_word(w) {
             // "softer than the apple": the apple is what the others are held against.
-            if !excluding
-                && relation.is_none()
-                && threshold.is_none()
-                && let Some(harder) = threshold::comparison_before(&words, i)
-            {
+            if let Some(harder) = threshold::comparison_before(&words, i) {
+                // "softer than the mango but harder than the banana", "softer than the apple
+                // and harder than 1 MPa": one bound at a time, as for values.
+                if let Some(first) = relation.as_ref().map(|r| format!("the {}", r.reference)) {
+                    return Err(second_bound(&f.name, &first));
+                }
+                if let Some(t) = &threshold {
+                    return Err(second_bound(&f.name, &t.said));
+                }
                 relation = Some(threshold::Relation {
                     harder,
                     reference: f.name.clone(),
@@ -277,6 +281,13 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         }
         if lexicon::OTHER_FRUITS.contains(&w) {
             let name = lexicon::singular(w);
+            // "softer than the pineapple": there is nothing to hold the fruit against.
+            if threshold::comparison_before(&words, i).is_some() {
+                return Err(QueryError::UnknownFruit {
+                    name,
+                    known: catalog.names().join(", "),
+                });
+            }
             if !unknown.contains(&name) {
                 unknown.push(name);
             }
@@ -324,9 +335,12 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             properties.push((pw.property, degree, pw.inverted ^ flipped));
         }
     }
-    // "Is the mango harder than the avocado?" compares two named fruit: the reference is
-    // one of them. A relation stands alone only against the fruit not named.
-    if let Some(r) = relation.take_if(|_| !targets.is_empty()) {
+    // "Is the mango harder than the avocado?" compares two named fruit, the reference one of
+    // them; "Which apple is softer than the lime?" holds the named ones against it.
+    let yes_no = words
+        .first()
+        .is_some_and(|w| matches!(w.as_str(), "is" | "are" | "was" | "does" | "do" | "can"));
+    if let Some(r) = relation.take_if(|_| yes_no && !targets.is_empty()) {
         targets.push(r.reference);
     }
     targets.retain(|t| !exclude.contains(t));
@@ -413,8 +427,10 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     } else {
         Extreme::Most
     });
-    // "the softest fruit harder than 2 MPa": the value narrows, the superlative picks one.
+    // "the softest fruit harder than 2 MPa": the value narrows, the superlative picks one
+    // (unless the fruit past it are ranked, "from hardest to softest").
     if intent == Intent::Threshold
+        && !ranked
         && let Some(&(p, _, low)) = properties.iter().find(|p| p.1 == Degree::Superlative)
     {
         property = p;
@@ -438,6 +454,14 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         threshold,
         relation,
     })
+}
+
+/// A second bound beside a first ("softer than the mango but harder than the banana").
+fn second_bound(name: &str, first: &str) -> QueryError {
+    QueryError::BadThreshold {
+        value: format!("the {name}"),
+        message: format!("a second comparison beside {first}: ask about one at a time"),
+    }
 }
 
 /// Position words in `explain::location_words` order: left/right/centre, then front/back.

@@ -112,10 +112,12 @@ impl Relation {
 /// X", "not harder than X", "less firm than X". Some(true): harder than X.
 pub fn comparison_before(words: &[String], i: usize) -> Option<bool> {
     let mut j = i.checked_sub(1)?;
+    // Articles and what describes the fruit: "than that ripe yellow banana".
     while matches!(
         words[j].as_str(),
-        "the" | "a" | "an" | "that" | "this" | "my" | "your"
-    ) {
+        "the" | "a" | "an" | "that" | "this" | "my" | "your" | "ripe" | "unripe"
+    ) || super::lexicon::COLOURS.contains(&words[j].as_str())
+    {
         j = j.checked_sub(1)?;
     }
     if words[j] != "than" {
@@ -222,9 +224,10 @@ fn direction(words: &[String], i: usize) -> Option<bool> {
     // "more soft", "less soft": the property word after turns the comparison round.
     let soft_next = next.is_some_and(|n| matches!(n, "soft" | "squishy" | "tender"));
     match w {
-        "harder" | "firmer" | "stiffer" | "tougher" | "above" | "over" | "exceeding" | "exceed"
-        | "exceeds" | "greater" | "higher" | "beyond" => Some(true),
-        "softer" | "squishier" | "below" | "under" | "lower" | "beneath" => Some(false),
+        "harder" | "firmer" | "stiffer" | "tougher" | "crunchier" | "above" | "over"
+        | "exceeding" | "exceed" | "exceeds" | "greater" | "higher" | "beyond" => Some(true),
+        "softer" | "squishier" | "mushier" | "squashier" | "tenderer" | "below" | "under"
+        | "lower" | "beneath" => Some(false),
         "more" => Some(!soft_next),
         "less" => Some(soft_next),
         "least" if prev == Some("at") => Some(true),
