@@ -45,6 +45,7 @@ fn describe(q: &Query) -> String {
     let over = match (q.all, q.targets.is_empty()) {
         (true, true) => "every fruit".to_string(),
         (true, false) => format!("{} and every other fruit", q.targets.join(", ")),
+        (false, true) if !q.categories.is_empty() => "the groups below".to_string(),
         (false, _) => q.targets.join(", "),
     };
     s += &format!("objects:  {over}\n");

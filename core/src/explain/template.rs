@@ -223,11 +223,15 @@ fn superlative(property: Property, extreme: Option<Extreme>) -> &'static str {
     }
 }
 
-/// A kind as a count of it reads: "one banana", "two bananas or tomatoes", "three citrus
-/// fruit", "two berries".
+/// A kind as a count of it reads: "one banana", "two bananas", "three citrus fruit", "two
+/// berries"; several kinds together are "fruit".
 fn counted(kind: &str, n: usize) -> String {
     if n == 1 {
         return kind.to_string();
+    }
+    // "Two bananas or tomatoes are ..." reads as a choice: several kinds are fruit.
+    if kind.contains(" or ") {
+        return "fruit".into();
     }
     let plural = |k: &str| -> String {
         if k.ends_with("fruit") {
@@ -405,7 +409,7 @@ mod tests {
     #[test]
     fn a_counted_kind_takes_its_plural() {
         assert_eq!(counted("banana", 1), "banana");
-        assert_eq!(counted("banana or tomato", 2), "bananas or tomatoes");
+        assert_eq!(counted("banana or tomato", 2), "fruit");
         assert_eq!(counted("citrus fruit", 3), "citrus fruit");
         assert_eq!(counted("berry", 2), "berries");
         assert_eq!(counted("peach", 2), "peaches");

@@ -99,6 +99,8 @@ pub enum QueryError {
     TooLong { max: usize },
     #[error("prompt: hardness value '{value}': {message}")]
     BadThreshold { value: String, message: String },
+    #[error("prompt: {what} is not read yet; {instead}")]
+    Unsupported { what: String, instead: String },
 }
 
 pub const MAX_PROMPT_CHARS: usize = 2000;
@@ -184,6 +186,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let mut positions: Vec<&str> = Vec::new();
     let mut excluding = false;
     let mut relation: Option<threshold::Relation> = None;
+    // "riper than the banana": a fruit held against another's ripeness.
+    let mut ripeness_reference: Option<String> = None;
     let mut generic = false;
     // "all", "every", "fruits": a summary; "the fruit on the left", "the yellow one": one.
     let mut generic_plural = false;
@@ -253,6 +257,9 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         }
         if let Some(f) = catalog.find_word(w) {
             // "softer than the apple": the apple is what the others are held against.
+            if threshold::ripeness_comparison_before(&words, i) {
+                ripeness_reference.get_or_insert_with(|| f.name.clone());
+            }
             if let Some(harder) = threshold::comparison_before(&words, i) {
                 // "softer than the mango but harder than the banana", "softer than the apple
                 // and harder than 1 MPa": one bound at a time, as for values.
@@ -342,6 +349,18 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         .is_some_and(|w| matches!(w.as_str(), "is" | "are" | "was" | "does" | "do" | "can"));
     if let Some(r) = relation.take_if(|_| yes_no && !targets.is_empty()) {
         targets.push(r.reference);
+    }
+    // "Is the banana riper than the mango?" compares; "Which fruit is riper than the
+    // banana?" would hold every fruit against one, which is not read yet.
+    if let Some(name) = ripeness_reference
+        && !yes_no
+    {
+        return Err(QueryError::Unsupported {
+            what: format!("ripeness against another fruit (than the {name})"),
+            instead:
+                "ask e.g. \"Which fruit is the ripest?\" or \"Is the mango riper than the banana?\""
+                    .into(),
+        });
     }
     targets.retain(|t| !exclude.contains(t));
     filters.position = position_phrase(&positions);

@@ -108,11 +108,26 @@ impl Relation {
     }
 }
 
-/// Which way the words just before word `i` compare it, when they do: "softer than (the)
-/// X", "not harder than X", "less firm than X". Some(true): harder than X.
-pub fn comparison_before(words: &[String], i: usize) -> Option<bool> {
+/// Whether the words just before word `i` compare ripeness with it: "riper than (the) X",
+/// "less ripe than X", "greener than X".
+pub fn ripeness_comparison_before(words: &[String], i: usize) -> bool {
+    let Some(than) = than_before(words, i) else {
+        return false;
+    };
+    let Some(k) = than.checked_sub(1) else {
+        return false;
+    };
+    match words[k].as_str() {
+        "riper" | "greener" | "readier" => true,
+        "ripe" | "mature" | "green" => k > 0 && matches!(words[k - 1].as_str(), "more" | "less"),
+        _ => false,
+    }
+}
+
+/// The index of "than" just before word `i`, past articles and what describes the fruit
+/// ("than that ripe yellow banana").
+fn than_before(words: &[String], i: usize) -> Option<usize> {
     let mut j = i.checked_sub(1)?;
-    // Articles and what describes the fruit: "than that ripe yellow banana".
     while matches!(
         words[j].as_str(),
         "the" | "a" | "an" | "that" | "this" | "my" | "your" | "ripe" | "unripe"
@@ -120,10 +135,13 @@ pub fn comparison_before(words: &[String], i: usize) -> Option<bool> {
     {
         j = j.checked_sub(1)?;
     }
-    if words[j] != "than" {
-        return None;
-    }
-    let k = j.checked_sub(1)?;
+    (words[j] == "than").then_some(j)
+}
+
+/// Which way the words just before word `i` compare it, when they do: "softer than (the)
+/// X", "not harder than X", "less firm than X". Some(true): harder than X.
+pub fn comparison_before(words: &[String], i: usize) -> Option<bool> {
+    let k = than_before(words, i)?.checked_sub(1)?;
     // "less firm than", "more soft than": a base property word after "more" or "less".
     let before_k = k.checked_sub(1).map(|m| words[m].as_str());
     let (harder, at) = match (before_k, words[k].as_str()) {
