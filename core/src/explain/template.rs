@@ -86,6 +86,12 @@ fn describe(m: &Measured) -> String {
     s
 }
 
+/// A measured fruit in a list of the others: "mango at 59 Shore A (3.43 MPa)".
+fn in_brief(m: &Measured) -> Option<String> {
+    let h = m.hardness.as_ref()?;
+    Some(format!("{} at {}", m.label, describe_hardness(h, None)))
+}
+
 /// The sentences of a threshold's answer: the fruit past the value (or that none is, and
 /// the nearest), the others asked about, and any whose likely range holds the value.
 fn past_threshold(
@@ -156,11 +162,7 @@ fn past_threshold(
                 let rest: Vec<String> = all_past
                     .iter()
                     .filter(|i| !selected.contains(i))
-                    .filter_map(|&i| {
-                        let m = &objects[i];
-                        let h = m.hardness.as_ref()?;
-                        Some(format!("{} at {}", m.label, describe_hardness(h, None)))
-                    })
+                    .filter_map(|&i| in_brief(&objects[i]))
                     .collect();
                 if !rest.is_empty() {
                     parts.push(format!("Also {rel}: {}.", rest.join(", ")));
@@ -186,11 +188,7 @@ fn past_threshold(
         others.sort_by(|&a, &b| past(b).total_cmp(&past(a)));
         let others: Vec<String> = others
             .iter()
-            .filter_map(|&i| {
-                let m = &objects[i];
-                let h = m.hardness.as_ref()?;
-                Some(format!("{} at {}", m.label, describe_hardness(h, None)))
-            })
+            .filter_map(|&i| in_brief(&objects[i]))
             .collect();
         if !others.is_empty() {
             parts.push(format!("Not {rel}: {}.", others.join(", ")));
