@@ -231,21 +231,15 @@ fn counted(kind: &str, n: usize) -> String {
     if kind.contains(" or ") {
         return "fruit".into();
     }
-    let plural = |k: &str| -> String {
-        if k.ends_with("fruit") {
-            k.to_string()
-        } else if let Some(stem) = k.strip_suffix('y') {
-            format!("{stem}ies")
-        } else if k.ends_with("ch") || k.ends_with("tomato") || k.ends_with("mango") {
-            format!("{k}es")
-        } else {
-            format!("{k}s")
-        }
-    };
-    kind.split(" or ")
-        .map(plural)
-        .collect::<Vec<_>>()
-        .join(" or ")
+    if kind.ends_with("fruit") {
+        kind.to_string()
+    } else if let Some(stem) = kind.strip_suffix('y') {
+        format!("{stem}ies")
+    } else if kind.ends_with("ch") || kind.ends_with("tomato") || kind.ends_with("mango") {
+        format!("{kind}es")
+    } else {
+        format!("{kind}s")
+    }
 }
 
 /// A count as an answer opens a sentence with it: "One", ..., "Ten", "12".
@@ -404,16 +398,6 @@ pub fn explain(
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_counted_kind_takes_its_plural() {
-        assert_eq!(counted("banana", 1), "banana");
-        assert_eq!(counted("banana or tomato", 2), "fruit");
-        assert_eq!(counted("citrus fruit", 3), "citrus fruit");
-        assert_eq!(counted("berry", 2), "berries");
-        assert_eq!(counted("peach", 2), "peaches");
-        assert_eq!(counted("avocado", 2), "avocados");
-        assert_eq!(counted("fruit", 0), "fruit");
-    }
     use crate::catalog::FruitCatalog;
     use crate::explain::{location_words, select};
     use crate::hardness::scale::Hardness;
@@ -594,5 +578,16 @@ mod tests {
         lemon.interval_68_mpa = [Some(0.45), Some(0.55)];
         let text = explain(&q, &[lime, lemon], &[0, 1], &[]);
         assert!(!text.contains("uncertainty"), "{text}");
+    }
+
+    #[test]
+    fn a_counted_kind_takes_its_plural() {
+        assert_eq!(counted("banana", 1), "banana");
+        assert_eq!(counted("banana or tomato", 2), "fruit");
+        assert_eq!(counted("citrus fruit", 3), "citrus fruit");
+        assert_eq!(counted("berry", 2), "berries");
+        assert_eq!(counted("peach", 2), "peaches");
+        assert_eq!(counted("avocado", 2), "avocados");
+        assert_eq!(counted("fruit", 0), "fruit");
     }
 }

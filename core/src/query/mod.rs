@@ -256,10 +256,10 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             }
         }
         if let Some(f) = catalog.find_word(w) {
-            // "softer than the apple": the apple is what the others are held against.
             if threshold::ripeness_comparison_before(&words, i) {
                 ripeness_reference.get_or_insert_with(|| f.name.clone());
             }
+            // "softer than the apple": the apple is what the others are held against.
             if let Some(harder) = threshold::comparison_before(&words, i) {
                 // "softer than the mango but harder than the banana", "softer than the apple
                 // and harder than 1 MPa": one bound at a time, as for values.

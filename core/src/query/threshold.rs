@@ -31,7 +31,7 @@ impl Threshold {
 
     /// "harder" or "softer", as the answer words the relation.
     pub fn relation(&self) -> &'static str {
-        if self.harder { "harder" } else { "softer" }
+        relation_word(self.harder)
     }
 
     /// The value on every scale; None for "rigid".
@@ -66,6 +66,11 @@ impl Threshold {
     }
 }
 
+/// The word for a direction against a value or a fruit.
+fn relation_word(harder: bool) -> &'static str {
+    if harder { "harder" } else { "softer" }
+}
+
 /// Another object the question holds the fruit against ("softer than the apple"): its
 /// value is the reference's measured hardness, known once it is pressed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -79,7 +84,7 @@ pub struct Relation {
 impl Relation {
     /// "harder" or "softer", as the answer words the relation.
     pub fn relation(&self) -> &'static str {
-        if self.harder { "harder" } else { "softer" }
+        relation_word(self.harder)
     }
 
     /// The value of the reference's measured moduli (MPa; infinite: rigid) as a threshold:
@@ -400,6 +405,9 @@ fn unit_said(number: &str, unit: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::hardness::scale::shore_a_to_modulus_mpa;
+
     fn words(text: &str) -> Vec<String> {
         text.split(' ').map(str::to_string).collect()
     }
@@ -447,9 +455,6 @@ mod tests {
             "the apple, which is rigid"
         );
     }
-
-    use super::*;
-    use crate::hardness::scale::shore_a_to_modulus_mpa;
 
     fn read(prompt: &str) -> Threshold {
         find(prompt)

@@ -288,8 +288,6 @@ fn fit_without_outliers(points: &[[f64; 2]]) -> Option<Circle> {
     Some((centre, radius, kept))
 }
 
-/// Area of the outline (shoelace). Its points come in ray order, so in angle order about
-/// the last ray origin, about which the outline is star-shaped.
 impl ContactCircle {
     /// The contact region's semi-axes (px, wide then narrow): the ellipse of the outline's
     /// area with the aspect of its second moments (a uniform ellipse of semi-axes a, b has
@@ -322,6 +320,8 @@ impl ContactCircle {
     }
 }
 
+/// Area of the outline (shoelace). Its points come in ray order, so in angle order about
+/// the last ray origin, about which the outline is star-shaped.
 fn polygon_area(points: &[[f64; 2]]) -> f64 {
     let twice: f64 = (0..points.len())
         .map(|i| {

@@ -1,8 +1,8 @@
 //! What one tactile frame says about the gel: its indentation map (slopes read through the
 //! sensor's optics against the no-contact frame, integrated), the imprint's peak depth, the
 //! contact's semi-axes (from the contact circle's outline where the frame shows a round
-//! contact, else from the half-depth region), and whether the imprint lies within the frame. The indentation estimator reads every frame of a press this way; `tactex read`
-//! shows one.
+//! contact, else from the half-depth region), and whether the imprint lies within the frame.
+//! The indentation estimator reads every frame of a press this way; `tactex read` shows one.
 
 use crate::tactile::contact_circle::contact_circle_around;
 use crate::tactile::depth::integrate_slopes;
@@ -80,7 +80,8 @@ pub fn read_frame(
     // The contact's edge is where the gel's slope peaks, which the colour change shows
     // directly (`contact_circle`); the half-depth region where the frame shows no round
     // contact (a first touch of a few pixels, an imprint cut by the frame's edge).
-    // The circle is in the frame's pixels; a fine frame's slopes are read on blocks.
+    // The circle is in the frame's pixels; a fine frame's slopes are read on blocks, so a
+    // frame pixel is this many of the reading's.
     let frame_px = slopes.width as f64 / frame.width() as f64;
     let circle = region_middle(&depth, slopes.width, deep)
         .and_then(|(x, y)| {
