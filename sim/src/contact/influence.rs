@@ -143,16 +143,28 @@ impl UnitLayer {
         static TABLES: Mutex<Vec<(TableKey, Arc<UnitLayer>)>> = Mutex::new(Vec::new());
         let extent = extent.max(1.0).log2().ceil().exp2();
         let key = (poisson.to_bits(), extent.to_bits());
+        let find = |tables: &[(TableKey, Arc<UnitLayer>)]| {
+            tables
+                .iter()
+                .find(|(k, _)| *k == key)
+                .map(|(_, t)| t.clone())
+        };
         // A poisoned lock only means another thread panicked mid-build; the list is intact.
+        if let Some(t) = find(&TABLES.lock().unwrap_or_else(|e| e.into_inner())) {
+            return t;
+        }
+        // Built with the lock released: the build is parallel, and a rayon thread waiting
+        // in it runs other presses' work, which would take the lock again and deadlock.
+        let table = Arc::new(UnitLayer::new(poisson, extent));
         let mut tables = TABLES.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, t)) = tables.iter().find(|(k, _)| *k == key) {
-            return t.clone();
+        // Another thread may have built the same table meanwhile; both are the same bits.
+        if let Some(t) = find(&tables) {
+            return t;
         }
         // Bound the cache for long randomised runs (Poisson's ratio drawn per sample).
         if tables.len() >= 32 {
             tables.clear();
         }
-        let table = Arc::new(UnitLayer::new(poisson, extent));
         tables.push((key, table.clone()));
         table
     }
@@ -241,16 +253,19 @@ impl UnitCells {
         if side > SHARED_UNIT_CELLS {
             return Arc::new(UnitCells::new(side));
         }
+        let covering = |slot: &Option<Arc<UnitCells>>| slot.clone().filter(|t| t.side >= side);
         // A poisoned lock only means another thread panicked mid-build; the slot is intact.
-        let mut table = TABLE.lock().unwrap_or_else(|e| e.into_inner());
-        match table.as_ref() {
-            Some(t) if t.side >= side => t.clone(),
-            _ => {
-                let built = Arc::new(UnitCells::new(side.next_power_of_two().max(64)));
-                *table = Some(built.clone());
-                built
-            }
+        if let Some(t) = covering(&TABLE.lock().unwrap_or_else(|e| e.into_inner())) {
+            return t;
         }
+        // Built with the lock released, for the reason given in `UnitLayer::shared`.
+        let built = Arc::new(UnitCells::new(side.next_power_of_two().max(64)));
+        let mut table = TABLE.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(t) = covering(&table) {
+            return t;
+        }
+        *table = Some(built.clone());
+        built
     }
 }
 
@@ -380,5 +395,35 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn tables_first_built_inside_parallel_work_do_not_deadlock() {
+        // Data generation presses many objects in parallel, each building its tables on
+        // first use; a table built under its cache's lock deadlocked with 16 threads. Each
+        // task here needs a table no other has built (its own Poisson's ratio and extent).
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(8)
+            .build()
+            .unwrap();
+        let (done, finished) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let built: usize = pool.install(|| {
+                (0..24)
+                    .into_par_iter()
+                    .map(|i| {
+                        let nu = 0.3 + 0.001 * f64::from(i);
+                        let layer = LayerCorrection::new(1.0, nu, 1.0);
+                        let cells = half_space_cells(8 + 8 * i as usize, 8, 0.1, nu);
+                        usize::from(layer.at(0.0).0 < 0.0) + usize::from(cells[0].normal > 0.0)
+                    })
+                    .sum()
+            });
+            let _ = done.send(built);
+        });
+        let built = finished
+            .recv_timeout(std::time::Duration::from_secs(120))
+            .expect("the parallel table builds deadlocked");
+        assert_eq!(built, 48);
     }
 }
