@@ -75,6 +75,7 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     let mut categories: Vec<String> = Vec::new();
     let mut threshold = None;
     let mut relation = None;
+    let mut goal: Option<String> = None;
     for pair in extras.split(' ').filter(|p| !p.is_empty()) {
         // A word without '=' continues a two-word position.
         let Some((key, value)) = pair.split_once('=') else {
@@ -100,6 +101,8 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
                 let (dir, name) = value.split_once(':').unwrap();
                 relation = Some((dir == "harder", name.to_string()));
             }
+            // goal=for_a_smoothie: the use as the answer says it back, '_' for spaces.
+            "goal" => goal = Some(value.replace('_', " ")),
             other => panic!("phrasings.tsv: extra {other:?}"),
         }
     }
@@ -154,6 +157,10 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
         .map(|r| (r.harder, r.reference.clone()));
     if got_relation != relation {
         wrong.push(format!("relation {got_relation:?}, expected {relation:?}"));
+    }
+    let got_goal = query.goal.as_ref().map(|g| g.said.clone());
+    if got_goal != goal {
+        wrong.push(format!("goal {got_goal:?}, expected {goal:?}"));
     }
     if query.unknown != unknown {
         wrong.push(format!("unknown {:?}, expected {unknown:?}", query.unknown));

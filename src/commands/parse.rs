@@ -42,6 +42,9 @@ fn describe(q: &Query) -> String {
     if let Some(e) = q.extreme {
         s += &format!("extreme:  {}\n", lower(&e));
     }
+    if let Some(g) = &q.goal {
+        s += &format!("goal:     {}\n", g.said);
+    }
     let over = match (q.all, q.targets.is_empty()) {
         (true, true) => "every fruit".to_string(),
         (true, false) => format!("{} and every other fruit", q.targets.join(", ")),

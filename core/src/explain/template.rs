@@ -221,6 +221,24 @@ fn superlative(property: Property, extreme: Option<Extreme>) -> &'static str {
     }
 }
 
+/// The indefinite article before a kind: "an apple", "a banana".
+fn article(kind: &str) -> &'static str {
+    if kind.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        "an"
+    } else {
+        "a"
+    }
+}
+
+/// A property as a noun: "hardness", "softness", "ripeness".
+fn property_noun(property: Property) -> &'static str {
+    match property {
+        Property::Hardness => "hardness",
+        Property::Softness => "softness",
+        Property::Ripeness => "ripeness",
+    }
+}
+
 /// A kind as a count of it reads: "one banana", "two bananas", "three citrus fruit", "two
 /// berries"; several kinds together are "fruit".
 fn counted(kind: &str, n: usize) -> String {
@@ -287,6 +305,20 @@ pub fn explain(
             which = format!("{which} at the {p}");
         }
         parts.push(format!("I found no {which} to touch on the table."));
+    }
+    // The use the question named, and how it was read: "You asked for a fruit for a
+    // smoothie: I read that as the ripest fruit."
+    if let Some(goal) = &query.goal {
+        let kind = query.asked_kind();
+        let reading = match query.extreme {
+            Some(_) => format!("the {} {kind}", superlative(query.property, query.extreme)),
+            None => format!("the {kind} ordered by {}", property_noun(query.property)),
+        };
+        parts.push(format!(
+            "You asked for {} {kind} {}: I read that as {reading}.",
+            article(&kind),
+            goal.said
+        ));
     }
     match query.intent {
         Intent::Extreme if !selected.is_empty() => {
@@ -379,12 +411,10 @@ pub fn explain(
         }
     }
     for kind in missing {
-        let article = if kind.starts_with(['a', 'e', 'i', 'o', 'u']) {
-            "an"
-        } else {
-            "a"
-        };
-        parts.push(format!("I could not find {article} {kind} on the table."));
+        parts.push(format!(
+            "I could not find {} {kind} on the table.",
+            article(kind)
+        ));
     }
     for name in &query.unknown {
         parts.push(format!(
@@ -541,6 +571,27 @@ mod tests {
         let text = explain(&q, &[], &[], &["orange".into()]);
         assert!(
             text.contains("I could not find an orange on the table."),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_use_is_said_back_with_the_property_it_was_read_as() {
+        let c = FruitCatalog::builtin();
+        let objs = [m("banana", 0.8, -0.15, -0.1), m("avocado", 5.0, 0.1, 0.1)];
+        let q = crate::query::parse("What should I keep for next week?", &c).unwrap();
+        let text = explain(&q, &objs, &select(&q, &objs, &c), &[]);
+        assert!(
+            text.starts_with(
+                "You asked for a fruit to keep for next week: I read that as the least ripe \
+                 fruit. The least ripe fruit is the avocado"
+            ),
+            "{text}"
+        );
+        let q = crate::query::parse("Which banana is best for a smoothie?", &c).unwrap();
+        let text = explain(&q, &objs, &select(&q, &objs, &c), &[]);
+        assert!(
+            text.starts_with("You asked for a banana for a smoothie: I read that as the ripest"),
             "{text}"
         );
     }

@@ -1,5 +1,6 @@
 //! Prompt -> `Query`: rule-based, offline. Says clearly when a prompt cannot be grounded.
 
+pub mod goal;
 pub mod lexicon;
 pub mod threshold;
 
@@ -85,6 +86,10 @@ pub struct Query {
     /// `Intent::Threshold`: its value is its measured hardness.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub relation: Option<threshold::Relation>,
+    /// What the fruit is wanted for ("for a smoothie"), when no property is named: it sets
+    /// the property and end asked for, and the answer says it back.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub goal: Option<goal::Goal>,
 }
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -342,6 +347,12 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             properties.push((pw.property, degree, pw.inverted ^ flipped));
         }
     }
+    // "Which fruit for a smoothie?": the use names the property when no word does, and is
+    // read as its superlative ("the ripest").
+    let goal = properties.is_empty().then(|| goal::find(&words)).flatten();
+    if let Some(g) = &goal {
+        properties.push((g.property, Degree::Superlative, g.low));
+    }
     // "Is the mango harder than the avocado?" compares two named fruit, the reference one of
     // them; "Which apple is softer than the lime?" holds the named ones against it.
     let yes_no = words
@@ -367,12 +378,13 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
 
     let known = || catalog.names().join(", ");
     let filtered = filters.color.is_some() || filters.position.is_some();
-    // "Is anything harder than 2 MPa?": a value with nothing named is about every fruit.
+    // "Is anything harder than 2 MPa?", "What should I keep for next week?": a value or a
+    // use with nothing named is about every fruit.
     let all = generic
         || !exclude.is_empty()
         || (targets.is_empty()
             && (filtered
-                || ((threshold.is_some() || relation.is_some())
+                || ((threshold.is_some() || relation.is_some() || goal.is_some())
                     && categories.is_empty()
                     && unknown.is_empty())));
     if targets.is_empty() && categories.is_empty() && !all {
@@ -472,6 +484,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         unknown,
         threshold,
         relation,
+        goal,
     })
 }
 
@@ -936,6 +949,38 @@ mod tests {
             (query.targets.clone(), query.unknown.clone()),
             (names(&["kiwi"]), names(&["grape"]))
         );
+    }
+
+    #[test]
+    fn a_use_names_the_property_when_no_word_does() {
+        let smoothie = q("Which fruit would you recommend for a smoothie today?");
+        assert_eq!(smoothie.intent, Intent::Extreme);
+        assert_eq!(
+            (smoothie.property, smoothie.extreme),
+            (Property::Ripeness, Some(Extreme::Most))
+        );
+        assert!(smoothie.all);
+        assert_eq!(smoothie.goal.unwrap().said, "for a smoothie");
+        // Nothing named: every fruit, as for a value.
+        let keep = q("What should I keep for next week?");
+        assert!(keep.all);
+        assert_eq!(
+            (keep.property, keep.extreme),
+            (Property::Ripeness, Some(Extreme::Least))
+        );
+        let slicing = q("Which apple is best for slicing?");
+        assert_eq!(slicing.targets, names(&["apple"]));
+        assert_eq!(
+            (slicing.property, slicing.extreme),
+            (Property::Hardness, Some(Extreme::Most))
+        );
+        let ranked = q("Rank the fruits for a smoothie");
+        assert_eq!((ranked.intent, ranked.ranked), (Intent::Summarize, true));
+        assert_eq!(ranked.property, Property::Ripeness);
+        // A property the prompt names is what it asks; the use is only context.
+        let said = q("Which is the softest fruit for a smoothie?");
+        assert_eq!(said.property, Property::Softness);
+        assert_eq!(said.goal, None);
     }
 
     #[test]
