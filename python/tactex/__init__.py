@@ -395,6 +395,7 @@ def ask(
     device: Optional[str] = None,
     sensor: Optional[PathLike] = None,
     explainer: Optional[str] = None,
+    parser: Optional[str] = None,
     llm_config: Optional[PathLike] = None,
     gel_modulus_mpa: Optional[float] = None,
     reproducible: bool = True,
@@ -403,7 +404,8 @@ def ask(
     built-in demo) and returns the object ``tactex ask --json`` prints: the query, every
     object touched with position, hardness, interval and ripeness, the answer text, timings.
     With ``reproducible`` (the default) wall-clock times are left out, so that the same
-    arguments give the same result, equal to ``ask --json --reproducible``.
+    arguments give the same result, equal to ``ask --json --reproducible``. ``parser="llm"``
+    has the endpoint ``explainer="llm"`` uses read the question (``tactex ask --parser``).
     """
     argv = _flags(
         scene=scene,
@@ -415,6 +417,7 @@ def ask(
         device=device,
         sensor=sensor,
         explainer=explainer,
+        parser=parser,
         llm_config=llm_config,
         gel_modulus_mpa=gel_modulus_mpa,
         reproducible=reproducible,

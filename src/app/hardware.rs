@@ -11,11 +11,10 @@ use tactex_hw::devices_toml::DevicesConfig;
 #[cfg(all(target_os = "linux", feature = "v4l2"))]
 use {
     crate::app::detector_choice::DetectorChoice,
-    crate::app::explainer_choice::explainer,
     crate::app::question::{Question, Recording},
     crate::app::replay::detector_without_truth,
     tactex_core::catalog::FruitCatalog,
-    tactex_core::pipeline::Devices,
+    tactex_core::pipeline::{Devices, Language},
     tactex_sim::contact::Fidelity,
 };
 
@@ -34,7 +33,7 @@ pub fn answer_on_hardware(
     let sensor = hardware_sensor(twin.sensor.as_deref())?;
     let choice = DetectorChoice::parse(&twin.detector)?;
     let detector = detector_without_truth(&choice, &catalog)?;
-    let explainer = explainer(twin.explainer, twin.llm_config.as_ref())?;
+    let (parser, explainer) = twin.language()?;
     // The twin's most faithful physics stands in for the real gel's.
     let estimator = twin.estimator.open(
         "--estimator",
@@ -52,7 +51,10 @@ pub fn answer_on_hardware(
         catalog: &catalog,
         detector: detector.as_ref(),
         estimator: estimator.as_ref(),
-        explainer: explainer.as_ref(),
+        language: Language {
+            reader: parser.as_ref(),
+            explainer: explainer.as_ref(),
+        },
         config,
         fidelity: None,
         sensor: Some(sensor.id()),

@@ -12,6 +12,8 @@ pub mod file_input;
 pub mod flag_range;
 pub mod hardware;
 pub mod image_input;
+pub mod llm_chat;
+pub mod parser_choice;
 pub mod question;
 pub mod replay;
 pub mod sample_space;

@@ -4,10 +4,9 @@ use anyhow::{Context, Result};
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::{Arm, RgbdCamera, TactileSensor};
-use tactex_core::explain::Explainer;
 use tactex_core::ground::detect::Detector;
 use tactex_core::hardness::estimate::HardnessEstimator;
-use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig};
+use tactex_core::pipeline::{self, Answer, Devices, Language, PipelineConfig};
 use tactex_hw::session::{SessionRecorder, TwinRecord};
 use tactex_sim::contact::Fidelity;
 
@@ -25,7 +24,7 @@ pub struct Question<'q> {
     pub catalog: &'q FruitCatalog,
     pub detector: &'q dyn Detector,
     pub estimator: &'q dyn HardnessEstimator,
-    pub explainer: &'q dyn Explainer,
+    pub language: Language<'q>,
     pub config: &'q PipelineConfig,
     /// The sim GelSight's contact physics, when the devices are the twin's.
     pub fidelity: Option<Fidelity>,
@@ -71,7 +70,7 @@ impl Question<'_> {
             devices,
             self.detector,
             self.estimator,
-            self.explainer,
+            self.language,
             self.config,
         )?;
         answer.fidelity = self.fidelity.map(|f| f.name().into());

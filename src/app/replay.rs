@@ -18,7 +18,7 @@ pub fn answer_on_replay(
     prompt: &str,
     config: &PipelineConfig,
 ) -> Result<Answer> {
-    let (choice, explainer) = (&opened.detector, opened.explainer.as_ref());
+    let choice = &opened.detector;
     let catalog = FruitCatalog::builtin();
     let (manifest, mut camera, mut tactile, mut arm) = open_session(dir).context("--session")?;
     let detector = detector_without_truth(choice, &catalog)?;
@@ -27,7 +27,7 @@ pub fn answer_on_replay(
         catalog: &catalog,
         detector: detector.as_ref(),
         estimator: opened.estimator.as_ref(),
-        explainer,
+        language: opened.language(),
         config,
         fidelity: None,
         sensor: None,

@@ -8,11 +8,10 @@ use std::path::Path;
 use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
-use tactex_core::explain::Explainer;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::ground::detect::Detector;
 use tactex_core::hardness::estimate::HardnessEstimator;
-use tactex_core::pipeline::{self, Answer, Devices, PipelineConfig, Progress};
+use tactex_core::pipeline::{self, Answer, Devices, Language, PipelineConfig, Progress};
 use tactex_core::scene::Scene;
 use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_hw::session::TwinRecord;
@@ -45,7 +44,7 @@ pub struct Twin<'a> {
     pub sensor: &'a SensorProfile,
     pub detector: &'a DetectorChoice,
     pub renderer: &'a Arc<dyn SceneRenderer>,
-    pub explainer: &'a dyn Explainer,
+    pub language: Language<'a>,
     pub estimator: &'a dyn HardnessEstimator,
     /// Contact physics of the sim GelSight.
     pub fidelity: Fidelity,
@@ -110,7 +109,7 @@ impl<'a> Twin<'a> {
             },
             detector.as_ref(),
             self.estimator,
-            self.explainer,
+            self.language,
             config,
             on_progress,
         )?;
@@ -146,7 +145,7 @@ impl<'a> Twin<'a> {
             catalog: &catalog,
             detector: prepared.detector.as_ref(),
             estimator: self.estimator,
-            explainer: self.explainer,
+            language: self.language,
             config,
             fidelity: Some(self.fidelity),
             sensor: Some(self.sensor.id()),

@@ -5,14 +5,17 @@
 use crate::app::detector_choice::DetectorChoice;
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::app::explainer_choice::{ExplainerChoice, explainer};
+use crate::app::parser_choice::{ParserChoice, PromptParser};
 use crate::app::scene::scene_renderer;
 use crate::app::sensor::load_sensor;
-use anyhow::Result;
+use anyhow::{Result, bail};
 use clap::Args;
 use std::path::PathBuf;
 use std::sync::Arc;
 use tactex_core::explain::Explainer;
 use tactex_core::hardness::estimate::HardnessEstimator;
+use tactex_core::pipeline::Language;
+use tactex_core::query::reader::PromptReader;
 use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_sim::contact::Fidelity;
 use tactex_sim::render::device::DeviceChoice;
@@ -37,7 +40,13 @@ pub struct TwinOptions {
     /// template with a notice).
     #[arg(long, value_enum, default_value = "template")]
     pub explainer: ExplainerChoice,
-    /// TOML with base_url, model, api_key_env and timeout_s for --explainer llm.
+    /// Who reads the question: rules (offline) or llm (the endpoint --explainer llm uses;
+    /// its reading must check out against the catalog, else the rules read it, with a
+    /// notice).
+    #[arg(long, value_enum, default_value = "rules")]
+    pub parser: ParserChoice,
+    /// TOML with base_url, model, api_key_env and timeout_s for --explainer llm and
+    /// --parser llm.
     #[arg(long)]
     pub llm_config: Option<PathBuf>,
     /// Contact physics of the sim GelSight: rigid, hertz, halfspace or layer (the bonded
@@ -68,13 +77,45 @@ pub const DEFAULT_ESTIMATOR: &str = "indentation";
 pub struct OpenedTwin {
     pub detector: DetectorChoice,
     pub renderer: Arc<dyn SceneRenderer>,
+    pub parser: Box<dyn PromptReader>,
     pub explainer: Box<dyn Explainer>,
     pub estimator: Box<dyn HardnessEstimator + Send + Sync>,
     pub fidelity: Fidelity,
     pub sensor: SensorProfile,
 }
 
+impl OpenedTwin {
+    pub fn language(&self) -> Language<'_> {
+        Language {
+            reader: self.parser.as_ref(),
+            explainer: self.explainer.as_ref(),
+        }
+    }
+}
+
 impl TwinOptions {
+    /// The prompt's reader and the answer's writer, one LLM configuration shared by both.
+    pub fn language(&self) -> Result<(Box<dyn PromptReader>, Box<dyn Explainer>)> {
+        let uses_llm = self.parser == ParserChoice::Llm || self.explainer == ExplainerChoice::Llm;
+        if let (Some(path), false) = (&self.llm_config, uses_llm) {
+            bail!(
+                "--llm-config {}: read only by --explainer llm or --parser llm",
+                path.display()
+            );
+        }
+        let config_for = |llm: bool| self.llm_config.as_ref().filter(|_| llm);
+        Ok((
+            Box::new(PromptParser::new(
+                self.parser,
+                config_for(self.parser == ParserChoice::Llm),
+            )?),
+            explainer(
+                self.explainer,
+                config_for(self.explainer == ExplainerChoice::Llm),
+            )?,
+        ))
+    }
+
     pub fn open(&self) -> Result<OpenedTwin> {
         let sensor = load_sensor(self.sensor.as_deref())?;
         let estimator = self.estimator.open(
@@ -91,10 +132,12 @@ impl TwinOptions {
         {
             eprintln!("{note}");
         }
+        let (parser, explainer) = self.language()?;
         Ok(OpenedTwin {
             detector: DetectorChoice::parse(&self.detector)?,
             renderer: scene_renderer(self.device)?,
-            explainer: explainer(self.explainer, self.llm_config.as_ref())?,
+            parser,
+            explainer,
             estimator,
             fidelity: self.fidelity,
             sensor,

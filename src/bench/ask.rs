@@ -16,8 +16,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::Arc;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::explain::TemplateExplainer;
-use tactex_core::pipeline::PipelineConfig;
+use tactex_core::pipeline::{Language, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_sim::contact::Fidelity;
 use tactex_sim::render::scene::{CpuSceneRenderer, SceneRenderer};
@@ -118,7 +117,7 @@ pub fn run(args: &AskBenchArgs) -> Result<()> {
             sensor: &sensor,
             detector: &detector,
             renderer: &renderer,
-            explainer: &TemplateExplainer,
+            language: Language::OFFLINE,
             estimator: estimator.as_ref(),
             fidelity,
         };

@@ -1,6 +1,7 @@
 //! `tactex ask`: one question answered on the twin, the real devices or a recorded session.
 
 use crate::app::hardware::answer_on_hardware;
+use crate::app::parser_choice::ParserChoice;
 use crate::app::replay::answer_on_replay;
 use crate::app::scene::{default_scene, load_scene};
 use crate::app::sensor::with_gel_modulus;
@@ -62,8 +63,11 @@ pub enum Backend {
 /// The answer `tactex ask` prints, as a value (the Python package's `ask` returns it).
 pub fn answer(args: &AskArgs) -> Result<Answer> {
     let catalog = FruitCatalog::builtin();
-    // The prompt is checked before any device is opened so that a bad question fails fast.
-    tactex_core::query::parse(&args.prompt, &catalog)?;
+    // The prompt is checked before any device is opened so that a bad question fails fast
+    // (a model may read what the rules refuse: with --parser llm it is read in the pipeline).
+    if args.twin.parser == ParserChoice::Rules {
+        tactex_core::query::parse(&args.prompt, &catalog)?;
+    }
     let config = PipelineConfig {
         measure_wall_time: !args.reproducible,
         ..PipelineConfig::default()
@@ -111,7 +115,7 @@ pub fn answer(args: &AskArgs) -> Result<Answer> {
                 sensor: &sensor,
                 detector: &opened.detector,
                 renderer: &opened.renderer,
-                explainer: opened.explainer.as_ref(),
+                language: opened.language(),
                 estimator: opened.estimator.as_ref(),
                 fidelity: opened.fidelity,
             };
@@ -138,7 +142,7 @@ pub fn run(args: &AskArgs) -> Result<()> {
 }
 
 fn print_answer(a: &Answer) {
-    if let Some(notice) = &a.explain_notice {
+    for notice in [&a.parse_notice, &a.explain_notice].into_iter().flatten() {
         eprintln!("note: {notice}");
     }
     // An LLM's answer is outside text: its lines kept, any control characters shown.

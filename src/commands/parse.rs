@@ -1,9 +1,12 @@
 //! `tactex parse`: what the prompt parser reads from a question, as text or JSON.
 
-use anyhow::{Context, Result};
+use crate::app::parser_choice::{ParserChoice, PromptParser};
+use anyhow::{Context, Result, bail};
 use clap::Args;
+use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::query::{self, Query};
+use tactex_core::query::Query;
+use tactex_core::query::reader::PromptReader;
 
 #[derive(Args)]
 pub struct ParseArgs {
@@ -12,18 +15,35 @@ pub struct ParseArgs {
     /// Print the parsed query as one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// Who reads the question: rules (offline) or llm (an OpenAI-compatible endpoint from
+    /// TACTEX_LLM_* or --llm-config; a reading that does not check out falls back to the
+    /// rules with a notice).
+    #[arg(long, value_enum, default_value = "rules")]
+    pub parser: ParserChoice,
+    /// TOML with base_url, model, api_key_env and timeout_s for --parser llm.
+    #[arg(long)]
+    pub llm_config: Option<PathBuf>,
 }
 
 pub fn run(args: &ParseArgs) -> Result<()> {
     let catalog = FruitCatalog::builtin();
-    let query = query::parse(&args.prompt, &catalog)?;
+    if let (Some(path), ParserChoice::Rules) = (&args.llm_config, args.parser) {
+        bail!("--llm-config {}: read only by --parser llm", path.display());
+    }
+    let parser = PromptParser::new(args.parser, args.llm_config.as_ref())?;
+    let read = parser.read(&args.prompt, &catalog);
+    if let Some(notice) = &read.notice {
+        eprintln!("note: {notice}");
+    }
+    let query = read.query?;
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&query).context("serialising the query")?
-        );
+        // The query's fields, and who read it ("rules" or "llm:<model>").
+        let mut json = serde_json::to_value(&query).context("serialising the query")?;
+        json["parser"] = read.parser.clone().into();
+        println!("{}", serde_json::to_string_pretty(&json)?);
     } else {
         print!("{}", describe(&query));
+        println!("parser:   {}", read.parser);
     }
     Ok(())
 }

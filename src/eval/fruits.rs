@@ -29,13 +29,12 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::{FruitCatalog, FruitSpec};
-use tactex_core::explain::TemplateExplainer;
 use tactex_core::hardness::estimate::Evidence;
 use tactex_core::hardness::interval_calibration::{
     HeldOutPress, IntervalCalibration, is_elongated,
 };
 use tactex_core::hardness::scale::Hardness;
-use tactex_core::pipeline::PipelineConfig;
+use tactex_core::pipeline::{Language, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_sim::contact::Fidelity;
@@ -583,7 +582,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
                 sensor: &sensor,
                 detector: &detector,
                 renderer: &renderer,
-                explainer: &TemplateExplainer,
+                language: Language::OFFLINE,
                 estimator: estimator.as_ref(),
                 fidelity: args.fidelity,
             }

@@ -33,8 +33,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::explain::TemplateExplainer;
-use tactex_core::pipeline::PipelineConfig;
+use tactex_core::pipeline::{Language, PipelineConfig};
 use tactex_core::scene::Scene;
 use tactex_sim::contact::Fidelity;
 use tactex_sim::datagen::scene_random::{Variation, random_scene};
@@ -569,7 +568,7 @@ pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
                 sensor: &sensor,
                 detector: &detectors[d],
                 renderer: &renderer,
-                explainer: &TemplateExplainer,
+                language: Language::OFFLINE,
                 estimator: estimator.as_ref(),
                 fidelity: args.fidelity,
             }
@@ -697,6 +696,8 @@ mod tests {
                 sensor: None,
                 explainer: "template".into(),
                 explain_notice: None,
+                parser: "rules".into(),
+                parse_notice: None,
                 timing: Vec::new(),
                 presses: Vec::new(),
             },

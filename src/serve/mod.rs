@@ -6,6 +6,7 @@
 mod queries;
 
 use crate::app::detector_choice::DetectorChoice;
+use crate::app::parser_choice::ParserChoice;
 use crate::app::{OpenedTwin, Twin, TwinOptions};
 use anyhow::{Context, Result};
 use axum::Router;
@@ -27,7 +28,8 @@ use tactex_core::catalog::FruitCatalog;
 use tactex_core::devices::RgbdCamera;
 use tactex_core::explain::Explainer;
 use tactex_core::hardness::estimate::HardnessEstimator;
-use tactex_core::pipeline::PipelineConfig;
+use tactex_core::pipeline::{Language, PipelineConfig};
+use tactex_core::query::reader::PromptReader;
 use tactex_core::scene::Scene;
 use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_sim::SimDevices;
@@ -68,6 +70,9 @@ struct Served {
     detector_name: String,
     detector: DetectorChoice,
     renderer: Arc<dyn SceneRenderer>,
+    parser: Box<dyn PromptReader>,
+    /// The rules read the prompts (no model): a prompt they refuse is refused at once.
+    rules_read: bool,
     explainer: Box<dyn Explainer>,
     estimator: Box<dyn HardnessEstimator + Send + Sync>,
     fidelity: Fidelity,
@@ -99,6 +104,7 @@ pub fn run(args: &ServeArgs) -> Result<()> {
     let OpenedTwin {
         detector,
         renderer,
+        parser,
         explainer,
         estimator,
         fidelity,
@@ -112,6 +118,8 @@ pub fn run(args: &ServeArgs) -> Result<()> {
         detector_name: args.twin.detector.clone(),
         detector,
         renderer,
+        parser,
+        rules_read: args.twin.parser == ParserChoice::Rules,
         explainer,
         estimator,
         fidelity,
@@ -337,7 +345,9 @@ async fn ask(
             ),
         );
     }
-    if let Err(e) = tactex_core::query::parse(&prompt, &FruitCatalog::builtin()) {
+    if s.rules_read
+        && let Err(e) = tactex_core::query::parse(&prompt, &FruitCatalog::builtin())
+    {
         // The parser's errors already name the prompt.
         return error(StatusCode::UNPROCESSABLE_ENTITY, &e.to_string());
     }
@@ -380,7 +390,10 @@ fn answer_question(s: &Served, run: &QueryRun, prompt: &str) {
         sensor: &s.sensor,
         detector: &s.detector,
         renderer: &s.renderer,
-        explainer: s.explainer.as_ref(),
+        language: Language {
+            reader: s.parser.as_ref(),
+            explainer: s.explainer.as_ref(),
+        },
         estimator: s.estimator.as_ref(),
         fidelity: s.fidelity,
     };

@@ -710,6 +710,95 @@ fn the_llm_explainer_without_an_endpoint_is_a_one_line_error() {
     assert!(err.contains("TACTEX_LLM_BASE_URL"), "{err}");
 }
 
+/// `tactex ARGS` with the LLM variables pointing at `url`: (exit code, stdout, stderr).
+fn with_llm(url: &str, args: &[&str]) -> (Option<i32>, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_tactex"))
+        .args(args)
+        .env("TACTEX_LLM_BASE_URL", url)
+        .env("TACTEX_LLM_MODEL", "fake")
+        .env("TACTEX_LLM_TIMEOUT_S", "2")
+        .env_remove("TACTEX_LLM_API_KEY")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("runs tactex");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn the_llm_parser_reads_what_the_rules_cannot_and_falls_back_when_it_fails() {
+    // The rules find nothing to ask about here; the model reads "the softest of every fruit".
+    let prompt = "Which would squash first if I sat on it?";
+    let (code, _, err) = with_llm("http://127.0.0.1:9/v1", &["parse", prompt]);
+    assert_eq!(code, Some(1), "{err}");
+    let url = fake_llm(|_| {
+        r#"{"intent": "extreme", "property": "softness", "extreme": "most", "all": true}"#.into()
+    });
+    let (code, out, err) = with_llm(&url, &["parse", "--json", "--parser", "llm", prompt]);
+    assert_eq!(code, Some(0), "{err}");
+    let q: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        (q["intent"].as_str(), q["all"].as_bool()),
+        (Some("extreme"), Some(true))
+    );
+    assert_eq!(q["parser"], "llm:fake");
+    // The whole question on the twin, read by the model.
+    let (code, out, err) = with_llm(
+        &url,
+        &[
+            "ask",
+            "--json",
+            "--reproducible",
+            "--parser",
+            "llm",
+            "--scene",
+            "tests/scenes/one.toml",
+            prompt,
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let a: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(a["parser"], "llm:fake");
+    assert_eq!(a["parse_notice"], Value::Null);
+    assert_eq!(a["selected"].as_array().map(Vec::len), Some(1));
+
+    // A model that writes prose, one that names a fruit the catalog lacks, and no server at
+    // all: the rules read the question, and a note says why.
+    let prose = fake_llm(|_| "The banana, surely.".into());
+    let outside = fake_llm(|_| {
+        r#"{"intent": "identify", "property": "hardness", "targets": ["durian"]}"#.into()
+    });
+    for (url, cause) in [
+        (prose.as_str(), "no JSON object in the reply"),
+        (outside.as_str(), "'durian' is not in the fruit catalog"),
+        ("http://127.0.0.1:9/v1", "127.0.0.1:9"),
+    ] {
+        let (code, out, err) = with_llm(
+            url,
+            &["parse", "--parser", "llm", "How hard is the banana?"],
+        );
+        assert_eq!(code, Some(0), "{err}");
+        assert!(out.contains("parser:   rules"), "{out}");
+        assert!(out.contains("objects:  banana"), "{out}");
+        assert!(err.starts_with("note: ") && err.contains(cause), "{err}");
+        assert!(err.trim_end().ends_with("read by the rules"), "{err}");
+    }
+    // Falling back to rules that refuse too: the rules' one-line error, after the note.
+    let (code, _, err) = with_llm(&prose, &["parse", "--parser", "llm", prompt]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("names no known fruit"), "{err}");
+    // --llm-config with no one to read it is refused.
+    let (code, _, err) = with_llm(&prose, &["parse", "--llm-config", "llm.toml", prompt]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--llm-config llm.toml: read only by --parser llm"),
+        "{err}"
+    );
+}
+
 #[test]
 fn a_prompt_with_terminal_escape_codes_is_shown_escaped_not_acted_on() {
     let err = fails(&["ask", "hello \u{1b}[2J\u{1b}]0;pwned\u{7} there"]);

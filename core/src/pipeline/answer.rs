@@ -141,6 +141,10 @@ pub struct Answer {
     pub explainer: String,
     /// Why a model's reply was not used, when the template stood in for it.
     pub explain_notice: Option<String>,
+    /// "rules", or "llm:<model>" when a model's reading of the prompt is the query.
+    pub parser: String,
+    /// Why a model's reading was not used, when the rules stood in for it.
+    pub parse_notice: Option<String>,
     pub timing: Vec<StageTiming>,
     /// Each object's press (no-contact reference and press frames), in `objects`' order;
     /// None where no contact was found. Left out of the JSON: images belong in image files.

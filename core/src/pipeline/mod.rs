@@ -26,10 +26,25 @@ use crate::hardness::estimate::{
     EstimateError, HardnessEstimate, HardnessEstimator, PressSequence,
 };
 use crate::press::site::PadClearance;
-use crate::query::{self};
+use crate::query::reader::PromptReader;
 use arm_press::{PressTaken, press};
 use std::time::Instant;
 use targets::ground;
+
+/// Who reads the question and who writes the answer.
+#[derive(Clone, Copy)]
+pub struct Language<'a> {
+    pub reader: &'a dyn PromptReader,
+    pub explainer: &'a dyn Explainer,
+}
+
+impl Language<'static> {
+    /// The rules read, the template writes: offline and deterministic (evaluations, benches).
+    pub const OFFLINE: Self = Self {
+        reader: &crate::query::reader::RuleReader,
+        explainer: &crate::explain::TemplateExplainer,
+    };
+}
 
 /// The devices one question runs on.
 pub struct Devices<'a, C: RgbdCamera, T: TactileSensor, A: Arm> {
@@ -47,7 +62,7 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
     devices: Devices<'_, C, T, A>,
     detector: &dyn Detector,
     estimator: &dyn HardnessEstimator,
-    explainer: &dyn Explainer,
+    language: Language<'_>,
     config: &PipelineConfig,
 ) -> Result<Answer, PipelineError> {
     answer_with_progress(
@@ -56,7 +71,7 @@ pub fn answer<C: RgbdCamera, T: TactileSensor, A: Arm>(
         devices,
         detector,
         estimator,
-        explainer,
+        language,
         config,
         &|_| {},
     )
@@ -70,10 +85,11 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
     devices: Devices<'_, C, T, A>,
     detector: &dyn Detector,
     estimator: &dyn HardnessEstimator,
-    explainer: &dyn Explainer,
+    language: Language<'_>,
     config: &PipelineConfig,
     on_progress: &dyn Fn(Progress),
 ) -> Result<Answer, PipelineError> {
+    let Language { reader, explainer } = language;
     let Devices {
         camera,
         tactile,
@@ -99,7 +115,8 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
     };
 
     let t = start("parse", arm);
-    let query = query::parse(prompt, catalog)?;
+    let read = reader.read(prompt, catalog);
+    let query = read.query?;
     lap("parse", arm, t);
 
     let t = start("ground", arm);
@@ -297,6 +314,8 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
         sensor: None,
         explainer: explanation.explainer,
         explain_notice: explanation.notice,
+        parser: read.parser,
+        parse_notice: read.notice,
         timing,
         presses: sequences,
     })

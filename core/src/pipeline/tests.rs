@@ -52,7 +52,7 @@ fn ask_with(
         },
         &OneApple,
         estimator,
-        &explain::TemplateExplainer,
+        Language::OFFLINE,
         &PipelineConfig::default(),
     )
 }

@@ -1,14 +1,17 @@
 //! Prompt -> `Query`: rule-based, offline. Says clearly when a prompt cannot be grounded.
 
+pub mod draft;
 pub mod goal;
 pub mod lexicon;
+pub mod llm_prompt;
+pub mod reader;
 pub mod threshold;
 
 use crate::catalog::FruitCatalog;
 use lexicon::Degree;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Intent {
     /// The property of named objects ("Identify the hardness of the lemon").
@@ -23,7 +26,7 @@ pub enum Intent {
     Threshold,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Property {
     Hardness,
@@ -31,7 +34,7 @@ pub enum Property {
     Ripeness,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Extreme {
     Most,
@@ -497,7 +500,7 @@ fn second_bound(name: &str, first: &str) -> QueryError {
 }
 
 /// Position words in `explain::location_words` order: left/right/centre, then front/back.
-fn position_phrase(positions: &[&str]) -> Option<String> {
+pub(crate) fn position_phrase(positions: &[&str]) -> Option<String> {
     let lr = positions
         .iter()
         .find(|p| matches!(**p, "left" | "right"))

@@ -67,7 +67,7 @@ impl Threshold {
 }
 
 /// The word for a direction against a value or a fruit.
-fn relation_word(harder: bool) -> &'static str {
+pub(crate) fn relation_word(harder: bool) -> &'static str {
     if harder { "harder" } else { "softer" }
 }
 
