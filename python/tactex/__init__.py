@@ -543,7 +543,8 @@ def read(
     against the no-contact ``reference`` (default the profile's background) through the
     profile's optics, as the estimators read every frame of a press. Returns what ``read
     --json`` prints (``peak_depth_mm``, ``contact_radius_mm``, ``contact_axes_mm``,
-    ``within_frame``, ``readable_share``, the sensor's id) and ``indentation_mm``, the gel's
+    ``contact_edge`` ("outline" or "half_depth"), ``within_frame``, ``readable_share``, the
+    sensor's id) and ``indentation_mm``, the gel's
     indentation map (H x W float32, mm into the gel). ``out`` writes the frame beside the map
     as a PNG."""
     argv = _flags(reference=reference, sensor=sensor, out=out) + ["--", os.fspath(image)]

@@ -46,8 +46,12 @@ pub struct ReadReport {
     pub imprint: bool,
     /// The imprint's depth into the gel (mean of the 20 deepest pixels).
     pub peak_depth_mm: f64,
-    /// The contact's semi-axes, wide then narrow (mm), from the half-depth region.
+    /// The contact's semi-axes, wide then narrow (mm), from the edge `contact_edge` names.
     pub contact_axes_mm: Option<[f64; 2]>,
+    /// Where the contact's size was taken: "outline" (the round outline where the gel's
+    /// slope peaks) or "half_depth" (the region deeper than half the peak, where the frame
+    /// shows no round outline: a first touch, an imprint cut by the frame).
+    pub contact_edge: Option<&'static str>,
     /// The radius of the circle of the contact's area (the semi-axes' geometric mean).
     pub contact_radius_mm: Option<f64>,
     /// Whether the imprint lies within the frame (else its depth reads short).
@@ -129,6 +133,10 @@ pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImag
         imprint,
         peak_depth_mm: reading.peak_mm.max(0.0),
         contact_axes_mm: imprint.then_some(reading.contact_axes_mm),
+        contact_edge: imprint.then_some(match reading.contact_outline_px {
+            Some(_) => "outline",
+            None => "half_depth",
+        }),
         contact_radius_mm: imprint.then(|| reading.contact_radius_mm()),
         within_frame: imprint.then_some(reading.within_frame),
         readable_share: readable as f64 / reading.valid.len() as f64,
@@ -167,8 +175,12 @@ pub fn run(args: &ReadArgs) -> Result<()> {
         );
         return Ok(());
     };
+    let edge = match report.contact_edge {
+        Some("outline") => "the outline where the slope peaks",
+        _ => "the half-depth region",
+    };
     println!(
-        "{}: peak depth {:.3} mm, contact radius {:.3} mm (semi-axes {:.3} x {:.3} mm){}; read through {}",
+        "{}: peak depth {:.3} mm, contact radius {:.3} mm (semi-axes {:.3} x {:.3} mm, from {edge}){}; read through {}",
         report.image,
         report.peak_depth_mm,
         radius,

@@ -464,6 +464,8 @@ fn the_stock_mini_reads_a_steel_balls_depth_within_five_percent() {
     let report = press_and_read(&flags, None);
     let depth = report["peak_depth_mm"].as_f64().unwrap();
     assert!((depth - 0.6).abs() < 0.05 * 0.6, "{report}");
+    // A round contact inside the frame: its size is the outline's.
+    assert_eq!(report["contact_edge"], "outline", "{report}");
 }
 
 /// `press` with these flags (through `sensor` when given), and the `read` report of its frame
@@ -686,7 +688,7 @@ fn compare_help_puts_the_splits_text_under_split() {
 /// against 0.57 on the ridge; zeroed on the lowest side of an unlevel border, 0.55 and 0.60.
 #[test]
 fn a_strip_running_off_the_frame_reads_as_deep_off_its_ridge_as_on_it() {
-    let depth_at = |at: &str| {
+    let read_at = |at: &str| {
         let at = format!("--at-mm={at}");
         let flags = [
             "--shape",
@@ -699,11 +701,14 @@ fn a_strip_running_off_the_frame_reads_as_deep_off_its_ridge_as_on_it() {
             "1.5",
             &at,
         ];
-        press_and_read(&flags, None)["peak_depth_mm"]
-            .as_f64()
-            .unwrap()
+        press_and_read(&flags, None)
     };
-    let (ridge, off) = (depth_at("0,0"), depth_at("0,-3.8"));
+    let (ridge, off) = (read_at("0,0"), read_at("0,-3.8"));
+    // A contact crossing the frame has no round outline: its size is the half-depth
+    // region's.
+    assert_eq!(ridge["contact_edge"], "half_depth", "{ridge}");
+    let depth = |r: &serde_json::Value| r["peak_depth_mm"].as_f64().unwrap();
+    let (ridge, off) = (depth(&ridge), depth(&off));
     assert!(
         (off / ridge - 1.0).abs() < 0.15,
         "{off} mm off the ridge, {ridge} mm on it"
