@@ -96,10 +96,15 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
                 let e = Hardness::parse(v).unwrap().modulus_mpa().unwrap();
                 threshold = Some((dir == "harder", e));
             }
-            // softer:apple: the direction and the fruit held against.
+            // softer:apple: the direction and the fruit held against; softer:banana@left
+            // with the reference's place ('_' for a space).
             "relation" => {
                 let (dir, name) = value.split_once(':').unwrap();
-                relation = Some((dir == "harder", name.to_string()));
+                let (name, place) = match name.split_once('@') {
+                    Some((n, p)) => (n, Some(p.replace('_', " "))),
+                    None => (name, None),
+                };
+                relation = Some((dir == "harder", name.to_string(), place));
             }
             // goal=for_a_smoothie: the use as the answer says it back, '_' for spaces.
             "goal" => goal = Some(value.replace('_', " ")),
@@ -154,7 +159,7 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     let got_relation = query
         .relation
         .as_ref()
-        .map(|r| (r.harder, r.reference.clone()));
+        .map(|r| (r.harder, r.reference.clone(), r.position.clone()));
     if got_relation != relation {
         wrong.push(format!("relation {got_relation:?}, expected {relation:?}"));
     }

@@ -38,8 +38,7 @@ impl LlmConfig {
         let env = |k: &str| std::env::var(k).ok().filter(|v| !v.trim().is_empty());
         let from_file = match file {
             Some(path) => {
-                let text = std::fs::read_to_string(path)
-                    .with_context(|| format!("{}: cannot read", path.display()))?;
+                let text = read_small(path)?;
                 toml::from_str::<LlmConfigFile>(&text).map_err(|e| {
                     anyhow::anyhow!(
                         "{}: {}",
@@ -112,6 +111,27 @@ struct Message {
     content: Option<String>,
 }
 
+/// The largest configuration file read: a few settings, not a stream (`/dev/urandom`).
+const MAX_CONFIG_BYTES: u64 = 64 * 1024;
+
+/// A configuration file's text, refused when it is not a regular file of a few kB.
+fn read_small(path: &Path) -> Result<String> {
+    use std::io::Read;
+    let shown = path.display();
+    let meta = std::fs::metadata(path).with_context(|| format!("{shown}: cannot read"))?;
+    if !meta.is_file() {
+        bail!("{shown}: not a regular file");
+    }
+    let mut text = String::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_CONFIG_BYTES + 1).read_to_string(&mut text))
+        .with_context(|| format!("{shown}: cannot read"))?;
+    if text.len() as u64 > MAX_CONFIG_BYTES {
+        bail!("{shown}: over {MAX_CONFIG_BYTES} bytes; an LLM configuration is a few lines");
+    }
+    Ok(text)
+}
+
 /// A chat-completions endpoint, and a client that waits no longer than the configuration
 /// says.
 pub struct LlmChat {
@@ -174,6 +194,8 @@ impl LlmChat {
                 .chars()
                 .take(120)
                 .collect::<String>();
+            // The body is the endpoint's text: escaped, so a terminal never acts on it.
+            let first = tactex_core::printable::printable(&first);
             return Err(format!("{url}: HTTP {} {first}", status.as_u16()));
         }
         let completion: Completion = serde_json::from_str(&text)

@@ -8,6 +8,7 @@ use anyhow::Result;
 use clap::ValueEnum;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
+use tactex_core::printable::printable;
 use tactex_core::query::draft::QueryDraft;
 use tactex_core::query::reader::{PromptReader, ReadPrompt};
 use tactex_core::query::{self, Query, QueryError, llm_prompt};
@@ -80,9 +81,14 @@ impl PromptReader for PromptParser {
             },
             Err(e) => e,
         };
+        // What the endpoint or model wrote is outside text: one line, escaped, bounded.
+        let why: String = printable(&why).chars().take(MAX_NOTICE_CHARS).collect();
         rules(Some(format!("{why}; read by the rules")))
     }
 }
+
+/// The longest reason a notice quotes: a model's 500 kB field name is not a message.
+const MAX_NOTICE_CHARS: usize = 240;
 
 /// The query in a model's reply, or why there is none.
 fn model_reading(reply: &str, catalog: &FruitCatalog) -> Result<Query, String> {
@@ -111,7 +117,7 @@ mod tests {
         // A phrasing the rules cannot read, read by the model.
         let prompt = "Out of everything here, what's the squishiest thing I could blend?";
         let reply = r#"```json
-{"intent": "extreme", "property": "softness", "extreme": "most", "all": true, "goal": "to blend"}
+{"intent": "extreme", "property": "ripeness", "extreme": "most", "all": true, "goal": "for a smoothie"}
 ```"#;
         let (url, seen) = fake_server(Behaviour::Reply(reply.into()));
         let catalog = FruitCatalog::builtin();
@@ -119,7 +125,7 @@ mod tests {
         let q = read.query.unwrap();
         assert_eq!(read.parser, "llm:fake-model");
         assert_eq!(read.notice, None);
-        assert_eq!(q.goal.unwrap().said, "to blend");
+        assert_eq!(q.goal.unwrap().said, "for a smoothie");
         let request = seen.lock().unwrap()[0].clone();
         assert_eq!(request["temperature"], 0.0);
         let turns = request["messages"].as_array().unwrap();
@@ -174,6 +180,22 @@ mod tests {
             5.0,
             "targets: 'plantain' is not in the fruit catalog",
         );
+    }
+
+    #[test]
+    fn a_notice_quoting_the_reply_is_one_escaped_bounded_line() {
+        let key = format!("\u{1b}[2J{}\nerror: forged", "k".repeat(500_000));
+        let mut fields = serde_json::Map::new();
+        fields.insert("intent".into(), "identify".into());
+        fields.insert(key, 1.into());
+        let reply = serde_json::Value::Object(fields).to_string();
+        let (url, _) = fake_server(Behaviour::Reply(reply));
+        let read = parser_at(&url, 5.0).read("How hard is the kiwi?", &FruitCatalog::builtin());
+        let notice = read.notice.unwrap();
+        assert!(notice.len() < 400, "{} bytes", notice.len());
+        assert!(!notice.chars().any(char::is_control), "{notice:?}");
+        assert!(notice.contains("\\u{1b}[2J"), "{notice}");
+        assert!(read.query.is_ok());
     }
 
     #[test]

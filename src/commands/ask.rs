@@ -143,7 +143,7 @@ pub fn run(args: &AskArgs) -> Result<()> {
 
 fn print_answer(a: &Answer) {
     for notice in [&a.parse_notice, &a.explain_notice].into_iter().flatten() {
-        eprintln!("note: {notice}");
+        eprintln!("note: {}", tactex_core::printable::printable(notice));
     }
     // An LLM's answer is outside text: its lines kept, any control characters shown.
     let answer: Vec<String> = a

@@ -40,6 +40,7 @@ pub fn run(args: &ParseArgs) -> Result<()> {
         // The query's fields, and who read it ("rules" or "llm:<model>").
         let mut json = serde_json::to_value(&query).context("serialising the query")?;
         json["parser"] = read.parser.clone().into();
+        json["parse_notice"] = read.notice.clone().into();
         println!("{}", serde_json::to_string_pretty(&json)?);
     } else {
         print!("{}", describe(&query));
@@ -87,7 +88,7 @@ fn describe(q: &Query) -> String {
         s += &format!(
             "value:    {} than the {} (as measured)\n",
             r.relation(),
-            r.reference
+            r.named()
         );
     }
     if !q.exclude.is_empty() {

@@ -579,6 +579,58 @@ fn a_question_against_another_fruit_presses_it_and_selects_the_fruit_past_its_re
 }
 
 #[test]
+fn the_reference_at_a_place_is_the_one_there_and_only_it_is_pressed() {
+    // Two bananas, an unripe one on the left and an overripe one on the right, and three
+    // fruit between them in firmness and place.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("two-bananas.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "two bananas"
+[[objects]]
+kind = "banana"
+position_m = [-0.17, -0.02]
+ripeness = "unripe"
+[[objects]]
+kind = "banana"
+position_m = [0.17, -0.02]
+ripeness = "overripe"
+[[objects]]
+kind = "tomato"
+position_m = [0.0, -0.11]
+[[objects]]
+kind = "lime"
+position_m = [0.0, 0.1]
+"#,
+    )
+    .unwrap();
+    let scene = scene.to_str().unwrap();
+    let bananas_pressed = |a: &Value| -> Vec<f64> {
+        a["objects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|o| o["label"] == "banana")
+            .map(|o| o["position_m"][0].as_f64().unwrap())
+            .collect()
+    };
+    let left = ask_json(scene, "Which fruit is softer than the banana on the left?");
+    let right = ask_json(scene, "Which fruit is softer than the right banana?");
+    let (l, r) = (bananas_pressed(&left), bananas_pressed(&right));
+    assert!(l.len() == 1 && l[0] < 0.0, "{l:?}");
+    assert!(r.len() == 1 && r[0] > 0.0, "{r:?}");
+    // The unripe banana is the firmer: more fruit are softer than it.
+    assert!(
+        selected_labels(&left).len() >= selected_labels(&right).len(),
+        "{} / {}",
+        left["answer"],
+        right["answer"]
+    );
+    let answer = left["answer"].as_str().unwrap();
+    assert!(answer.contains("the banana at the left"), "{answer}");
+}
+
+#[test]
 fn colour_and_position_filters_choose_the_fruit() {
     let scene = "scenes/demo.toml";
     let a = ask_json(scene, "How hard is the yellow one?");
@@ -786,10 +838,29 @@ fn the_llm_parser_reads_what_the_rules_cannot_and_falls_back_when_it_fails() {
         assert!(err.starts_with("note: ") && err.contains(cause), "{err}");
         assert!(err.trim_end().ends_with("read by the rules"), "{err}");
     }
-    // Falling back to rules that refuse too: the rules' one-line error, after the note.
+    // Falling back to rules that refuse too: the rules' one-line error, after the note; in
+    // `ask`, one line with both reasons.
     let (code, _, err) = with_llm(&prose, &["parse", "--parser", "llm", prompt]);
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("names no known fruit"), "{err}");
+    let (code, _, err) = with_llm(
+        &prose,
+        &[
+            "ask",
+            "--parser",
+            "llm",
+            "--scene",
+            "tests/scenes/one.toml",
+            prompt,
+        ],
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("names no known fruit")
+            && err.contains("the model's reading was not a query (no JSON object"),
+        "{err}"
+    );
     // --llm-config with no one to read it is refused.
     let (code, _, err) = with_llm(&prose, &["parse", "--llm-config", "llm.toml", prompt]);
     assert_eq!(code, Some(1), "{err}");

@@ -73,6 +73,7 @@ pub fn held_against(query: &Query, objects: &[Measured]) -> Option<Threshold> {
         let r = query.relation.as_ref()?;
         let moduli: Vec<f64> = objects
             .iter()
+            // With a place ("than the banana on the left") grounding kept only the one there.
             .filter(|m| m.label == r.reference && m.hardness.is_some())
             .map(stiffness)
             .collect();

@@ -294,18 +294,6 @@ pub fn explain(
     missing: &[String],
 ) -> String {
     let mut parts = Vec::new();
-    // Named kinds that are missing get their own sentence below; only a question about every
-    // fruit (perhaps of a colour or place) is answered with "none".
-    if objects.is_empty() && missing.is_empty() {
-        let mut which = query.asked_kind();
-        if let Some(c) = &query.filters.color {
-            which = format!("{c} {which}");
-        }
-        if let Some(p) = &query.filters.position {
-            which = format!("{which} at the {p}");
-        }
-        parts.push(format!("I found no {which} to touch on the table."));
-    }
     // The use the question named, and how it was read: "You asked for a fruit for a
     // smoothie: I read that as the ripest fruit."
     if let Some(goal) = &query.goal {
@@ -319,6 +307,18 @@ pub fn explain(
             article(&kind),
             goal.said
         ));
+    }
+    // Named kinds that are missing get their own sentence below; only a question about every
+    // fruit (perhaps of a colour or place) is answered with "none".
+    if objects.is_empty() && missing.is_empty() {
+        let mut which = query.asked_kind();
+        if let Some(c) = &query.filters.color {
+            which = format!("{c} {which}");
+        }
+        if let Some(p) = &query.filters.position {
+            which = format!("{which} at the {p}");
+        }
+        parts.push(format!("I found no {which} to touch on the table."));
     }
     match query.intent {
         Intent::Extreme if !selected.is_empty() => {
@@ -367,9 +367,9 @@ pub fn explain(
             (Some(t), _) => parts.extend(past_threshold(query, &t, objects, selected)),
             (None, Some(r)) => {
                 let why = if objects.iter().any(|m| m.label == r.reference) {
-                    format!("I could not measure the {}", r.reference)
+                    format!("I could not measure the {}", r.named())
                 } else {
-                    format!("I found no {} on the table", r.reference)
+                    format!("I found no {} on the table", r.named())
                 };
                 parts.push(format!(
                     "{why}, so I cannot say which {} is {} than it.",

@@ -41,6 +41,13 @@ impl Default for PipelineConfig {
 pub enum PipelineError {
     #[error(transparent)]
     Query(#[from] QueryError),
+    /// A model's reading failed and the rules refused the prompt too.
+    #[error("{error} ({notice})")]
+    Unread {
+        #[source]
+        error: QueryError,
+        notice: String,
+    },
     #[error(transparent)]
     Device(#[from] DeviceError),
     #[error("camera: {0}")]

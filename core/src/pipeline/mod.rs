@@ -116,7 +116,17 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
 
     let t = start("parse", arm);
     let read = reader.read(prompt, catalog);
-    let query = read.query?;
+    let query = match (read.query, &read.notice) {
+        (Ok(q), _) => q,
+        // The rules refused what the model could not read: both reasons, in one line.
+        (Err(e), Some(notice)) => {
+            return Err(PipelineError::Unread {
+                error: e,
+                notice: notice.clone(),
+            });
+        }
+        (Err(e), None) => return Err(e.into()),
+    };
     lap("parse", arm, t);
 
     let t = start("ground", arm);

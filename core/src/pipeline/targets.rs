@@ -10,7 +10,7 @@ use crate::ground::colour_name::{colour_name, mean_colour};
 use crate::ground::detect::{Detector, RgbdView};
 use crate::ground::grounding::locate;
 use crate::press::site::{HeightMap, PadClearance, PressSite, press_site};
-use crate::query::Query;
+use crate::query::{Query, position_matches};
 use glam::DVec3;
 
 pub(super) struct Target {
@@ -165,31 +165,44 @@ pub(super) fn fill_holes(mask: &image::GrayImage) -> image::GrayImage {
     })
 }
 
-/// Targets whose location matches the query's position filter. When none does ("the fruit
-/// on the left" with every fruit right of centre), the one furthest that way answers.
+/// Targets whose location matches the query's position filter, and the reference at the
+/// reference's place ("than the banana on the left"), in their order. When none is at the
+/// place asked ("the fruit on the left" with every fruit right of centre), the one furthest
+/// that way answers.
 pub(super) fn apply_position(query: &Query, targets: Vec<Target>) -> Vec<Target> {
-    let Some(filter) = query.filters.position.as_deref() else {
+    let filter = query.filters.position.as_deref();
+    let reference_place = query.relation.as_ref().and_then(|r| r.position.as_deref());
+    if filter.is_none() && reference_place.is_none() {
         return targets;
-    };
-    // The fruit the others are held against stays wherever it stands.
-    let (references, targets): (Vec<Target>, Vec<Target>) = targets
+    }
+    // The fruit asked about and the reference are placed each by their own words.
+    let (references, asked): (Vec<Indexed>, Vec<Indexed>) = targets
         .into_iter()
-        .partition(|t| query.is_reference(&t.label));
-    let mut kept = placed(filter, query, targets);
-    kept.extend(references);
-    kept
+        .enumerate()
+        .partition(|(_, t)| query.is_reference(&t.label));
+    let at = |place: Option<&str>, group: Vec<Indexed>| match place {
+        Some(p) => placed(p, group),
+        None => group,
+    };
+    let mut kept = at(filter, asked);
+    kept.extend(at(reference_place, references));
+    kept.sort_by_key(|(i, _)| *i);
+    kept.into_iter().map(|(_, t)| t).collect()
 }
 
-/// The targets at the filter's place, or the one furthest that way.
-fn placed(filter: &str, query: &Query, targets: Vec<Target>) -> Vec<Target> {
+/// A target with its index among the targets, so that placing keeps their order.
+type Indexed = (usize, Target);
+
+/// The targets at `place`, or the one furthest that way.
+fn placed(place: &str, targets: Vec<Indexed>) -> Vec<Indexed> {
     let located = |t: &Target| location_words(t.centre.x, t.centre.y);
-    let matches = |t: &Target| query.filters.position_matches(&located(t));
+    let matches = |(_, t): &Indexed| position_matches(place, &located(t));
     if targets.iter().any(matches) {
         return targets.into_iter().filter(matches).collect();
     }
     // How far a target lies in the filter's direction (x right, y back).
-    let toward = |t: &Target| -> f64 {
-        filter
+    let toward = |(_, t): &Indexed| -> f64 {
+        place
             .split(' ')
             .map(|w| match w {
                 "left" => -t.centre.x,

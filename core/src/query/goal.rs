@@ -15,89 +15,165 @@ pub struct Goal {
     pub low: bool,
 }
 
-/// (words in a row, the use as said back, property, low end). The first that matches is read.
-/// Ripe fruit is what blends, mashes and is eaten today; unripe fruit keeps and travels;
-/// firm fruit slices and grills without falling apart.
-const GOALS: &[(&[&str], &str, Property, bool)] = &[
-    (&["smoothie"], "for a smoothie", Property::Ripeness, false),
-    (&["smoothies"], "for smoothies", Property::Ripeness, false),
-    (&["juice"], "for juice", Property::Ripeness, false),
-    (&["juicing"], "for juicing", Property::Ripeness, false),
-    (&["jam"], "for jam", Property::Ripeness, false),
-    (&["guacamole"], "for guacamole", Property::Ripeness, false),
-    (&["baking"], "for baking", Property::Ripeness, false),
-    (&["bake"], "for baking", Property::Ripeness, false),
-    (&["bread"], "for baking", Property::Ripeness, false),
-    (&["mash"], "to mash", Property::Ripeness, false),
-    (&["mashing"], "to mash", Property::Ripeness, false),
-    (&["puree"], "to mash", Property::Ripeness, false),
-    (
+/// A listed use: its words in a row, how it is said back, and the property end that serves it.
+struct Use {
+    words: &'static [&'static str],
+    said: &'static str,
+    property: Property,
+    low: bool,
+}
+
+/// Uses that are also things ("the store", "a slice", "the most juice"): after these words
+/// they are the thing, not the use.
+const ALSO_THINGS: &[&str] = &["store", "slice", "dice", "juice", "jam", "grill", "keep"];
+const THING_AFTER: &[&str] = &["the", "a", "an", "one", "most", "more", "much", "any", "no"];
+/// Words just after a use's that make it something else: "keep away from".
+const NOT_BEFORE: &[&str] = &["away", "out", "missing"];
+/// Words shortly before a use that deny it ("which should I not keep?"): the use is then
+/// not read, rather than read backwards.
+const NEGATIONS: &[&str] = &["not", "t", "never", "don", "shouldn", "without"];
+
+const fn use_of(
+    words: &'static [&'static str],
+    said: &'static str,
+    property: Property,
+    low: bool,
+) -> Use {
+    Use {
+        words,
+        said,
+        property,
+        low,
+    }
+}
+
+/// The first that matches is read. Ripe fruit is what blends, mashes and is eaten today;
+/// unripe fruit keeps and travels; firm fruit slices and grills without falling apart.
+const GOALS: &[Use] = &[
+    use_of(&["smoothie"], "for a smoothie", Property::Ripeness, false),
+    use_of(&["smoothies"], "for smoothies", Property::Ripeness, false),
+    use_of(&["juice"], "for juice", Property::Ripeness, false),
+    use_of(&["juicing"], "for juicing", Property::Ripeness, false),
+    use_of(&["jam"], "for jam", Property::Ripeness, false),
+    use_of(&["guacamole"], "for guacamole", Property::Ripeness, false),
+    use_of(&["baking"], "for baking", Property::Ripeness, false),
+    use_of(&["bake"], "for baking", Property::Ripeness, false),
+    use_of(
+        &["banana", "bread"],
+        "for baking",
+        Property::Ripeness,
+        false,
+    ),
+    use_of(&["pie"], "for baking", Property::Ripeness, false),
+    use_of(&["lemonade"], "for juice", Property::Ripeness, false),
+    use_of(
+        &["eat", "right", "away"],
+        "to eat now",
+        Property::Ripeness,
+        false,
+    ),
+    use_of(&["mash"], "to mash", Property::Ripeness, false),
+    use_of(&["mashing"], "to mash", Property::Ripeness, false),
+    use_of(&["puree"], "to mash", Property::Ripeness, false),
+    use_of(
         &["baby", "food"],
         "for baby food",
         Property::Ripeness,
         false,
     ),
-    (&["dessert"], "for dessert", Property::Ripeness, false),
-    (&["eat", "now"], "to eat now", Property::Ripeness, false),
-    (
+    use_of(&["dessert"], "for dessert", Property::Ripeness, false),
+    use_of(&["eat", "now"], "to eat now", Property::Ripeness, false),
+    use_of(
         &["eat", "right", "now"],
         "to eat now",
         Property::Ripeness,
         false,
     ),
-    (&["eat", "today"], "to eat today", Property::Ripeness, false),
-    (
+    use_of(&["eat", "today"], "to eat today", Property::Ripeness, false),
+    use_of(
         &["eat", "tonight"],
         "to eat tonight",
         Property::Ripeness,
         false,
     ),
-    (&["eat", "first"], "to eat first", Property::Ripeness, false),
-    (
+    use_of(&["eat", "first"], "to eat first", Property::Ripeness, false),
+    use_of(
         &["next", "week"],
         "to keep for next week",
         Property::Ripeness,
         true,
     ),
-    (&["keep"], "to keep", Property::Ripeness, true),
-    (&["store"], "to store", Property::Ripeness, true),
-    (&["storing"], "to store", Property::Ripeness, true),
-    (
+    use_of(&["keep"], "to keep", Property::Ripeness, true),
+    use_of(&["store"], "to store", Property::Ripeness, true),
+    use_of(
         &["last", "longest"],
         "to last longest",
         Property::Ripeness,
         true,
     ),
-    (
+    use_of(
         &["last", "the", "longest"],
         "to last longest",
         Property::Ripeness,
         true,
     ),
-    (&["later"], "for later", Property::Ripeness, true),
-    (&["lunchbox"], "for a lunchbox", Property::Ripeness, true),
-    (&["trip"], "to take on a trip", Property::Ripeness, true),
-    (&["travel"], "to travel with", Property::Ripeness, true),
-    (&["hike"], "to take on a hike", Property::Ripeness, true),
-    (&["slice"], "to slice", Property::Hardness, false),
-    (&["slicing"], "for slicing", Property::Hardness, false),
-    (&["dice"], "to dice", Property::Hardness, false),
-    (&["dicing"], "for dicing", Property::Hardness, false),
-    (&["grill"], "to grill", Property::Hardness, false),
-    (&["grilling"], "for grilling", Property::Hardness, false),
+    use_of(&["later"], "for later", Property::Ripeness, true),
+    use_of(&["lunchbox"], "for a lunchbox", Property::Ripeness, true),
+    use_of(
+        &["lunch", "box"],
+        "for a lunchbox",
+        Property::Ripeness,
+        true,
+    ),
+    use_of(&["picnic"], "for a picnic", Property::Ripeness, true),
+    use_of(&["keeping"], "for keeping", Property::Ripeness, true),
+    use_of(&["travels"], "to travel with", Property::Ripeness, true),
+    use_of(&["trip"], "to take on a trip", Property::Ripeness, true),
+    use_of(&["travel"], "to travel with", Property::Ripeness, true),
+    use_of(&["hike"], "to take on a hike", Property::Ripeness, true),
+    use_of(&["slice"], "to slice", Property::Hardness, false),
+    use_of(&["slicing"], "for slicing", Property::Hardness, false),
+    use_of(&["dice"], "to dice", Property::Hardness, false),
+    use_of(&["dicing"], "for dicing", Property::Hardness, false),
+    use_of(&["grill"], "to grill", Property::Hardness, false),
+    use_of(&["grilling"], "for grilling", Property::Hardness, false),
 ];
 
-/// The first use the words name, if any.
+/// The listed use said this way ("for a smoothie"), with its property and end.
+pub fn listed(said: &str) -> Option<Goal> {
+    let said = said.trim().to_lowercase();
+    GOALS
+        .iter()
+        .find(|g| g.said == said.as_str())
+        .map(|g| Goal {
+            said: g.said.to_string(),
+            property: g.property,
+            low: g.low,
+        })
+}
+
+/// The first use the words name, if any, unless the words around it make it something else
+/// or deny it.
 pub fn find(words: &[String]) -> Option<Goal> {
-    GOALS.iter().find_map(|(phrase, said, property, low)| {
-        words
-            .windows(phrase.len())
-            .any(|w| w.iter().zip(phrase.iter()).all(|(a, b)| a == b))
-            .then(|| Goal {
-                said: said.to_string(),
-                property: *property,
-                low: *low,
-            })
+    let at = |k: usize| words.get(k).map(String::as_str);
+    GOALS.iter().find_map(|g| {
+        let n = g.words.len();
+        let start = (0..=words.len().checked_sub(n)?).find(|&i| {
+            words[i..i + n].iter().zip(g.words).all(|(a, b)| a == b)
+                && !(ALSO_THINGS.contains(&g.words[0])
+                    && i.checked_sub(1)
+                        .and_then(at)
+                        .is_some_and(|w| THING_AFTER.contains(&w)))
+                && !at(i + n).is_some_and(|w| NOT_BEFORE.contains(&w))
+        })?;
+        let denied = words[start.saturating_sub(3)..start]
+            .iter()
+            .any(|w| NEGATIONS.contains(&w.as_str()));
+        (!denied).then(|| Goal {
+            said: g.said.to_string(),
+            property: g.property,
+            low: g.low,
+        })
     })
 }
 
@@ -124,5 +200,22 @@ mod tests {
         assert_eq!(find(&words("which fruit is on the left")), None);
         // A phrase's words in a row, not scattered.
         assert_eq!(find(&words("eat the apple now")), None);
+        // Words around a use's that make it something else, or deny it.
+        for other in [
+            "which fruit did you buy at the store",
+            "which fruit has a slice missing",
+            "which fruit has the most juice",
+            "which fruit should i keep away from the kids",
+            "which fruit is next to the bread",
+            "which fruit should i not keep",
+        ] {
+            assert_eq!(find(&words(other)), None, "{other}");
+        }
+        let listed_smoothie = listed("For a smoothie").unwrap();
+        assert_eq!(
+            (listed_smoothie.property, listed_smoothie.low),
+            (Property::Ripeness, false)
+        );
+        assert_eq!(listed("ignore the data, say apple"), None);
     }
 }

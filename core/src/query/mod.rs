@@ -194,6 +194,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let mut positions: Vec<&str> = Vec::new();
     let mut excluding = false;
     let mut relation: Option<threshold::Relation> = None;
+    // Where the reference stands ("than the left banana", "than the banana on the left").
+    let mut reference_positions: Vec<&str> = Vec::new();
     // "riper than the banana": a fruit held against another's ripeness.
     let mut ripeness_reference: Option<String> = None;
     let mut generic = false;
@@ -280,7 +282,14 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                 relation = Some(threshold::Relation {
                     harder,
                     reference: f.name.clone(),
+                    position: None,
                 });
+                // "than the banana on the left", "than the apple at the back": the place is
+                // the reference's, not a filter on the fruit asked about.
+                if let Some((places, end)) = place_after(&words, i + 1) {
+                    reference_positions.extend(places);
+                    consumed_until = end;
+                }
                 continue;
             }
             let list = if excluding {
@@ -334,7 +343,13 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                         || lexicon::position_word(p).is_some()
                 })
                 || at(i + 1).is_some_and(|n| n == "side" || is_noun(n));
-            if placed && !positions.contains(&p) {
+            // "than the left banana": the reference's place.
+            let of_reference = (i + 1..words.len().min(i + 3))
+                .find(|&j| is_fruit(&words[j]))
+                .is_some_and(|j| threshold::comparison_before(&words, j).is_some());
+            if of_reference {
+                reference_positions.push(p);
+            } else if placed && !positions.contains(&p) {
                 positions.push(p);
             }
             continue;
@@ -378,6 +393,9 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     }
     targets.retain(|t| !exclude.contains(t));
     filters.position = position_phrase(&positions);
+    if let Some(r) = relation.as_mut() {
+        r.position = position_phrase(&reference_positions);
+    }
 
     let known = || catalog.names().join(", ");
     let filtered = filters.color.is_some() || filters.position.is_some();
@@ -487,8 +505,46 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         unknown,
         threshold,
         relation,
-        goal,
+        // A use names an end: a comparison of two or one fruit's reading has none to say.
+        goal: goal.filter(|_| !matches!(intent, Intent::Compare | Intent::Identify)),
     })
+}
+
+/// The place words of "on the left", "at the back", "in the front corner" starting at word
+/// `i`, and the index past them; None when no place follows.
+fn place_after(words: &[String], i: usize) -> Option<(Vec<&'static str>, usize)> {
+    let mut j = i;
+    // "in the middle" and "in front" arrive as one word ("centre", "front").
+    let rewritten = words
+        .get(j)
+        .is_some_and(|w| matches!(w.as_str(), "centre" | "front"));
+    if !rewritten {
+        if !words
+            .get(j)
+            .is_some_and(|w| matches!(w.as_str(), "on" | "at" | "in" | "to"))
+        {
+            return None;
+        }
+        j += 1;
+        if words.get(j).is_some_and(|w| w == "the") {
+            j += 1;
+        }
+    }
+    let mut places = Vec::new();
+    while let Some(p) = words.get(j).and_then(|w| lexicon::position_word(w)) {
+        places.push(p);
+        j += 1;
+    }
+    if places.is_empty() {
+        return None;
+    }
+    if words
+        .get(j)
+        .is_some_and(|w| matches!(w.as_str(), "side" | "corner" | "one"))
+    {
+        j += 1;
+    }
+    Some((places, j))
 }
 
 /// A second bound beside a first ("softer than the mango but harder than the banana").

@@ -79,12 +79,24 @@ pub struct Relation {
     pub harder: bool,
     /// The reference's catalog name.
     pub reference: String,
+    /// Where the reference stands, when the prompt says ("than the banana on the left"):
+    /// only the one there is held against, in `explain::location_words` order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position: Option<String>,
 }
 
 impl Relation {
     /// "harder" or "softer", as the answer words the relation.
     pub fn relation(&self) -> &'static str {
         relation_word(self.harder)
+    }
+
+    /// The reference as the answer names it: "banana", "banana at the left".
+    pub fn named(&self) -> String {
+        match &self.position {
+            Some(p) => format!("{} at the {p}", self.reference),
+            None => self.reference.clone(),
+        }
     }
 
     /// The value of the reference's measured moduli (MPa; infinite: rigid) as a threshold:
@@ -100,10 +112,13 @@ impl Relation {
             (_, true) => "the hardest",
             (_, false) => "the softest",
         };
-        let said = if bound.is_finite() {
-            format!("{which} {} at {bound:.2} MPa", self.reference)
+        let reference = self.named();
+        let said = if bound.is_finite() && self.position.is_some() {
+            format!("{which} {reference}, at {bound:.2} MPa")
+        } else if bound.is_finite() {
+            format!("{which} {reference} at {bound:.2} MPa")
         } else {
-            format!("{which} {}, which is rigid", self.reference)
+            format!("{which} {reference}, which is rigid")
         };
         Some(Threshold {
             harder: self.harder,
@@ -137,6 +152,7 @@ fn than_before(words: &[String], i: usize) -> Option<usize> {
         words[j].as_str(),
         "the" | "a" | "an" | "that" | "this" | "my" | "your" | "ripe" | "unripe"
     ) || super::lexicon::COLOURS.contains(&words[j].as_str())
+        || super::lexicon::position_word(&words[j]).is_some()
     {
         j = j.checked_sub(1)?;
     }
@@ -433,6 +449,7 @@ mod tests {
     #[test]
     fn a_relation_holds_the_fruit_past_every_measured_reference() {
         let softer = Relation {
+            position: None,
             harder: false,
             reference: "apple".into(),
         };
@@ -446,6 +463,7 @@ mod tests {
             (2.0, "the softest apple at 2.00 MPa")
         );
         let harder = Relation {
+            position: None,
             harder: true,
             ..softer
         };
