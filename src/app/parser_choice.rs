@@ -10,8 +10,8 @@ use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::printable::printable;
 use tactex_core::query::draft::QueryDraft;
-use tactex_core::query::reader::{PromptReader, ReadPrompt};
-use tactex_core::query::{self, Query, QueryError, llm_prompt};
+use tactex_core::query::reader::{PromptReader, ReadPrompt, RuleReader};
+use tactex_core::query::{self, Query, llm_prompt};
 
 /// Which parser reads the prompt.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -46,23 +46,19 @@ impl PromptParser {
 impl PromptReader for PromptParser {
     fn read(&self, prompt: &str, catalog: &FruitCatalog) -> ReadPrompt {
         let rules = |notice: Option<String>| ReadPrompt {
-            query: query::parse(prompt, catalog),
-            parser: "rules".into(),
             notice,
+            ..RuleReader.read(prompt, catalog)
         };
         let chat = match self {
             Self::Rules => return rules(None),
             Self::Llm(chat) => chat,
         };
-        // The rules' limits hold for every parser: an empty or over-long prompt is refused
+        // The prompt's limits hold for every parser: an empty or over-long prompt is refused
         // before anything is sent.
-        if let Err(e @ (QueryError::Empty | QueryError::TooLong { .. })) =
-            query::parse(prompt, catalog)
-        {
+        if let Err(e) = query::checked_prompt(prompt) {
             return ReadPrompt {
                 query: Err(e),
-                parser: "rules".into(),
-                notice: None,
+                ..rules(None)
             };
         }
         let why = match chat.complete(

@@ -154,7 +154,8 @@ const LOOK_PAST: &[&str] = &[
     "the", "of", "these", "those", "my", "your", "ripe", "unripe",
 ];
 
-pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> {
+/// The prompt trimmed, or why no parser reads it: empty, or over `MAX_PROMPT_CHARS`.
+pub fn checked_prompt(prompt: &str) -> Result<&str, QueryError> {
     let trimmed = prompt.trim();
     if trimmed.is_empty() {
         return Err(QueryError::Empty);
@@ -164,6 +165,11 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             max: MAX_PROMPT_CHARS,
         });
     }
+    Ok(trimmed)
+}
+
+pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> {
+    let trimmed = checked_prompt(prompt)?;
     let threshold = threshold::find(trimmed)?;
     let (words, breaks) = words_of(trimmed);
     let at = |i: usize| words.get(i).map(String::as_str);
