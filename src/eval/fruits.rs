@@ -123,6 +123,9 @@ pub struct FruitRow {
     pub estimate_mpa: Option<f64>,
     /// Wide over narrow semi-axis of the first contact, as the estimator's evidence says.
     pub first_contact_aspect: Option<f64>,
+    /// The estimator's own standard error in ln E (half its own 68% interval in ln), before
+    /// any interval calibration.
+    pub own_ln_se: Option<f64>,
     /// ln(E_est / E_true).
     pub ln_error: Option<f64>,
     pub in_68: Option<bool>,
@@ -349,6 +352,9 @@ fn score(table: &Table, twin: &TwinAnswer) -> (Vec<FruitRow>, usize) {
                     Some(Evidence::Physics(p)) => p.first_contact_aspect,
                     _ => None,
                 }),
+                own_ln_se: interval
+                    .filter(|i| measured && !i.calibrated)
+                    .and_then(|i| i.ln_half_width68()),
                 ln_error: estimate_mpa.map(|e| (e / truth).ln()),
                 in_68: interval
                     .filter(|_| measured)
@@ -626,6 +632,7 @@ pub fn run(args: &FruitEvalArgs) -> Result<()> {
                     ln_estimate: e.ln(),
                     residual: (r.true_modulus_mpa / e).ln(),
                     elongated: r.first_contact_aspect.is_some_and(is_elongated),
+                    own_ln_se: r.own_ln_se,
                 })
             })
             .collect();

@@ -135,6 +135,15 @@ impl ModulusInterval {
     }
 
     /// Whether the 68% (`wide` false) or 95% interval holds `modulus_mpa` (infinite: rigid).
+    /// Half the 68% interval's width in ln E: the estimate's standard error in ln E as the
+    /// interval states it (None when a bound is open or not positive).
+    pub fn ln_half_width68(&self) -> Option<f64> {
+        let [Some(lo), Some(hi)] = self.p68_mpa else {
+            return None;
+        };
+        (lo > 0.0 && hi >= lo && hi.is_finite()).then(|| 0.5 * (hi / lo).ln())
+    }
+
     pub fn holds(&self, modulus_mpa: f64, wide: bool) -> Option<bool> {
         let [lo, hi] = if wide { self.p95_mpa } else { self.p68_mpa };
         let lo = lo?;

@@ -11,6 +11,14 @@
 //! the same kind of scene. The quantile levels are widened by (n + 1) / n, the finite-sample
 //! correction.
 //!
+//! A press's error grows with what its own reading leaves open (a depth fit through three
+//! frames pins the modulus far less than one through eight: on the held-out presses of two
+//! real sensors' profiles |residual| and the fit's own standard error correlate at 0.85), so
+//! the residuals are taken in units of sqrt(se^2 + floor^2), se the estimate's own standard
+//! error in ln E and floor the held-out presses' median se (normalised conformal scores): a
+//! press the estimator itself reads loosely gets a wide interval, a well-pinned one a narrow
+//! one, and coverage still holds over the presses as a whole.
+//!
 //! Elongated contacts (a banana's first touch is a line across the pad, its imprint runs off
 //! the frame) are read with another bias than round ones: when the held-out set has enough of
 //! them they get bins of their own, chosen by the contact's aspect in the estimate's evidence.
@@ -25,7 +33,9 @@ use crate::tactile::sensor_profile::{ProfileId, SensorProfile};
 use crate::tactile::spec::TactileSpec;
 use serde::{Deserialize, Serialize};
 
-pub const FORMAT: &str = "tactex-interval-calibration/1";
+pub const FORMAT: &str = "tactex-interval-calibration/2";
+/// The format before residuals were scaled by each press's own error: read as unscaled.
+const FORMAT_UNSCALED: &str = "tactex-interval-calibration/1";
 /// The two-sided levels: 68% and 95%.
 const LEVELS: [f64; 4] = [0.025, 0.16, 0.84, 0.975];
 /// A first contact this many times longer than wide is elongated. On the held-out presses of
@@ -55,6 +65,10 @@ pub struct IntervalCalibration {
     /// built-in GelSight Mini. Residuals measured through one sensor say nothing of another's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sensor: Option<ProfileId>,
+    /// The floor (ln E) of the scale the residuals are in units of, sqrt(se^2 + floor^2);
+    /// absent: residuals in ln E, whatever the press's own error.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub own_se_floor_ln: Option<f64>,
 }
 
 /// One group of held-out presses and its bins.
@@ -73,17 +87,20 @@ pub struct ResidualBin {
     /// the recentring at that estimate.
     pub ln_modulus_median: f64,
     pub median_residual: f64,
-    /// Quantiles of ln(E_true / E_recentred) at 2.5, 16, 84 and 97.5%.
+    /// Quantiles of ln(E_true / E_recentred) at 2.5, 16, 84 and 97.5%, in units of the
+    /// press's scale when the calibration has `own_se_floor_ln`.
     pub residual_quantiles: [f64; 4],
 }
 
 /// One held-out press: the estimator's raw ln(E_est / MPa), the residual ln(E_true / E_est),
-/// and whether its first contact was elongated.
+/// whether its first contact was elongated, and the estimator's own standard error in ln E
+/// (`ModulusInterval::ln_half_width68` of its uncalibrated interval).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeldOutPress {
     pub ln_estimate: f64,
     pub residual: f64,
     pub elongated: bool,
+    pub own_ln_se: Option<f64>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -127,11 +144,14 @@ impl IntervalCalibration {
             source_name: format!("calibration of {estimator}"),
             message,
         };
-        if samples
-            .iter()
-            .any(|s| !(s.ln_estimate.is_finite() && s.residual.is_finite()))
-        {
-            return Err(invalid("a residual or estimate is not finite".into()));
+        if samples.iter().any(|s| {
+            !(s.ln_estimate.is_finite()
+                && s.residual.is_finite()
+                && s.own_ln_se.is_none_or(|se| se.is_finite() && se >= 0.0))
+        }) {
+            return Err(invalid(
+                "a residual, estimate or standard error is not finite".into(),
+            ));
         }
         if samples.len() < MIN_PER_BIN {
             return Err(invalid(format!(
@@ -139,11 +159,19 @@ impl IntervalCalibration {
                 samples.len()
             )));
         }
-        let pairs = |elongated: Option<bool>| -> Vec<(f64, f64)> {
+        // The median own error over the presses that state one; none: unscaled. A floor of
+        // zero (every press pinned exactly) would divide by zero, so it is kept above 1e-3.
+        let own: Vec<f64> = samples.iter().filter_map(|s| s.own_ln_se).collect();
+        let floor = quantile(&own, 0.5).ok().map(|m| m.max(1e-3));
+        let pairs = |elongated: Option<bool>| -> Vec<Scored> {
             samples
                 .iter()
                 .filter(|s| elongated.is_none_or(|e| s.elongated == e))
-                .map(|s| (s.ln_estimate, s.residual))
+                .map(|s| Scored {
+                    ln_estimate: s.ln_estimate,
+                    residual: s.residual,
+                    scale: scale(floor, s.own_ln_se),
+                })
                 .collect()
         };
         let (round, long) = (pairs(Some(false)), pairs(Some(true)));
@@ -165,6 +193,7 @@ impl IntervalCalibration {
             bins: fit_bins(main, max_bins),
             sensor: None,
             elongated_contact,
+            own_se_floor_ln: floor,
         })
     }
 
@@ -175,8 +204,19 @@ impl IntervalCalibration {
             message,
         };
         let c: Self = serde_json::from_str(text).map_err(|e| invalid(e.to_string()))?;
-        if c.format != FORMAT {
-            return Err(invalid(format!("format: {:?} is not {FORMAT:?}", c.format)));
+        match (c.format.as_str(), c.own_se_floor_ln) {
+            (FORMAT, Some(f)) if !(f.is_finite() && f > 0.0) => {
+                return Err(invalid(
+                    "own_se_floor_ln: must be finite and positive".into(),
+                ));
+            }
+            (FORMAT, _) | (FORMAT_UNSCALED, None) => {}
+            (FORMAT_UNSCALED, Some(_)) => {
+                return Err(invalid(format!(
+                    "own_se_floor_ln: not read by {FORMAT_UNSCALED:?}"
+                )));
+            }
+            _ => return Err(invalid(format!("format: {:?} is not {FORMAT:?}", c.format))),
         }
         check_bins(&c.bins, "bins").map_err(invalid)?;
         if let Some(group) = &c.elongated_contact {
@@ -206,9 +246,14 @@ impl IntervalCalibration {
         modulus_mpa * shift_at(&centres(bins), modulus_mpa.ln()).exp()
     }
 
-    /// The calibrated intervals for a raw estimate of `modulus_mpa`, around its recentred
-    /// value.
-    pub fn interval(&self, modulus_mpa: f64, elongated: bool) -> ModulusInterval {
+    /// The calibrated intervals for a raw estimate of `modulus_mpa` whose own standard error
+    /// in ln E is `own_ln_se`, around its recentred value.
+    pub fn interval(
+        &self,
+        modulus_mpa: f64,
+        elongated: bool,
+        own_ln_se: Option<f64>,
+    ) -> ModulusInterval {
         let (bins, presses, group) = self.group(elongated);
         let ln = modulus_mpa.ln();
         let bin = bins
@@ -216,25 +261,50 @@ impl IntervalCalibration {
             .find(|b| b.ln_modulus_below.is_none_or(|edge| ln < edge))
             .expect("the last bin has no edge");
         let e = self.recentred(modulus_mpa, elongated);
-        let [a, b, c, d] = bin.residual_quantiles.map(|q| Some(e * q.exp()));
+        let k = scale(self.own_se_floor_ln, own_ln_se);
+        let [a, b, c, d] = bin.residual_quantiles.map(|q| Some(e * (k * q).exp()));
         ModulusInterval {
             p68_mpa: [b, c],
             p95_mpa: [a, d],
             source: format!(
-                "calibrated on {presses} held-out presses{group} at {} ({} in this bin; the estimator's {:.3} MPa recentred by {:+.0}%)",
+                "calibrated on {presses} held-out presses{group} at {} ({} in this bin; the estimator's {:.3} MPa recentred by {:+.0}%{})",
                 self.fidelity,
                 bin.presses,
                 modulus_mpa,
-                100.0 * (e / modulus_mpa - 1.0)
+                100.0 * (e / modulus_mpa - 1.0),
+                match (self.own_se_floor_ln, own_ln_se) {
+                    (Some(_), Some(se)) =>
+                        format!("; widths scaled by its own error, {se:.3} in ln E"),
+                    _ => String::new(),
+                }
             ),
             calibrated: true,
         }
     }
 }
 
-/// Equal-count bins of `(ln E_est, residual)` pairs (at least `MIN_PER_BIN` of them).
-fn fit_bins(mut sorted: Vec<(f64, f64)>, max_bins: usize) -> Vec<ResidualBin> {
-    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+/// A held-out press as the bins take it: its residual's scale is `scale`'s.
+struct Scored {
+    ln_estimate: f64,
+    residual: f64,
+    scale: f64,
+}
+
+/// The scale a press's residual is taken in: sqrt(se^2 + floor^2), an unstated se counted as
+/// the floor; 1 for an unscaled calibration.
+fn scale(floor: Option<f64>, own_ln_se: Option<f64>) -> f64 {
+    match floor {
+        Some(f) => {
+            let se = own_ln_se.filter(|v| v.is_finite()).unwrap_or(f);
+            se.hypot(f)
+        }
+        None => 1.0,
+    }
+}
+
+/// Equal-count bins of held-out presses (at least `MIN_PER_BIN` of them), by estimate.
+fn fit_bins(mut sorted: Vec<Scored>, max_bins: usize) -> Vec<ResidualBin> {
+    sorted.sort_by(|a, b| a.ln_estimate.total_cmp(&b.ln_estimate));
     let bins = (sorted.len() / MIN_PER_BIN).clamp(1, max_bins.max(1));
     let n = sorted.len();
     let mut out = Vec::with_capacity(bins);
@@ -245,8 +315,8 @@ fn fit_bins(mut sorted: Vec<(f64, f64)>, max_bins: usize) -> Vec<ResidualBin> {
             let (lo, hi) = range(b);
             let part = &sorted[lo..hi];
             (
-                median(part.iter().map(|s| s.0).collect()),
-                median(part.iter().map(|s| s.1).collect()),
+                median(part.iter().map(|s| s.ln_estimate).collect()),
+                median(part.iter().map(|s| s.residual).collect()),
             )
         })
         .collect();
@@ -254,13 +324,14 @@ fn fit_bins(mut sorted: Vec<(f64, f64)>, max_bins: usize) -> Vec<ResidualBin> {
         let (lo, hi) = range(b);
         let residuals: Vec<f64> = sorted[lo..hi]
             .iter()
-            .map(|s| s.1 - shift_at(&centres, s.0))
+            .map(|s| (s.residual - shift_at(&centres, s.ln_estimate)) / s.scale)
             .collect();
         let m = residuals.len() as f64;
         let widen = |q: f64| (0.5 + (q - 0.5) * (m + 1.0) / m).clamp(0.0, 1.0);
         let residual_quantiles = LEVELS
             .map(|q| quantile(&residuals, widen(q)).expect("non-empty, finite, level in [0, 1]"));
-        let ln_modulus_below = (b + 1 < bins).then(|| (sorted[hi - 1].0 + sorted[hi].0) / 2.0);
+        let ln_modulus_below =
+            (b + 1 < bins).then(|| (sorted[hi - 1].ln_estimate + sorted[hi].ln_estimate) / 2.0);
         out.push(ResidualBin {
             ln_modulus_below,
             presses: residuals.len(),
@@ -368,7 +439,8 @@ impl<E: HardnessEstimator> HardnessEstimator for Calibrated<E> {
         let elongated = elongated_contact(&estimate.evidence) == Some(true);
         // A rigid reading keeps the estimator's own bound: no held-out press was rigid.
         if let Some(e) = estimate.hardness.modulus_mpa().filter(|e| *e > 0.0) {
-            estimate.interval = self.calibration.interval(e, elongated);
+            let own = estimate.interval.ln_half_width68();
+            estimate.interval = self.calibration.interval(e, elongated, own);
             let recentred = Hardness::from_modulus_mpa(self.calibration.recentred(e, elongated))
                 .map_err(|err| EstimateError::Model(format!("recentred estimate: {err}")))?;
             estimate.hardness = recentred;
@@ -402,6 +474,7 @@ mod tests {
                 ln_estimate,
                 residual,
                 elongated,
+                own_ln_se: None,
             })
             .collect()
     }
@@ -427,13 +500,13 @@ mod tests {
         // Below the first bin's median the bias applies whole: the soft read is raised 5%.
         let soft_e = (-1.0f64).exp();
         assert!((c.recentred(soft_e, false) / soft_e - 0.05f64.exp()).abs() < 0.005);
-        let soft = c.interval(soft_e, false);
+        let soft = c.interval(soft_e, false, None);
         let [lo, hi] = soft.p68_mpa.map(|v| (v.unwrap() / soft_e).ln());
         assert!(
             (lo - (0.05 - 0.1)).abs() < 0.01 && (hi - (0.05 + 0.1)).abs() < 0.01,
             "{lo} {hi}"
         );
-        let hard = c.interval(3.0, false);
+        let hard = c.interval(3.0, false, None);
         let [lo, hi] = hard.p95_mpa.map(|v| (v.unwrap() / 3.0).ln());
         assert!(
             (lo + 1.96 * 0.3).abs() < 0.02 && (hi - 1.96 * 0.3).abs() < 0.02,
@@ -446,6 +519,99 @@ mod tests {
                 assert!((x - y).abs() < 1e-12);
             }
         }
+    }
+
+    #[test]
+    fn presses_read_loosely_get_wide_intervals_and_each_kind_is_covered() {
+        // Presses pinned to 0.05, 0.1 and 0.4 in ln E by their own fits, each erring by its own
+        // error beside a model error of the median's size (0.1): unscaled intervals would be
+        // too wide for the first and too narrow for the last; scaled ones hold 68% and 95% of
+        // each kind.
+        let groups = [(0.05, 150), (0.1, 100), (0.4, 150)];
+        let err = |se: f64| f64::hypot(se, 0.1);
+        let samples: Vec<HeldOutPress> = groups
+            .iter()
+            .flat_map(|&(se, n)| {
+                normal_residuals(n, 1.0, 0.0)
+                    .into_iter()
+                    .enumerate()
+                    .map(move |(i, z)| HeldOutPress {
+                        ln_estimate: 0.001 * i as f64,
+                        residual: err(se) * z,
+                        elongated: false,
+                        own_ln_se: Some(se),
+                    })
+            })
+            .collect();
+        let c = IntervalCalibration::fit("indentation", "layer", "", &samples, 1).unwrap();
+        assert_eq!(c.own_se_floor_ln, Some(0.1));
+        for (se, _) in groups {
+            let z = normal_residuals(100, 1.0, 0.0);
+            let cover = |wide: bool| {
+                let inside = z
+                    .iter()
+                    .filter(|&&z| {
+                        let truth = 2.0 * (err(se) * z).exp();
+                        c.interval(2.0, false, Some(se)).holds(truth, wide) == Some(true)
+                    })
+                    .count();
+                inside as f64 / z.len() as f64
+            };
+            assert!(
+                (0.62..=0.74).contains(&cover(false)),
+                "se {se}: {}",
+                cover(false)
+            );
+            assert!(
+                (0.92..=0.98).contains(&cover(true)),
+                "se {se}: {}",
+                cover(true)
+            );
+        }
+        let floor = 0.1;
+        let width = |se| {
+            let [lo, hi] = c.interval(2.0, false, Some(se)).p68_mpa;
+            (hi.unwrap() / lo.unwrap()).ln()
+        };
+        assert!(width(0.4) > 3.0 * width(0.05));
+        // A press that states no error is taken at the floor; an unscaled file ignores it.
+        assert_eq!(
+            width(floor),
+            c.interval(2.0, false, None).ln_half_width68().unwrap() * 2.0
+        );
+        let back =
+            IntervalCalibration::parse(&serde_json::to_string(&c).unwrap(), "c.json").unwrap();
+        assert_eq!(back.own_se_floor_ln, c.own_se_floor_ln);
+    }
+
+    #[test]
+    fn a_file_of_the_unscaled_format_is_read_unscaled_and_a_bad_floor_refused() {
+        let samples = held_out(
+            (0..80).map(|i| (0.01 * i as f64, 0.1 * (i % 7) as f64)),
+            false,
+        );
+        let mut unscaled = IntervalCalibration::fit("learned", "layer", "", &samples, 1).unwrap();
+        assert_eq!(unscaled.own_se_floor_ln, None);
+        unscaled.format = FORMAT_UNSCALED.into();
+        let text = serde_json::to_string(&unscaled).unwrap();
+        let back = IntervalCalibration::parse(&text, "old.json").unwrap();
+        assert_eq!(
+            back.interval(2.0, false, Some(3.0)),
+            back.interval(2.0, false, None)
+        );
+        let mut bad = unscaled.clone();
+        bad.own_se_floor_ln = Some(0.1);
+        let e = IntervalCalibration::parse(&serde_json::to_string(&bad).unwrap(), "old.json")
+            .unwrap_err();
+        assert!(
+            e.to_string().starts_with("old.json: own_se_floor_ln"),
+            "{e}"
+        );
+        bad.format = FORMAT.into();
+        bad.own_se_floor_ln = Some(-1.0);
+        let e = IntervalCalibration::parse(&serde_json::to_string(&bad).unwrap(), "c.json")
+            .unwrap_err();
+        assert!(e.to_string().contains("finite and positive"), "{e}");
     }
 
     #[test]
@@ -505,7 +671,11 @@ mod tests {
         let shift = |elongated| (c.recentred(1.5, elongated) / 1.5).ln();
         assert!((shift(false) - 0.25).abs() < 0.01, "{}", shift(false));
         assert!((shift(true) + 0.05).abs() < 0.01, "{}", shift(true));
-        assert!(c.interval(1.5, true).source.contains("elongated contact"));
+        assert!(
+            c.interval(1.5, true, None)
+                .source
+                .contains("elongated contact")
+        );
         let back =
             IntervalCalibration::parse(&serde_json::to_string(&c).unwrap(), "c.json").unwrap();
         let (a, b) = (
