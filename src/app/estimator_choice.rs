@@ -200,7 +200,7 @@ impl EstimatorChoice {
                     "note: intervals measured through this sensor: {}",
                     path.display()
                 );
-                Some(c)
+                Some(*c)
             }
             Beside::Missing(_) => None,
             Beside::Stale(path, e) => {
@@ -248,7 +248,7 @@ impl EstimatorChoice {
             return Beside::Missing(path);
         }
         match self.measured_intervals(&path, "intervals", estimator, sensor) {
-            Ok(c) => Beside::Found(path, c),
+            Ok(c) => Beside::Found(path, Box::new(c)),
             Err(e) => Beside::Stale(path, e),
         }
     }
@@ -257,7 +257,7 @@ impl EstimatorChoice {
 /// An interval calibration beside a sensor profile: found and measured through it, missing,
 /// or there but not for this estimator or this profile (why, in the error).
 pub enum Beside {
-    Found(PathBuf, IntervalCalibration),
+    Found(PathBuf, Box<IntervalCalibration>),
     Missing(PathBuf),
     Stale(PathBuf, anyhow::Error),
 }
