@@ -115,6 +115,7 @@ mod tests {
             interval_95_mpa: [Some(e - 0.1), Some(e + 0.1)],
             ripeness: Some(r.into()),
             not_measured: None,
+            reference: false,
         };
         let objects = vec![
             m("banana", 0.80, -0.15, -0.1, "ripe"),

@@ -330,6 +330,7 @@ pub fn facts(case: &Case, catalog: &FruitCatalog) -> Result<Facts> {
             ],
             ripeness: t.ripeness.clone(),
             not_measured: None,
+            reference: query.is_reference(&t.label),
         })
         .collect();
     let not_found = query

@@ -651,6 +651,7 @@ mod tests {
             .iter()
             .map(|&i| ObjectReport {
                 label: sc.kinds[i].clone(),
+                reference: false,
                 detection_score: 0.9,
                 position_m: centres[i],
                 surface_centroid_m: top(i),
@@ -679,6 +680,7 @@ mod tests {
                 interval_95_mpa: [None, None],
                 ripeness: None,
                 not_measured: None,
+                reference: o.reference,
             })
             .collect();
         let selected = tactex_core::explain::select(&query, &measured, &catalog);

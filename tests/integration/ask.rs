@@ -614,20 +614,43 @@ position_m = [0.0, 0.1]
             .map(|o| o["position_m"][0].as_f64().unwrap())
             .collect()
     };
+    // The reference is the one banana at its place (marked so in --json); the other banana
+    // is a fruit like any other, asked about and pressed.
+    let reference_x = |a: &Value| -> Vec<f64> {
+        a["objects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|o| o["reference"] == true)
+            .map(|o| o["position_m"][0].as_f64().unwrap())
+            .collect()
+    };
     let left = ask_json(scene, "Which fruit is softer than the banana on the left?");
     let right = ask_json(scene, "Which fruit is softer than the right banana?");
-    let (l, r) = (bananas_pressed(&left), bananas_pressed(&right));
+    let (l, r) = (reference_x(&left), reference_x(&right));
     assert!(l.len() == 1 && l[0] < 0.0, "{l:?}");
     assert!(r.len() == 1 && r[0] > 0.0, "{r:?}");
-    // The unripe banana is the firmer: more fruit are softer than it.
+    assert_eq!(bananas_pressed(&left).len(), 2);
+    // The unripe banana is the firmer: more fruit are softer than it, the overripe banana
+    // among them; nothing on the table is softer than the overripe one.
+    let softer_than_left = selected_labels(&left);
     assert!(
-        selected_labels(&left).len() >= selected_labels(&right).len(),
+        softer_than_left.contains(&"banana".to_string())
+            && softer_than_left.len() > selected_labels(&right).len(),
         "{} / {}",
         left["answer"],
         right["answer"]
     );
     let answer = left["answer"].as_str().unwrap();
     assert!(answer.contains("the banana at the left"), "{answer}");
+    // Instances of the reference's own kind: the banana asked about is the other one.
+    let which = ask_json(scene, "Which banana is softer than the banana on the left?");
+    assert_eq!(selected_labels(&which), ["banana"], "{}", which["answer"]);
+    let selected = &which["objects"][which["selected"][0].as_u64().unwrap() as usize];
+    assert!(selected["position_m"][0].as_f64().unwrap() > 0.0);
+    assert_eq!(bananas_pressed(&which).len(), 2);
+    let none = ask_json(scene, "Which banana is harder than the banana on the left?");
+    assert!(selected_labels(&none).is_empty(), "{}", none["answer"]);
 }
 
 #[test]

@@ -283,6 +283,7 @@ mod tests {
             interval_95_mpa: [Some(e * 0.8), Some(e * 1.2)],
             ripeness: Some(r.into()),
             not_measured: None,
+            reference: false,
         };
         let objects = vec![
             m("banana", 0.80, -0.15, -0.1, "ripe"),

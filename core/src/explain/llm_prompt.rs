@@ -78,6 +78,7 @@ mod tests {
                 interval_95_mpa: [Some(0.6), Some(1.0)],
                 ripeness: Some("ripe".into()),
                 not_measured: None,
+                reference: false,
             }],
             selected: vec![0],
             not_found: vec!["kiwi".into()],

@@ -29,6 +29,9 @@ pub struct Measured {
     pub ripeness: Option<String>,
     /// Why there is no hardness, when there is none (a sentence fragment).
     pub not_measured: Option<String>,
+    /// What the fruit asked about are held against ("than the banana on the left").
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub reference: bool,
 }
 
 /// Everything an explanation may say: the question, what was measured, which objects answer
@@ -73,8 +76,8 @@ pub fn held_against(query: &Query, objects: &[Measured]) -> Option<Threshold> {
         let r = query.relation.as_ref()?;
         let moduli: Vec<f64> = objects
             .iter()
-            // With a place ("than the banana on the left") grounding kept only the one there.
-            .filter(|m| m.label == r.reference && m.hardness.is_some())
+            // With a place ("than the banana on the left") grounding marked only the one there.
+            .filter(|m| m.reference && m.label == r.reference && m.hardness.is_some())
             .map(stiffness)
             .collect();
         r.resolve(&moduli)
@@ -107,7 +110,7 @@ pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Ve
         Intent::Threshold => {
             let against = held_against(query, objects);
             measured.retain(|&i| {
-                query.wants(&objects[i].label)
+                query.asks_about(&objects[i].label, objects[i].reference)
                     && against
                         .as_ref()
                         .is_some_and(|t| t.holds_for(stiffness(&objects[i])))

@@ -109,7 +109,10 @@ fn past_threshold(
     };
     let kind = query.asked_kind();
     let asked: Vec<usize> = (0..objects.len())
-        .filter(|&i| query.wants(&objects[i].label) && objects[i].hardness.is_some())
+        .filter(|&i| {
+            query.asks_about(&objects[i].label, objects[i].reference)
+                && objects[i].hardness.is_some()
+        })
         .collect();
     let mut parts = Vec::new();
     if selected.is_empty() {
@@ -366,7 +369,7 @@ pub fn explain(
         Intent::Threshold => match (super::held_against(query, objects), &query.relation) {
             (Some(t), _) => parts.extend(past_threshold(query, &t, objects, selected)),
             (None, Some(r)) => {
-                let why = if objects.iter().any(|m| m.label == r.reference) {
+                let why = if objects.iter().any(|m| m.reference) {
                     format!("I could not measure the {}", r.named())
                 } else {
                     format!("I found no {} on the table", r.named())
@@ -405,7 +408,7 @@ pub fn explain(
     }
     // A fruit that was found but could not be pressed is said so, with why, once.
     for (i, m) in objects.iter().enumerate() {
-        let asked = query.wants(&m.label);
+        let asked = query.asks_about(&m.label, m.reference);
         if m.hardness.is_none() && asked && !selected.contains(&i) {
             parts.push(capitalise(&format!("{}.", describe(m))));
         }
@@ -441,6 +444,7 @@ mod tests {
             interval_95_mpa: [None, None],
             ripeness: Some("ripe".into()),
             not_measured: None,
+            reference: false,
         }
     }
 

@@ -17,6 +17,10 @@ pub struct StageTiming {
 #[derive(Clone, Debug, Serialize)]
 pub struct ObjectReport {
     pub label: String,
+    /// What the fruit asked about are held against ("than the banana on the left"), pressed
+    /// for its reading, not asked about itself.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub reference: bool,
     pub detection_score: f64,
     /// Centre estimate: x, y of the refined-mask centroid, z half the top height (it rests on
     /// the table).

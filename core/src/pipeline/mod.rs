@@ -220,6 +220,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
     for ((target, pressed), estimate) in targets.iter().zip(&presses).zip(estimates) {
         let mut report = ObjectReport {
             label: target.label.clone(),
+            reference: target.reference,
             detection_score: target.score,
             position_m: target.centre.to_array(),
             surface_centroid_m: target.surface.to_array(),
@@ -298,6 +299,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
                 interval_95_mpa: calibrated.map_or([None, None], |i| i.p95_mpa),
                 ripeness: o.ripeness.clone(),
                 not_measured: o.not_measured.as_ref().map(|n| n.to_string()),
+                reference: o.reference,
             }
         })
         .collect();

@@ -24,6 +24,9 @@ pub(super) struct Target {
     pub(super) pad_yaw_rad: f64,
     /// No site was clear of the neighbours by the grounding margin (see `press_site`).
     pub(super) crowded: bool,
+    /// What the fruit asked about are held against ("than the banana on the left"), not
+    /// asked about itself.
+    pub(super) reference: bool,
 }
 
 /// Detections for the query's targets, with refined-mask centroids from the depth median.
@@ -85,6 +88,7 @@ pub(super) fn ground<C: RgbdCamera>(
                 touch: site.at,
                 pad_yaw_rad: site.yaw_rad,
                 crowded: site.crowded,
+                reference: false,
             })
         })
         .collect();
@@ -166,26 +170,43 @@ pub(super) fn fill_holes(mask: &image::GrayImage) -> image::GrayImage {
 }
 
 /// Targets whose location matches the query's position filter, and the reference at the
-/// reference's place ("than the banana on the left"), in their order. When none is at the
-/// place asked ("the fruit on the left" with every fruit right of centre), the one furthest
-/// that way answers.
+/// reference's place ("than the banana on the left") marked as the reference, in their
+/// order. When none is at the place asked ("the fruit on the left" with every fruit right of
+/// centre), the one furthest that way answers. The reference's other instances are asked
+/// about when their kind is ("Which banana is softer than the banana on the left?").
 pub(super) fn apply_position(query: &Query, targets: Vec<Target>) -> Vec<Target> {
     let filter = query.filters.position.as_deref();
     let reference_place = query.relation.as_ref().and_then(|r| r.position.as_deref());
-    if filter.is_none() && reference_place.is_none() {
-        return targets;
-    }
     // The fruit asked about and the reference are placed each by their own words.
-    let (references, asked): (Vec<Indexed>, Vec<Indexed>) = targets
+    let (references, mut asked): (Vec<Indexed>, Vec<Indexed>) = targets
         .into_iter()
         .enumerate()
         .partition(|(_, t)| query.is_reference(&t.label));
-    let at = |place: Option<&str>, group: Vec<Indexed>| match place {
-        Some(p) => placed(p, group),
-        None => group,
+    let references = match reference_place {
+        Some(place) => {
+            let (there, others) = placed(place, references);
+            asked.extend(
+                others
+                    .into_iter()
+                    .filter(|(_, t)| query.asks_about_kind(&t.label)),
+            );
+            there
+        }
+        None => references,
     };
-    let mut kept = at(filter, asked);
-    kept.extend(at(reference_place, references));
+    let mut kept = match filter {
+        Some(place) => placed(place, asked).0,
+        None => asked,
+    };
+    kept.extend(references.into_iter().map(|(i, t)| {
+        (
+            i,
+            Target {
+                reference: true,
+                ..t
+            },
+        )
+    }));
     kept.sort_by_key(|(i, _)| *i);
     kept.into_iter().map(|(_, t)| t).collect()
 }
@@ -193,12 +214,12 @@ pub(super) fn apply_position(query: &Query, targets: Vec<Target>) -> Vec<Target>
 /// A target with its index among the targets, so that placing keeps their order.
 type Indexed = (usize, Target);
 
-/// The targets at `place`, or the one furthest that way.
-fn placed(place: &str, targets: Vec<Indexed>) -> Vec<Indexed> {
+/// The targets at `place`, or the one furthest that way; and the others.
+fn placed(place: &str, targets: Vec<Indexed>) -> (Vec<Indexed>, Vec<Indexed>) {
     let located = |t: &Target| location_words(t.centre.x, t.centre.y);
     let matches = |(_, t): &Indexed| position_matches(place, &located(t));
     if targets.iter().any(matches) {
-        return targets.into_iter().filter(matches).collect();
+        return targets.into_iter().partition(matches);
     }
     // How far a target lies in the filter's direction (x right, y back).
     let toward = |(_, t): &Indexed| -> f64 {
@@ -213,9 +234,17 @@ fn placed(place: &str, targets: Vec<Indexed>) -> Vec<Indexed> {
             })
             .sum()
     };
-    targets
+    let furthest = targets
+        .iter()
+        .enumerate()
+        .max_by(|(_, a), (_, b)| toward(a).total_cmp(&toward(b)))
+        .map(|(k, _)| k);
+    let (there, others): (Vec<_>, Vec<_>) = targets
         .into_iter()
-        .max_by(|a, b| toward(a).total_cmp(&toward(b)))
-        .into_iter()
-        .collect()
+        .enumerate()
+        .partition(|(k, _)| Some(*k) == furthest);
+    (
+        there.into_iter().map(|(_, t)| t).collect(),
+        others.into_iter().map(|(_, t)| t).collect(),
+    )
 }

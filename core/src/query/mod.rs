@@ -579,8 +579,16 @@ pub(crate) fn position_phrase(positions: &[&str]) -> Option<String> {
 }
 
 impl Query {
-    /// Whether an object with this label is among those the query asks about.
+    /// Whether an object with this label is among those the query asks about: of a kind
+    /// asked about and not the relation's reference.
     pub fn wants(&self, label: &str) -> bool {
+        self.asks_about_kind(label) && !self.is_reference(label)
+    }
+
+    /// Whether the prompt asks about this kind (named, in a group named, or every fruit),
+    /// the reference's kind included: "Which banana is softer than the banana on the left?"
+    /// asks about the bananas that are not the reference.
+    pub fn asks_about_kind(&self, label: &str) -> bool {
         let named = self.targets.iter().any(|t| t == label);
         let grouped = self
             .categories
@@ -588,9 +596,18 @@ impl Query {
             .any(|c| c.members.iter().any(|m| m == label));
         // A group bounds "all": "of all the fruit, which citrus is softest" is about the citrus.
         let every = self.all && self.categories.is_empty();
-        !self.exclude.iter().any(|e| e == label)
-            && !self.is_reference(label)
-            && (every || named || grouped)
+        !self.exclude.iter().any(|e| e == label) && (every || named || grouped)
+    }
+
+    /// Whether this object is among those the query asks about: a reference at a place
+    /// ("than the banana on the left") is the one there, and the others of its kind may be
+    /// asked about; without a place every object of the reference's kind is the reference.
+    pub fn asks_about(&self, label: &str, is_reference: bool) -> bool {
+        if self.relation.as_ref().is_some_and(|r| r.position.is_some()) {
+            !is_reference && self.asks_about_kind(label)
+        } else {
+            self.wants(label)
+        }
     }
 
     /// Whether the answer needs this object pressed: it is asked about, or it is what the
