@@ -97,7 +97,7 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
                 threshold = Some((dir == "harder", e));
             }
             // softer:apple: the direction and the fruit held against; softer:banana@left
-            // with the reference's place ('_' for a space).
+            // with the reference's place ('_' for a space); softer:apple+mango: several.
             "relation" => {
                 let (dir, name) = value.split_once(':').unwrap();
                 let (name, place) = match name.split_once('@') {
@@ -156,10 +156,13 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
             "threshold {got_threshold:?}, expected {threshold:?}"
         ));
     }
-    let got_relation = query
-        .relation
-        .as_ref()
-        .map(|r| (r.harder, r.reference.clone(), r.position.clone()));
+    let got_relation = query.relation.as_ref().map(|r| {
+        (
+            r.harder,
+            r.kinds().collect::<Vec<_>>().join("+"),
+            r.position.clone(),
+        )
+    });
     if got_relation != relation {
         wrong.push(format!("relation {got_relation:?}, expected {relation:?}"));
     }

@@ -576,6 +576,38 @@ fn a_question_against_another_fruit_presses_it_and_selects_the_fruit_past_its_re
     assert_eq!(selected_labels(&a), Vec::<String>::new());
     let answer = a["answer"].as_str().unwrap();
     assert!(answer.contains("I found no peach"), "{answer}");
+    // Several references: past every one of them, each said with its reading, the one that
+    // bounds last; both pressed and marked as what the others are held against.
+    let a = ask_json(
+        "scenes/demo.toml",
+        "Which fruit is softer than the apple and the mango?",
+    );
+    let mut got = selected_labels(&a);
+    got.sort();
+    assert_eq!(got, ["banana", "lime", "tomato"], "{}", a["answer"]);
+    let mut references: Vec<&str> = a["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|o| o["reference"] == true)
+        .map(|o| o["label"].as_str().unwrap())
+        .collect();
+    references.sort();
+    assert_eq!(references, ["apple", "mango"]);
+    let answer = a["answer"].as_str().unwrap();
+    assert!(
+        answer.starts_with("Three fruit are softer than both the "),
+        "{answer}"
+    );
+    let a = ask_json(
+        "scenes/demo.toml",
+        "Which fruit is softer than the apple and the peach?",
+    );
+    assert!(selected_labels(&a).is_empty());
+    let answer = a["answer"].as_str().unwrap();
+    assert!(answer.contains("I found no peach"), "{answer}");
+    let e = fails(&["parse", "Is anything softer than the apple or the mango?"]);
+    assert!(e.contains("'or' leaves open which fruit"), "{e}");
 }
 
 #[test]

@@ -74,13 +74,13 @@ pub(crate) fn stiffness(m: &Measured) -> f64 {
 pub fn held_against(query: &Query, objects: &[Measured]) -> Option<Threshold> {
     query.threshold.clone().or_else(|| {
         let r = query.relation.as_ref()?;
-        let moduli: Vec<f64> = objects
+        let readings: Vec<(&str, f64)> = objects
             .iter()
             // With a place ("than the banana on the left") grounding marked only the one there.
-            .filter(|m| m.reference && m.label == r.reference && m.hardness.is_some())
-            .map(stiffness)
+            .filter(|m| m.reference && r.holds_against(&m.label) && m.hardness.is_some())
+            .map(|m| (m.label.as_str(), stiffness(m)))
             .collect();
-        r.resolve(&moduli)
+        r.resolve(&readings)
     })
 }
 

@@ -369,15 +369,35 @@ pub fn explain(
         Intent::Threshold => match (super::held_against(query, objects), &query.relation) {
             (Some(t), _) => parts.extend(past_threshold(query, &t, objects, selected)),
             (None, Some(r)) => {
-                let why = if objects.iter().any(|m| m.reference) {
-                    format!("I could not measure the {}", r.named())
-                } else {
-                    format!("I found no {} on the table", r.named())
+                // The first reference not found, else the first not measured.
+                let of_kind = |k: &str| -> Vec<&Measured> {
+                    objects
+                        .iter()
+                        .filter(|m| m.reference && m.label == k)
+                        .collect()
+                };
+                let named = |k: &str| {
+                    if r.also.is_empty() {
+                        r.named()
+                    } else {
+                        k.to_string()
+                    }
+                };
+                let why = match r.kinds().find(|k| of_kind(k).is_empty()) {
+                    Some(k) => format!("I found no {} on the table", named(k)),
+                    None => {
+                        let k = r
+                            .kinds()
+                            .find(|k| of_kind(k).iter().all(|m| m.hardness.is_none()))
+                            .unwrap_or(&r.reference);
+                        format!("I could not measure the {}", named(k))
+                    }
                 };
                 parts.push(format!(
-                    "{why}, so I cannot say which {} is {} than it.",
+                    "{why}, so I cannot say which {} is {} than {}.",
                     query.asked_kind(),
-                    r.relation()
+                    r.relation(),
+                    if r.also.is_empty() { "it" } else { "them" }
                 ))
             }
             (None, None) => {}

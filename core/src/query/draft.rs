@@ -65,6 +65,9 @@ pub struct DraftThreshold {
 pub struct DraftRelation {
     pub harder: bool,
     pub reference: String,
+    /// Further references named with it ("than the apple and the mango").
+    #[serde(default)]
+    pub also: Vec<String>,
     /// Where the reference stands ("left"), when the prompt says.
     #[serde(default)]
     pub position: Option<String>,
@@ -97,6 +100,7 @@ impl QueryDraft {
             relation: query.relation.as_ref().map(|r| DraftRelation {
                 harder: r.harder,
                 reference: r.reference.clone(),
+                also: r.also.clone(),
                 position: r.position.clone(),
             }),
             goal: query.goal.as_ref().map(|g| g.said.clone()),
@@ -179,14 +183,29 @@ impl QueryDraft {
             None => None,
         };
         let relation = match self.relation {
-            Some(r) => Some(Relation {
-                harder: r.harder,
-                reference: fruit("relation.reference", &r.reference)?,
-                position: match &r.position {
+            Some(r) => {
+                let reference = fruit("relation.reference", &r.reference)?;
+                let mut also: Vec<String> = Vec::new();
+                for name in &r.also {
+                    let kind = fruit("relation.also", name)?;
+                    if kind != reference && !also.contains(&kind) {
+                        also.push(kind);
+                    }
+                }
+                let position = match &r.position {
                     Some(p) => place("relation.position", p)?,
                     None => None,
-                },
-            }),
+                };
+                if position.is_some() && !also.is_empty() {
+                    return Err("relation.position: a place with several references".into());
+                }
+                Some(Relation {
+                    harder: r.harder,
+                    reference,
+                    also,
+                    position,
+                })
+            }
             None => None,
         };
         let holds_against = threshold.is_some() || relation.is_some();

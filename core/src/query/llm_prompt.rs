@@ -39,8 +39,9 @@ pub fn system_role(catalog: &FruitCatalog) -> String {
          count (how many the question expects, or null); ranked (an order was asked for); \
          unknown (fruit named that are not in the catalog); threshold ({{\"harder\": bool, \
          \"value\": \"2 MPa\"}} with the unit: MPa, kPa, Shore A or Shore 00, or null); \
-         relation ({{\"harder\": bool, \"reference\": catalog name}} for \"softer than the \
-         apple\", or null); goal (what the fruit is wanted for, as said back to the user: \
+         relation ({{\"harder\": bool, \"reference\": catalog name, \"also\": [further \
+         catalog names]}} for \"softer than the apple\" or \"than the apple and the mango\", \
+         or null); goal (what the fruit is wanted for, as said back to the user: \
          \"for a smoothie\", or null). Catalog names: {names}.",
         colours = lexicon::COLOURS.join(", "),
         names = catalog.names().join(", "),

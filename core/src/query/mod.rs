@@ -200,6 +200,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let mut positions: Vec<&str> = Vec::new();
     let mut excluding = false;
     let mut relation: Option<threshold::Relation> = None;
+    // The word after the last reference and its place ("than the apple| and the mango").
+    let mut reference_end = 0;
     // Where the reference stands ("than the left banana", "than the banana on the left").
     let mut reference_positions: Vec<&str> = Vec::new();
     // "riper than the banana": a fruit held against another's ripeness.
@@ -288,14 +290,56 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                 relation = Some(threshold::Relation {
                     harder,
                     reference: f.name.clone(),
+                    also: Vec::new(),
                     position: None,
                 });
+                reference_end = i + 1;
                 // "than the banana on the left", "than the apple at the back": the place is
                 // the reference's, not a filter on the fruit asked about.
                 if let Some((places, end)) = place_after(&words, i + 1) {
                     reference_positions.extend(places);
                     consumed_until = end;
+                    reference_end = end;
                 }
+                continue;
+            }
+            // "softer than the apple and the mango", "than the lime, the kiwi and the
+            // tomato": a further reference, past which the fruit must be too; "or" leaves open
+            // which one, so it is refused. A list after a comma that ends in "or" names the
+            // fruit asked about ("Which is softer than the lime, the banana or the tomato?").
+            if let Some(r) = relation.as_mut()
+                && reference_end > 0
+                && reference_end <= i
+                && ((breaks[reference_end - 1] && list_ends_with_and(&words, i, is_fruit))
+                    || words[reference_end..i]
+                        .iter()
+                        .any(|w| w == "and" || w == "or"))
+                && words[reference_end..i]
+                    .iter()
+                    .all(|w| matches!(w.as_str(), "and" | "or" | "the" | "a" | "an" | "both"))
+            {
+                let value = format!("the {}", f.name);
+                if words[reference_end..i].iter().any(|w| w == "or") {
+                    return Err(QueryError::BadThreshold {
+                        value,
+                        message: format!(
+                            "'or' leaves open which fruit to hold against: say 'the {} and the {}' for both, or ask about one",
+                            r.reference, f.name
+                        ),
+                    });
+                }
+                if !reference_positions.is_empty() || place_after(&words, i + 1).is_some() {
+                    return Err(QueryError::BadThreshold {
+                        value,
+                        message:
+                            "a place beside several fruit to hold against: ask about one at a time"
+                                .into(),
+                    });
+                }
+                if f.name != r.reference && !r.also.contains(&f.name) {
+                    r.also.push(f.name.clone());
+                }
+                reference_end = i + 1;
                 continue;
             }
             let list = if excluding {
@@ -335,7 +379,9 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             continue;
         }
         if let Some(n) = lexicon::count_word(w) {
-            if noun_after(i).is_some() || w == "both" {
+            // "than both the apple and the mango" counts the references, not the fruit asked.
+            let of_references = prev == Some("than");
+            if !of_references && (noun_after(i).is_some() || w == "both") {
                 filters.count.get_or_insert(n);
             }
             continue;
@@ -554,6 +600,16 @@ fn place_after(words: &[String], i: usize) -> Option<(Vec<&'static str>, usize)>
 }
 
 /// A second bound beside a first ("softer than the mango but harder than the banana").
+/// Whether the list of fruit from word `i` on ("the kiwi and the tomato", "the kiwi, the
+/// tomato and the lime") is joined by "and" before anything else.
+fn list_ends_with_and(words: &[String], i: usize, is_fruit: impl Fn(&str) -> bool) -> bool {
+    words[i..]
+        .iter()
+        .map(String::as_str)
+        .find(|w| !(is_fruit(w) || matches!(*w, "the" | "a" | "an")))
+        == Some("and")
+}
+
 fn second_bound(name: &str, first: &str) -> QueryError {
     QueryError::BadThreshold {
         value: format!("the {name}"),
@@ -618,7 +674,9 @@ impl Query {
 
     /// Whether objects with this label are the relation's reference ("than the apple").
     pub fn is_reference(&self, label: &str) -> bool {
-        self.relation.as_ref().is_some_and(|r| r.reference == label)
+        self.relation
+            .as_ref()
+            .is_some_and(|r| r.holds_against(label))
     }
 
     /// How the answer names what was asked about: "fruit", "citrus fruit", "lime or lemon".

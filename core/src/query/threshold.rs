@@ -79,8 +79,13 @@ pub struct Relation {
     pub harder: bool,
     /// The reference's catalog name.
     pub reference: String,
+    /// Further references named with it ("softer than the apple and the mango"): the fruit
+    /// asked for are past every one of them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub also: Vec<String>,
     /// Where the reference stands, when the prompt says ("than the banana on the left"):
-    /// only the one there is held against, in `explain::location_words` order.
+    /// only the one there is held against, in `explain::location_words` order. Only for a
+    /// single reference.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub position: Option<String>,
 }
@@ -91,34 +96,76 @@ impl Relation {
         relation_word(self.harder)
     }
 
-    /// The reference as the answer names it: "banana", "banana at the left".
+    /// The references' catalog names, in the order named.
+    pub fn kinds(&self) -> impl Iterator<Item = &str> {
+        std::iter::once(self.reference.as_str()).chain(self.also.iter().map(String::as_str))
+    }
+
+    /// Whether objects of this kind are held against.
+    pub fn holds_against(&self, label: &str) -> bool {
+        self.kinds().any(|k| k == label)
+    }
+
+    /// The references as the answer names them after "the": "banana", "banana at the left",
+    /// "apple and the mango".
     pub fn named(&self) -> String {
         match &self.position {
             Some(p) => format!("{} at the {p}", self.reference),
-            None => self.reference.clone(),
+            None => self.kinds().collect::<Vec<_>>().join(" and the "),
         }
     }
 
-    /// The value of the reference's measured moduli (MPa; infinite: rigid) as a threshold:
-    /// with several of its kind, past every one of them ("softer than the apples" is
-    /// softer than the softest apple). None when none of them was measured.
-    pub fn resolve(&self, moduli: &[f64]) -> Option<Threshold> {
-        let (&first, rest) = moduli.split_first()?;
-        let bound = rest
-            .iter()
-            .fold(first, |b, &e| if self.harder { b.max(e) } else { b.min(e) });
-        let which = match (moduli.len(), self.harder) {
-            (1, _) => "the",
-            (_, true) => "the hardest",
-            (_, false) => "the softest",
-        };
-        let reference = self.named();
-        let said = if bound.is_finite() && self.position.is_some() {
-            format!("{which} {reference}, at {bound:.2} MPa")
-        } else if bound.is_finite() {
-            format!("{which} {reference} at {bound:.2} MPa")
-        } else {
-            format!("{which} {reference}, which is rigid")
+    /// The value of the references' measured moduli (MPa; infinite: rigid), given with each
+    /// object's kind, as a threshold: past every one of them ("softer than the apples" is
+    /// softer than the softest apple; "than the apple and the mango" than the softer of
+    /// the two). None when a reference's kind has no measured object.
+    pub fn resolve(&self, readings: &[(&str, f64)]) -> Option<Threshold> {
+        let past = |b: f64, e: f64| if self.harder { b.max(e) } else { b.min(e) };
+        let several = !self.also.is_empty();
+        let mut bound: Option<f64> = None;
+        let mut phrases = Vec::new();
+        for kind in self.kinds() {
+            let moduli: Vec<f64> = readings
+                .iter()
+                .filter(|(k, _)| *k == kind)
+                .map(|(_, e)| *e)
+                .collect();
+            let (&first, rest) = moduli.split_first()?;
+            let kind_bound = rest.iter().fold(first, |b, &e| past(b, e));
+            bound = Some(bound.map_or(kind_bound, |b| past(b, kind_bound)));
+            let which = match (moduli.len(), self.harder) {
+                (1, _) => "the",
+                (_, true) => "the hardest",
+                (_, false) => "the softest",
+            };
+            let named = if several {
+                kind.to_string()
+            } else {
+                self.named()
+            };
+            phrases.push((
+                kind_bound,
+                if kind_bound.is_finite() && self.position.is_some() {
+                    format!("{which} {named}, at {kind_bound:.2} MPa")
+                } else if kind_bound.is_finite() {
+                    format!("{which} {named} at {kind_bound:.2} MPa")
+                } else {
+                    format!("{which} {named}, which is rigid")
+                },
+            ));
+        }
+        // The reference that bounds comes last, where the value's other scale follows it.
+        let bound = bound?;
+        if let Some(k) = phrases.iter().position(|(b, _)| *b == bound) {
+            let last = phrases.remove(k);
+            phrases.push(last);
+        }
+        let phrases: Vec<String> = phrases.into_iter().map(|(_, p)| p).collect();
+        let said = match phrases.as_slice() {
+            [one] => one.clone(),
+            [a, b] => format!("both {a} and {b}"),
+            [init @ .., last] => format!("each of {} and {last}", init.join(", ")),
+            [] => return None,
         };
         Some(Threshold {
             harder: self.harder,
@@ -150,7 +197,17 @@ fn than_before(words: &[String], i: usize) -> Option<usize> {
     let mut j = i.checked_sub(1)?;
     while matches!(
         words[j].as_str(),
-        "the" | "a" | "an" | "that" | "this" | "my" | "your" | "ripe" | "unripe"
+        "the"
+            | "a"
+            | "an"
+            | "that"
+            | "this"
+            | "my"
+            | "your"
+            | "ripe"
+            | "unripe"
+            | "both"
+            | "either"
     ) || super::lexicon::COLOURS.contains(&words[j].as_str())
         || super::lexicon::position_word(&words[j]).is_some()
     {
@@ -452,12 +509,14 @@ mod tests {
             position: None,
             harder: false,
             reference: "apple".into(),
+            also: Vec::new(),
         };
         assert_eq!(softer.resolve(&[]), None);
-        let one = softer.resolve(&[3.25]).unwrap();
+        assert_eq!(softer.resolve(&[("mango", 3.0)]), None);
+        let one = softer.resolve(&[("apple", 3.25)]).unwrap();
         assert_eq!(one.said, "the apple at 3.25 MPa");
         assert!(one.holds_for(3.0) && !one.holds_for(3.25));
-        let two = softer.resolve(&[3.25, 2.0]).unwrap();
+        let two = softer.resolve(&[("apple", 3.25), ("apple", 2.0)]).unwrap();
         assert_eq!(
             (two.modulus_mpa, two.said.as_str()),
             (2.0, "the softest apple at 2.00 MPa")
@@ -465,11 +524,34 @@ mod tests {
         let harder = Relation {
             position: None,
             harder: true,
+            ..softer.clone()
+        };
+        assert_eq!(
+            harder
+                .resolve(&[("apple", 3.25), ("apple", 2.0)])
+                .unwrap()
+                .modulus_mpa,
+            3.25
+        );
+        // Several references: past each of them, each said with its reading; one of them
+        // unmeasured leaves nothing to hold against.
+        let both = Relation {
+            also: vec!["mango".into()],
             ..softer
         };
-        assert_eq!(harder.resolve(&[3.25, 2.0]).unwrap().modulus_mpa, 3.25);
+        let t = both
+            .resolve(&[("mango", 3.36), ("apple", 3.29), ("lime", 1.7)])
+            .unwrap();
+        assert_eq!(t.modulus_mpa, 3.29);
         assert_eq!(
-            harder.resolve(&[f64::INFINITY]).unwrap().said,
+            t.said,
+            "both the mango at 3.36 MPa and the apple at 3.29 MPa"
+        );
+        assert_eq!(both.resolve(&[("apple", 3.29)]), None);
+        assert_eq!(both.named(), "apple and the mango");
+        assert!(both.holds_against("mango") && !both.holds_against("lime"));
+        assert_eq!(
+            harder.resolve(&[("apple", f64::INFINITY)]).unwrap().said,
             "the apple, which is rigid"
         );
     }
