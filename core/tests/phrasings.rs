@@ -70,6 +70,7 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     let mut position = None;
     let mut exclude = Vec::new();
     let mut count = None;
+    let mut size: Option<String> = None;
     let mut ranked = false;
     let mut unknown = Vec::new();
     let mut categories: Vec<String> = Vec::new();
@@ -85,6 +86,7 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
             "colour" => colour = Some(value.to_string()),
             "exclude" => exclude.push(value.to_string()),
             "count" => count = Some(value.parse().unwrap()),
+            "size" => size = Some(value.to_string()),
             "ranked" => ranked = value == "true",
             "unknown" => unknown.push(value.to_string()),
             "position" => position = Some(value.to_string()),
@@ -130,6 +132,10 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     }
     if query.exclude != exclude {
         wrong.push(format!("exclude {:?}, expected {exclude:?}", query.exclude));
+    }
+    let got_size = query.filters.size.map(|s| s.name().to_string());
+    if got_size != size {
+        wrong.push(format!("size {got_size:?}, expected {size:?}"));
     }
     if count.is_some() && query.filters.count != count {
         wrong.push(format!(

@@ -103,6 +103,9 @@ fn describe(q: &Query) -> String {
     if let Some(n) = q.filters.count {
         s += &format!("count:    {n}\n");
     }
+    if let Some(size) = q.filters.size {
+        s += &format!("size:     {}\n", size.name());
+    }
     if q.ranked {
         s += "ranked:   yes\n";
     }

@@ -686,6 +686,50 @@ position_m = [0.0, 0.1]
 }
 
 #[test]
+fn a_size_word_picks_the_instance_that_shows_the_camera_the_most_or_least() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("two-limes.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "two limes"
+[[objects]]
+kind = "lime"
+position_m = [-0.12, 0.0]
+size_m = [0.045, 0.045, 0.04]
+[[objects]]
+kind = "lime"
+position_m = [0.12, 0.02]
+size_m = [0.058, 0.058, 0.052]
+[[objects]]
+kind = "apple"
+position_m = [0.0, 0.1]
+"#,
+    )
+    .unwrap();
+    let scene = scene.to_str().unwrap();
+    let pressed_x = |a: &Value| -> Vec<f64> {
+        a["objects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|o| o["position_m"][0].as_f64().unwrap())
+            .collect()
+    };
+    // Only the one picked is pressed: the larger lime stands on the right.
+    let bigger = ask_json(scene, "How hard is the bigger lime?");
+    assert_eq!(selected_labels(&bigger), ["lime"]);
+    let x = pressed_x(&bigger);
+    assert!(x.len() == 1 && x[0] > 0.0, "{x:?}");
+    let smaller = ask_json(scene, "How hard is the smaller of the two limes?");
+    let x = pressed_x(&smaller);
+    assert!(x.len() == 1 && x[0] < 0.0, "{x:?}");
+    let answer = smaller["answer"].as_str().unwrap();
+    assert!(!answer.contains("You mentioned"), "{answer}");
+    let e = fails(&["parse", "Which fruit is bigger than the apple?"]);
+    assert!(e.contains("size against another fruit"), "{e}");
+}
+
+#[test]
 fn colour_and_position_filters_choose_the_fruit() {
     let scene = "scenes/demo.toml";
     let a = ask_json(scene, "How hard is the yellow one?");

@@ -417,7 +417,9 @@ pub fn explain(
             }
         }
     }
+    // "the larger of the two limes" counts the limes it picks from, not the one picked.
     if let Some(n) = query.filters.count
+        && query.filters.size.is_none()
         && !objects.is_empty()
         && objects.len() != n
     {

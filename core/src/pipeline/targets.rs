@@ -5,12 +5,14 @@
 use super::config::{PipelineConfig, PipelineError};
 use crate::devices::RgbdCamera;
 use crate::explain::location_words;
+use crate::frames::DepthImage;
+use crate::geometry::CameraIntrinsics;
 use crate::ground::centroid::median_depth;
 use crate::ground::colour_name::{colour_name, mean_colour};
 use crate::ground::detect::{Detector, RgbdView};
 use crate::ground::grounding::locate;
 use crate::press::site::{HeightMap, PadClearance, PressSite, press_site};
-use crate::query::{Query, position_matches};
+use crate::query::{Query, Size, position_matches};
 use glam::DVec3;
 
 pub(super) struct Target {
@@ -27,6 +29,8 @@ pub(super) struct Target {
     /// What the fruit asked about are held against ("than the banana on the left"), not
     /// asked about itself.
     pub(super) reference: bool,
+    /// The area the object shows the camera (m^2), which "the bigger lime" picks by.
+    pub(super) seen_area_m2: f64,
 }
 
 /// Detections for the query's targets, with refined-mask centroids from the depth median.
@@ -89,10 +93,11 @@ pub(super) fn ground<C: RgbdCamera>(
                 pad_yaw_rad: site.yaw_rad,
                 crowded: site.crowded,
                 reference: false,
+                seen_area_m2: seen_area_m2(&d.mask, &depth, &k),
             })
         })
         .collect();
-    let mut targets = apply_position(query, candidates);
+    let mut targets = apply_size(query, apply_position(query, candidates));
     // A stable order: left to right, then front to back.
     targets.sort_by(|a, b| {
         (a.centre.x, a.centre.y)
@@ -209,6 +214,42 @@ pub(super) fn apply_position(query: &Query, targets: Vec<Target>) -> Vec<Target>
     }));
     kept.sort_by_key(|(i, _)| *i);
     kept.into_iter().map(|(_, t)| t).collect()
+}
+
+/// The area a mask shows the camera (m^2): each pixel with a depth z covers (z / fx)(z / fy)
+/// facing it, so near and far objects compare by their true size.
+fn seen_area_m2(mask: &image::GrayImage, depth: &DepthImage, k: &CameraIntrinsics) -> f64 {
+    mask.enumerate_pixels()
+        .filter(|(_, _, m)| m[0] > 0)
+        .filter_map(|(u, v, _)| {
+            let z = f64::from(depth.get_pixel_checked(u, v)?[0]);
+            (z > 0.0 && z.is_finite()).then(|| (z / k.fx) * (z / k.fy))
+        })
+        .sum()
+}
+
+/// The one target asked about that shows the camera the most or least area, with the
+/// references, when the prompt picks by size ("the bigger lime"); all of them otherwise.
+pub(super) fn apply_size(query: &Query, targets: Vec<Target>) -> Vec<Target> {
+    let Some(size) = query.filters.size else {
+        return targets;
+    };
+    let area = |t: &Target| match size {
+        Size::Largest => t.seen_area_m2,
+        Size::Smallest => -t.seen_area_m2,
+    };
+    let pick = targets
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| !t.reference)
+        .max_by(|(_, a), (_, b)| area(a).total_cmp(&area(b)))
+        .map(|(i, _)| i);
+    targets
+        .into_iter()
+        .enumerate()
+        .filter(|(i, t)| t.reference || Some(*i) == pick)
+        .map(|(_, t)| t)
+        .collect()
 }
 
 /// A target with its index among the targets, so that placing keeps their order.

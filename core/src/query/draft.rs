@@ -6,7 +6,7 @@
 
 use super::threshold::{self, Relation, Threshold};
 use super::{
-    CategoryFilter, Extreme, Filters, Intent, Property, Query, goal, lexicon, position_phrase,
+    CategoryFilter, Extreme, Filters, Intent, Property, Query, Size, goal, lexicon, position_phrase,
 };
 use crate::catalog::FruitCatalog;
 use serde::{Deserialize, Serialize};
@@ -37,6 +37,9 @@ pub struct QueryDraft {
     pub position: Option<String>,
     #[serde(default)]
     pub count: Option<usize>,
+    /// "largest" or "smallest": the one asked about picked by size.
+    #[serde(default)]
+    pub size: Option<Size>,
     #[serde(default)]
     pub ranked: bool,
     /// Fruit the prompt names that the catalog does not know.
@@ -91,6 +94,7 @@ impl QueryDraft {
             color: query.filters.color.clone(),
             position: query.filters.position.clone(),
             count: query.filters.count,
+            size: query.filters.size,
             ranked: query.ranked,
             unknown: query.unknown.clone(),
             threshold: query.threshold.as_ref().map(|t| DraftThreshold {
@@ -286,6 +290,7 @@ impl QueryDraft {
                 color,
                 position,
                 count: self.count,
+                size: self.size,
             },
             ranked: self.ranked,
             unknown,

@@ -122,6 +122,16 @@ pub fn position_word(w: &str) -> Option<&'static str> {
     })
 }
 
+/// Size words: which end of size they pick ("the bigger lime", "the smallest apple").
+pub fn size_word(w: &str) -> Option<super::Size> {
+    use super::Size::{Largest, Smallest};
+    Some(match w {
+        "big" | "bigger" | "biggest" | "large" | "larger" | "largest" | "huge" => Largest,
+        "small" | "smaller" | "smallest" | "little" | "tiny" | "tinier" | "tiniest" => Smallest,
+        _ => return None,
+    })
+}
+
 /// Small counts ("both", "the two limes", "all 3 apples").
 pub fn count_word(w: &str) -> Option<usize> {
     Some(match w {

@@ -36,7 +36,8 @@ pub fn system_role(catalog: &FruitCatalog) -> String {
          {groups}); all (true when the question is about every fruit, or every one the \
          filters keep); exclude (fruit left out); color (one of {colours}, or null); position \
          (left, right, front, back, centre or two of them such as \"left front\", or null); \
-         count (how many the question expects, or null); ranked (an order was asked for); \
+         count (how many the question expects, or null); size (\"largest\" or \"smallest\" \
+         when one is picked by size: \"the bigger lime\", or null); ranked (an order was asked for); \
          unknown (fruit named that are not in the catalog); threshold ({{\"harder\": bool, \
          \"value\": \"2 MPa\"}} with the unit: MPa, kPa, Shore A or Shore 00, or null); \
          relation ({{\"harder\": bool, \"reference\": catalog name, \"also\": [further \

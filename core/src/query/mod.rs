@@ -51,6 +51,28 @@ pub struct Filters {
     pub position: Option<String>,
     /// How many objects the prompt expects ("both bananas", "the two limes").
     pub count: Option<usize>,
+    /// The one of those asked about that shows the camera the most or least ("the bigger
+    /// lime", "the smallest of the apples").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size: Option<Size>,
+}
+
+/// Which end of size the prompt picks an object by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Size {
+    Largest,
+    Smallest,
+}
+
+impl Size {
+    /// As the typed query and `parse` say it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Size::Largest => "largest",
+            Size::Smallest => "smallest",
+        }
+    }
 }
 
 /// A group of the catalog the prompt names ("the citrus fruits"), with its kinds.
@@ -383,6 +405,31 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             let of_references = prev == Some("than");
             if !of_references && (noun_after(i).is_some() || w == "both") {
                 filters.count.get_or_insert(n);
+            }
+            continue;
+        }
+        // "the bigger lime", "the smallest of the apples", "the big one": one object by size
+        // ("bigger than the apple" compares sizes, which the twin does not answer).
+        if let Some(size) = lexicon::size_word(w) {
+            let compares = at(i + 1) == Some("than");
+            // "the small fruits" describes them, it does not pick one: a base size word
+            // before a plural picks nothing.
+            let base = matches!(w, "big" | "large" | "huge" | "small" | "little" | "tiny");
+            let picks = at(i + 1).is_some_and(|n| {
+                let plural = lexicon::singular(n) != n;
+                n == "of"
+                    || n == "one"
+                    || (is_noun(n) && !(base && plural))
+                    || lexicon::COLOURS.contains(&n)
+            });
+            if compares {
+                return Err(QueryError::Unsupported {
+                    what: format!("size against another fruit ('{w} than')"),
+                    instead: "ask how hard, soft or ripe the fruit are".into(),
+                });
+            }
+            if picks {
+                filters.size.get_or_insert(size);
             }
             continue;
         }
