@@ -383,9 +383,14 @@ pub fn explain(
                         k.to_string()
                     }
                 };
-                let why = match r.kinds().find(|k| of_kind(k).is_empty()) {
-                    Some(k) => format!("I found no {} on the table", named(k)),
-                    None => {
+                let missing: Vec<String> = r
+                    .kinds()
+                    .filter(|k| of_kind(k).is_empty())
+                    .map(named)
+                    .collect();
+                let why = match missing.as_slice() {
+                    [_, ..] => format!("I found no {} on the table", missing.join(" or ")),
+                    [] => {
                         let k = r
                             .kinds()
                             .find(|k| of_kind(k).iter().all(|m| m.hardness.is_none()))

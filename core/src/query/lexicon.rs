@@ -113,8 +113,8 @@ pub const COMPARING: &[&str] = &["compare", "comparison", "versus", "vs", "than"
 /// `explain::location_words`.
 pub fn position_word(w: &str) -> Option<&'static str> {
     Some(match w {
-        "left" | "leftmost" => "left",
-        "right" | "rightmost" => "right",
+        "left" | "leftmost" | "lefthand" => "left",
+        "right" | "rightmost" | "righthand" => "right",
         "centre" | "center" | "middle" | "central" | "centremost" => "centre",
         "front" | "frontmost" | "nearest" | "closest" => "front",
         "back" | "rear" | "backmost" | "farthest" | "furthest" => "back",
@@ -150,6 +150,9 @@ pub fn count_word(w: &str) -> Option<usize> {
 
 /// Phrases rewritten to one word before the prompt is read word by word. Longer phrases first.
 pub const PHRASES: &[(&str, &str)] = &[
+    // "the left-hand banana": the hyphen is a space by then.
+    ("left hand", "left"),
+    ("right hand", "right"),
     ("ready to be eaten", "ripe"),
     ("ready to eat", "ripe"),
     ("good to eat", "ripe"),

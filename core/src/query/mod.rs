@@ -246,6 +246,17 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         }
         let rest: Vec<&str> = words[i..].iter().take(3).map(String::as_str).collect();
         if let Some((category, n)) = catalog.category_at(&rest) {
+            // "softer than the citrus fruits": a group to hold against is not read yet.
+            if threshold::comparison_before(&words, i).is_some()
+                || (relation.is_some()
+                    && reference_end > 0
+                    && joins_references(&words, &breaks, reference_end, i, is_fruit))
+            {
+                return Err(QueryError::Unsupported {
+                    what: format!("holding fruit against a group ({})", category.name),
+                    instead: "name the fruit to hold against, e.g. \"softer than the lime and the lemon\"".into(),
+                });
+            }
             consumed_until = i + n;
             let members = catalog.members(&category.name);
             if excluding {
@@ -303,6 +314,20 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             if let Some(harder) = threshold::comparison_before(&words, i) {
                 // "softer than the mango but harder than the banana", "softer than the apple
                 // and harder than 1 MPa": one bound at a time, as for values.
+                // "softer than the apple and softer than the mango": the same bound, twice.
+                if let Some(r) = relation.as_mut()
+                    && r.harder == harder
+                    && r.position.is_none()
+                    && reference_positions.is_empty()
+                    && threshold.is_none()
+                    && place_after(&words, i + 1).is_none()
+                {
+                    if f.name != r.reference && !r.also.contains(&f.name) {
+                        r.also.push(f.name.clone());
+                    }
+                    reference_end = i + 1;
+                    continue;
+                }
                 if let Some(first) = relation.as_ref().map(|r| format!("the {}", r.reference)) {
                     return Err(second_bound(&f.name, &first));
                 }
@@ -331,14 +356,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             // fruit asked about ("Which is softer than the lime, the banana or the tomato?").
             if let Some(r) = relation.as_mut()
                 && reference_end > 0
-                && reference_end <= i
-                && ((breaks[reference_end - 1] && list_ends_with_and(&words, i, is_fruit))
-                    || words[reference_end..i]
-                        .iter()
-                        .any(|w| w == "and" || w == "or"))
-                && words[reference_end..i]
-                    .iter()
-                    .all(|w| matches!(w.as_str(), "and" | "or" | "the" | "a" | "an" | "both"))
+                && joins_references(&words, &breaks, reference_end, i, is_fruit)
             {
                 let value = format!("the {}", f.name);
                 if words[reference_end..i].iter().any(|w| w == "or") {
@@ -350,7 +368,12 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                         ),
                     });
                 }
-                if !reference_positions.is_empty() || place_after(&words, i + 1).is_some() {
+                if !reference_positions.is_empty()
+                    || place_after(&words, i + 1).is_some()
+                    || words[reference_end..i]
+                        .iter()
+                        .any(|w| lexicon::position_word(w).is_some())
+                {
                     return Err(QueryError::BadThreshold {
                         value,
                         message:
@@ -377,8 +400,13 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         }
         if lexicon::OTHER_FRUITS.contains(&w) {
             let name = lexicon::singular(w);
-            // "softer than the pineapple": there is nothing to hold the fruit against.
-            if threshold::comparison_before(&words, i).is_some() {
+            // "softer than the pineapple", "than the apple and the pineapple": there is
+            // nothing to hold the fruit against.
+            if threshold::comparison_before(&words, i).is_some()
+                || (relation.is_some()
+                    && reference_end > 0
+                    && joins_references(&words, &breaks, reference_end, i, is_fruit))
+            {
                 return Err(QueryError::UnknownFruit {
                     name,
                     known: catalog.names().join(", "),
@@ -476,6 +504,21 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         .first()
         .is_some_and(|w| matches!(w.as_str(), "is" | "are" | "was" | "does" | "do" | "can"));
     if let Some(r) = relation.take_if(|_| yes_no && !targets.is_empty()) {
+        // A yes/no question against several ("Is the banana harder than both the tomato
+        // and the avocado?") would answer about the first alone.
+        if let Some(other) = r.also.first() {
+            return Err(QueryError::Unsupported {
+                what: format!(
+                    "a yes/no comparison with the {} and the {other}",
+                    r.reference
+                ),
+                instead: format!(
+                    "ask e.g. \"Which fruit is {} than the {} and the {other}?\"",
+                    r.relation(),
+                    r.reference
+                ),
+            });
+        }
         targets.push(r.reference);
     }
     // "Is the banana riper than the mango?" compares; "Which fruit is riper than the
@@ -500,11 +543,16 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let filtered = filters.color.is_some() || filters.position.is_some();
     // "Is anything harder than 2 MPa?", "What should I keep for next week?": a value or a
     // use with nothing named is about every fruit.
+    // "What's ripe?", "Which is softest?": a question word and a property, nothing named.
+    let asks_which = words
+        .first()
+        .is_some_and(|w| matches!(w.as_str(), "what" | "whats" | "which"))
+        && !properties.is_empty();
     let all = generic
         || !exclude.is_empty()
         || (targets.is_empty()
             && (filtered
-                || ((threshold.is_some() || relation.is_some() || goal.is_some())
+                || ((threshold.is_some() || relation.is_some() || goal.is_some() || asks_which)
                     && categories.is_empty()
                     && unknown.is_empty())));
     if targets.is_empty() && categories.is_empty() && !all {
@@ -647,6 +695,52 @@ fn place_after(words: &[String], i: usize) -> Option<(Vec<&'static str>, usize)>
 }
 
 /// A second bound beside a first ("softer than the mango but harder than the banana").
+/// Whether the words from `end` (just after a reference and its place) to the fruit at `i`
+/// join it to the references: "and (the)", "as well as", "plus", "and also", "both", a
+/// "ripe" or a colour or a place before it, or a comma in a list that ends in "and" (a list
+/// ending in "or" names the fruit asked about: "softer than the lime, the banana or the
+/// tomato"). A place among them is for the caller to refuse.
+fn joins_references(
+    words: &[String],
+    breaks: &[bool],
+    end: usize,
+    i: usize,
+    is_fruit: impl Fn(&str) -> bool + Copy,
+) -> bool {
+    if end > i {
+        return false;
+    }
+    let gap = &words[end..i];
+    let joiner = gap
+        .iter()
+        .any(|w| matches!(w.as_str(), "and" | "or" | "plus" | "nor") || w == "well");
+    let comma = end > 0 && breaks[end - 1] && list_ends_with_and(words, i, is_fruit);
+    (joiner || comma)
+        && gap.iter().all(|w| {
+            matches!(
+                w.as_str(),
+                "and"
+                    | "or"
+                    | "the"
+                    | "a"
+                    | "an"
+                    | "both"
+                    | "as"
+                    | "well"
+                    | "plus"
+                    | "also"
+                    | "ripe"
+                    | "unripe"
+                    | "that"
+                    | "this"
+                    | "of"
+                    | "each"
+                    | "all"
+            ) || lexicon::COLOURS.contains(&w.as_str())
+                || lexicon::position_word(w).is_some()
+        })
+}
+
 /// Whether the list of fruit from word `i` on ("the kiwi and the tomato", "the kiwi, the
 /// tomato and the lime") is joined by "and" before anything else.
 fn list_ends_with_and(words: &[String], i: usize, is_fruit: impl Fn(&str) -> bool) -> bool {

@@ -208,6 +208,9 @@ fn than_before(words: &[String], i: usize) -> Option<usize> {
             | "unripe"
             | "both"
             | "either"
+            | "each"
+            | "all"
+            | "of"
     ) || super::lexicon::COLOURS.contains(&words[j].as_str())
         || super::lexicon::position_word(&words[j]).is_some()
     {
