@@ -683,6 +683,28 @@ position_m = [0.0, 0.1]
     assert_eq!(bananas_pressed(&which).len(), 2);
     let none = ask_json(scene, "Which banana is harder than the banana on the left?");
     assert!(selected_labels(&none).is_empty(), "{}", none["answer"]);
+    // Two of one kind told apart by place in a yes/no question, and "the other one".
+    let x_of_selected = |a: &Value| -> Vec<f64> {
+        a["selected"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|i| {
+                a["objects"][i.as_u64().unwrap() as usize]["position_m"][0]
+                    .as_f64()
+                    .unwrap()
+            })
+            .collect()
+    };
+    let yes = ask_json(
+        scene,
+        "Is the banana on the right softer than the banana on the left?",
+    );
+    let x = x_of_selected(&yes);
+    assert!(x.len() == 1 && x[0] > 0.0, "{}", yes["answer"]);
+    let other = ask_json(scene, "Is the left banana harder than the other one?");
+    let x = x_of_selected(&other);
+    assert!(x.len() == 1 && x[0] < 0.0, "{}", other["answer"]);
 }
 
 #[test]

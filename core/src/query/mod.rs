@@ -228,6 +228,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let mut reference_positions: Vec<&str> = Vec::new();
     // "riper than the banana": a fruit held against another's ripeness.
     let mut ripeness_reference: Option<String> = None;
+    // The ripeness reference is "the one" of the kind asked about.
+    let mut ripeness_of_one = false;
     let mut generic = false;
     // "all", "every", "fruits": a summary; "the fruit on the left", "the yellow one": one.
     let mut generic_plural = false;
@@ -417,6 +419,35 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             }
             continue;
         }
+        // "Which banana is softer than the one on the left?": "one" after a comparison
+        // stands for the one kind asked about.
+        if w == "one"
+            && relation.is_none()
+            && threshold.is_none()
+            && categories.is_empty()
+            && let [kind] = targets.as_slice()
+        {
+            if let Some(harder) = threshold::comparison_before(&words, i) {
+                relation = Some(threshold::Relation {
+                    harder,
+                    reference: kind.clone(),
+                    also: Vec::new(),
+                    position: None,
+                });
+                reference_end = i + 1;
+                if let Some((places, end)) = place_after(&words, i + 1) {
+                    reference_positions.extend(places);
+                    consumed_until = end;
+                    reference_end = end;
+                }
+                continue;
+            }
+            if threshold::ripeness_comparison_before(&words, i) {
+                ripeness_reference.get_or_insert_with(|| kind.clone());
+                ripeness_of_one = true;
+                continue;
+            }
+        }
         if lexicon::GENERIC.contains(&w) {
             // "kiwi fruit", "all bananas", "one of the limes": the word belongs to a fruit
             // name, not to every fruit.
@@ -472,7 +503,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                 || at(i + 1).is_some_and(|n| n == "side" || is_noun(n));
             // "than the left banana": the reference's place.
             let of_reference = (i + 1..words.len().min(i + 3))
-                .find(|&j| is_fruit(&words[j]))
+                .find(|&j| is_fruit(&words[j]) || words[j] == "one")
                 .is_some_and(|j| threshold::comparison_before(&words, j).is_some());
             if of_reference {
                 reference_positions.push(p);
@@ -503,7 +534,24 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let yes_no = words
         .first()
         .is_some_and(|w| matches!(w.as_str(), "is" | "are" | "was" | "does" | "do" | "can"));
-    if let Some(r) = relation.take_if(|_| yes_no && !targets.is_empty()) {
+    // "Is the banana on the right softer than the banana on the left?": two of one kind, told
+    // apart by place, stay the fruit asked about (at its place) held against the one at the
+    // reference's place.
+    let same_kind = relation
+        .as_ref()
+        .is_some_and(|r| targets.len() == 1 && targets[0] == r.reference && r.also.is_empty());
+    // "Is the left banana harder than the other one?": the other is across the table.
+    if same_kind && reference_positions.is_empty() {
+        reference_positions.extend(positions.iter().filter_map(|p| match *p {
+            "left" => Some("right"),
+            "right" => Some("left"),
+            "front" => Some("back"),
+            "back" => Some("front"),
+            _ => None,
+        }));
+    }
+    let same_kind_by_place = same_kind && !reference_positions.is_empty();
+    if let Some(r) = relation.take_if(|_| yes_no && !targets.is_empty() && !same_kind_by_place) {
         // A yes/no question against several ("Is the banana harder than both the tomato
         // and the avocado?") would answer about the first alone.
         if let Some(other) = r.also.first() {
@@ -523,6 +571,27 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     }
     // "Is the banana riper than the mango?" compares; "Which fruit is riper than the
     // banana?" would hold every fruit against one, which is not read yet.
+    // "Is the banana on the left riper than the one on the right?": the ripeness of two of
+    // one kind is not compared yet (it would be read as a comparison of one banana).
+    let named_twice = |name: &str| {
+        words
+            .iter()
+            .filter(|w| catalog.find_word(w).is_some_and(|f| f.name == name))
+            .count()
+            >= 2
+    };
+    if let Some(name) = &ripeness_reference
+        && targets.len() == 1
+        && targets[0] == *name
+        && (named_twice(name) || ripeness_of_one)
+    {
+        return Err(QueryError::Unsupported {
+            what: format!("the ripeness of one {name} against another"),
+            instead: format!(
+                "ask \"Which {name} is the ripest?\", or whether one is softer than the other"
+            ),
+        });
+    }
     if let Some(name) = ripeness_reference
         && !yes_no
     {

@@ -208,6 +208,7 @@ fn than_before(words: &[String], i: usize) -> Option<usize> {
             | "unripe"
             | "both"
             | "either"
+            | "other"
             | "each"
             | "all"
             | "of"
