@@ -336,20 +336,10 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                 if let Some(t) = &threshold {
                     return Err(second_bound(&f.name, &t.said));
                 }
-                relation = Some(threshold::Relation {
-                    harder,
-                    reference: f.name.clone(),
-                    also: Vec::new(),
-                    position: None,
-                });
-                reference_end = i + 1;
-                // "than the banana on the left", "than the apple at the back": the place is
-                // the reference's, not a filter on the fruit asked about.
-                if let Some((places, end)) = place_after(&words, i + 1) {
-                    reference_positions.extend(places);
-                    consumed_until = end;
-                    reference_end = end;
-                }
+                let (r, places, end) = relation_at(&words, i, harder, &f.name);
+                relation = Some(r);
+                reference_positions.extend(places);
+                (consumed_until, reference_end) = (consumed_until.max(end), end);
                 continue;
             }
             // "softer than the apple and the mango", "than the lime, the kiwi and the
@@ -428,18 +418,10 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             && let [kind] = targets.as_slice()
         {
             if let Some(harder) = threshold::comparison_before(&words, i) {
-                relation = Some(threshold::Relation {
-                    harder,
-                    reference: kind.clone(),
-                    also: Vec::new(),
-                    position: None,
-                });
-                reference_end = i + 1;
-                if let Some((places, end)) = place_after(&words, i + 1) {
-                    reference_positions.extend(places);
-                    consumed_until = end;
-                    reference_end = end;
-                }
+                let (r, places, end) = relation_at(&words, i, harder, kind);
+                relation = Some(r);
+                reference_positions.extend(places);
+                (consumed_until, reference_end) = (consumed_until.max(end), end);
                 continue;
             }
             if threshold::ripeness_comparison_before(&words, i) {
@@ -728,6 +710,27 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
 
 /// The place words of "on the left", "at the back", "in the front corner" starting at word
 /// `i`, and the index past them; None when no place follows.
+/// A relation to `kind` named at word `i`, the reference's place words ("than the banana on
+/// the left", "than the apple at the back": the place is the reference's, not a filter on
+/// the fruit asked about) and the word after the reference and its place.
+fn relation_at(
+    words: &[String],
+    i: usize,
+    harder: bool,
+    kind: &str,
+) -> (threshold::Relation, Vec<&'static str>, usize) {
+    let relation = threshold::Relation {
+        harder,
+        reference: kind.to_string(),
+        also: Vec::new(),
+        position: None,
+    };
+    match place_after(words, i + 1) {
+        Some((places, end)) => (relation, places, end),
+        None => (relation, Vec::new(), i + 1),
+    }
+}
+
 fn place_after(words: &[String], i: usize) -> Option<(Vec<&'static str>, usize)> {
     let mut j = i;
     // "in the middle" and "in front" arrive as one word ("centre", "front").
