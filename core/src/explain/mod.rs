@@ -77,7 +77,7 @@ pub fn held_against(query: &Query, objects: &[Measured]) -> Option<Threshold> {
         let readings: Vec<(&str, f64)> = objects
             .iter()
             // With a place ("than the banana on the left") grounding marked only the one there.
-            .filter(|m| m.reference && r.holds_against(&m.label) && m.hardness.is_some())
+            .filter(|m| m.reference && m.hardness.is_some())
             .map(|m| (m.label.as_str(), stiffness(m)))
             .collect();
         r.resolve(&readings)

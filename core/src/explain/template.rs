@@ -369,7 +369,7 @@ pub fn explain(
         Intent::Threshold => match (super::held_against(query, objects), &query.relation) {
             (Some(t), _) => parts.extend(past_threshold(query, &t, objects, selected)),
             (None, Some(r)) => {
-                // The first reference not found, else the first not measured.
+                // Every reference not found, else the first not measured.
                 let of_kind = |k: &str| -> Vec<&Measured> {
                     objects
                         .iter()

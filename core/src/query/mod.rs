@@ -868,15 +868,11 @@ impl Query {
         !self.exclude.iter().any(|e| e == label) && (every || named || grouped)
     }
 
-    /// Whether this object is among those the query asks about: a reference at a place
-    /// ("than the banana on the left") is the one there, and the others of its kind may be
-    /// asked about; without a place every object of the reference's kind is the reference.
+    /// Whether this object is among those the query asks about: of a kind asked about and
+    /// not marked by grounding as what the others are held against (the one at the
+    /// reference's place, or, without a place, every one of the reference's kind).
     pub fn asks_about(&self, label: &str, is_reference: bool) -> bool {
-        if self.relation.as_ref().is_some_and(|r| r.position.is_some()) {
-            !is_reference && self.asks_about_kind(label)
-        } else {
-            self.wants(label)
-        }
+        !is_reference && self.asks_about_kind(label)
     }
 
     /// Whether the answer needs this object pressed: it is asked about, or it is what the
