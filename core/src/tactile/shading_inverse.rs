@@ -28,18 +28,26 @@ const RING_MAGNITUDES: [f32; 5] = [0.1, 0.3, 0.6, 1.0, 1.6];
 const RING_DIRECTIONS: usize = 12;
 
 impl ShadingTable {
-    /// The table collapsed to normalised row position `v`, for reading a row backwards.
-    pub fn row(&self, v: f32) -> ShadingRow<'_> {
+    /// The table collapsed to normalised row position `v`, for shading a row forwards: each
+    /// lookup then costs half the quadratics, and the direction is `direction`'s, not libm's
+    /// atan2 (the renderer's table shading was a sixth of a 640 x 480 profile's `ask`).
+    pub fn lookup_row(&self, v: f32) -> ShadingRow<'_> {
         let poly = self
             .coefficients
             .chunks_exact(TERMS)
             .map(|t| [t[0] + t[2] * v + t[5] * v * v, t[1] + t[4] * v, t[3]])
             .collect();
-        let mut row = ShadingRow {
+        ShadingRow {
             table: self,
             poly,
             ring: Vec::new(),
-        };
+        }
+    }
+
+    /// The table collapsed to normalised row position `v`, for reading a row backwards: the
+    /// lookup row and the coarse ring of slopes the inverse searches from.
+    pub fn row(&self, v: f32) -> ShadingRow<'_> {
+        let mut row = self.lookup_row(v);
         for mag in RING_MAGNITUDES {
             let mag = mag * self.mag_max / 2.5;
             for k in 0..RING_DIRECTIONS {
@@ -128,7 +136,7 @@ impl ShadingRow<'_> {
     }
 
     /// The table's change at slope (gx, gy) and position u along the row.
-    fn change(&self, gx: f32, gy: f32, u: f32) -> [f32; 3] {
+    pub fn change(&self, gx: f32, gy: f32, u: f32) -> [f32; 3] {
         let b = self.bin(gx, gy);
         let n = self.corners(&b, u);
         let mut out = [0.0f32; 3];

@@ -152,12 +152,13 @@ impl<'a> ShadedFrame<'a> {
         match &self.optics.shading {
             Shading::Lights(_) => shade_row_lit(&self.lit, g, bg, fade, row),
             Shading::Table(table) => {
+                let table = table.lookup_row(2.0 * v);
                 for x in 0..w {
                     if let Some(flat) = flat.filter(|_| g[x] == [0.0, 0.0]) {
                         row[x] = flat[x];
                         continue;
                     }
-                    let d = table.change(g[x][0], g[x][1], 2.0 * self.us[x], 2.0 * v);
+                    let d = table.change(g[x][0], g[x][1], 2.0 * self.us[x]);
                     row[x] = std::array::from_fn(|c| (bg[x][c] + d[c]) * fade[x]);
                 }
             }
