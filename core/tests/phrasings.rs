@@ -99,14 +99,17 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
                 threshold = Some((dir == "harder", e));
             }
             // softer:apple: the direction and the fruit held against; softer:banana@left
-            // with the reference's place ('_' for a space); softer:apple+mango: several.
+            // with the reference's place ('_' for a space); softer:apple+mango: several;
+            // riper:banana@right, less_ripe:banana: by ripeness, two of one kind.
             "relation" => {
                 let (dir, name) = value.split_once(':').unwrap();
                 let (name, place) = match name.split_once('@') {
                     Some((n, p)) => (n, Some(p.replace('_', " "))),
                     None => (name, None),
                 };
-                relation = Some((dir == "harder", name.to_string(), place));
+                let harder = matches!(dir, "harder" | "less_ripe");
+                let ripeness = matches!(dir, "riper" | "less_ripe");
+                relation = Some((harder, ripeness, name.to_string(), place));
             }
             // goal=for_a_smoothie: the use as the answer says it back, '_' for spaces.
             "goal" => goal = Some(value.replace('_', " ")),
@@ -165,6 +168,7 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     let got_relation = query.relation.as_ref().map(|r| {
         (
             r.harder,
+            r.ripeness,
             r.kinds().collect::<Vec<_>>().join("+"),
             r.position.clone(),
         )

@@ -705,6 +705,32 @@ position_m = [0.0, 0.1]
     let other = ask_json(scene, "Is the left banana harder than the other one?");
     let x = x_of_selected(&other);
     assert!(x.len() == 1 && x[0] < 0.0, "{}", other["answer"]);
+    // Their ripeness, as the issue asked it: the overripe right banana is the riper, and
+    // the answer says so in ripeness, with each one's stage.
+    let riper = ask_json(
+        scene,
+        "Is the banana on the right riper than the one on the left?",
+    );
+    let x = x_of_selected(&riper);
+    assert!(x.len() == 1 && x[0] > 0.0, "{}", riper["answer"]);
+    let answer = riper["answer"].as_str().unwrap();
+    assert!(
+        answer.contains("riper than the banana at the left") && answer.contains("overripe"),
+        "{answer}"
+    );
+    let not = ask_json(
+        scene,
+        "Is the banana on the left riper than the one on the right?",
+    );
+    assert!(x_of_selected(&not).is_empty(), "{}", not["answer"]);
+    assert!(
+        not["answer"]
+            .as_str()
+            .unwrap()
+            .contains("is not riper than"),
+        "{}",
+        not["answer"]
+    );
 }
 
 #[test]

@@ -3,7 +3,7 @@
 
 use super::{Explainer, Explanation, Facts, Measured, stiffness};
 use crate::hardness::scale::HardnessReport;
-use crate::query::threshold::Threshold;
+use crate::query::threshold::{Threshold, comparison_word};
 use crate::query::{Extreme, Intent, Property, Query};
 
 /// The default explainer: the same facts always give the same words.
@@ -137,7 +137,12 @@ fn past_threshold(
             .copied()
             .max_by(|&a, &b| past(a).total_cmp(&past(b)));
         if let Some(i) = nearest {
-            let word = if t.harder { "hardest" } else { "softest" };
+            let word = match (t.ripeness, t.harder) {
+                (false, true) => "hardest",
+                (false, false) => "softest",
+                (true, true) => "least ripe",
+                (true, false) => "ripest",
+            };
             // Against another fruit, that fruit is past every other: the nearest is of them.
             let of = if query.relation.is_some() {
                 " of the others"
@@ -348,22 +353,20 @@ pub fn explain(
         }
         Intent::Compare if selected.len() >= 2 => {
             let (a, b) = (&objects[selected[0]], &objects[selected[1]]);
-            let rel = if stiffness(a) > stiffness(b) {
-                "harder"
-            } else {
-                "softer"
-            };
+            // Two of one kind asked by ripeness: within a kind the softer is the riper.
+            let by_ripeness = query.property == Property::Ripeness && a.label == b.label;
+            let rel = comparison_word(stiffness(a) > stiffness(b), by_ripeness);
             parts.push(capitalise(&format!(
                 "{}, is {rel} than {}.",
                 describe(a),
                 describe(b)
             )));
             if within_uncertainty(a, b) {
-                parts.push(
+                let alike = if by_ripeness { "ripe" } else { "hard" };
+                parts.push(format!(
                     "The difference is within the measurement uncertainty, so they may be \
-                     equally hard."
-                        .into(),
-                );
+                     equally {alike}."
+                ));
             }
         }
         Intent::Threshold => match (super::held_against(query, objects), &query.relation) {

@@ -74,6 +74,10 @@ pub struct DraftRelation {
     /// Where the reference stands ("left"), when the prompt says.
     #[serde(default)]
     pub position: Option<String>,
+    /// By ripeness between two of one kind ("riper than the one on the left"); `harder`
+    /// then means less ripe.
+    #[serde(default)]
+    pub ripeness: bool,
 }
 
 /// The longest name or phrase a draft may carry (a model's ramble is not a fruit).
@@ -106,6 +110,7 @@ impl QueryDraft {
                 reference: r.reference.clone(),
                 also: r.also.clone(),
                 position: r.position.clone(),
+                ripeness: r.ripeness,
             }),
             goal: query.goal.as_ref().map(|g| g.said.clone()),
         }
@@ -203,11 +208,17 @@ impl QueryDraft {
                 if position.is_some() && !also.is_empty() {
                     return Err("relation.position: a place with several references".into());
                 }
+                if r.ripeness && !(also.is_empty() && targets == [reference.as_str()]) {
+                    return Err(
+                        "relation.ripeness: only between two of the one kind asked about".into(),
+                    );
+                }
                 Some(Relation {
                     harder: r.harder,
                     reference,
                     also,
                     position,
+                    ripeness: r.ripeness,
                 })
             }
             None => None,

@@ -41,8 +41,9 @@ pub fn system_role(catalog: &FruitCatalog) -> String {
          unknown (fruit named that are not in the catalog); threshold ({{\"harder\": bool, \
          \"value\": \"2 MPa\"}} with the unit: MPa, kPa, Shore A or Shore 00, or null); \
          relation ({{\"harder\": bool, \"reference\": catalog name, \"also\": [further \
-         catalog names]}} for \"softer than the apple\" or \"than the apple and the mango\", \
-         or null); goal (what the fruit is wanted for, as said back to the user: \
+         catalog names], \"ripeness\": bool}} for \"softer than the apple\" or \"than the \
+         apple and the mango\", ripeness true for \"riper than the one on the left\" between \
+         two of one kind (harder: less ripe), or null); goal (what the fruit is wanted for, as said back to the user: \
          \"for a smoothie\", or null). Catalog names: {names}.",
         colours = lexicon::COLOURS.join(", "),
         names = catalog.names().join(", "),

@@ -226,10 +226,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let mut reference_end = 0;
     // Where the reference stands ("than the left banana", "than the banana on the left").
     let mut reference_positions: Vec<&str> = Vec::new();
-    // "riper than the banana": a fruit held against another's ripeness.
+    // "riper than the mango": a fruit held against another kind's ripeness.
     let mut ripeness_reference: Option<String> = None;
-    // The ripeness reference is "the one" of the kind asked about.
-    let mut ripeness_of_one = false;
     let mut generic = false;
     // "all", "every", "fruits": a summary; "the fruit on the left", "the yellow one": one.
     let mut generic_plural = false;
@@ -309,7 +307,17 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             }
         }
         if let Some(f) = catalog.find_word(w) {
-            if threshold::ripeness_comparison_before(&words, i) {
+            if let Some(less_ripe) = threshold::ripeness_comparison_before(&words, i) {
+                // "Is the banana on the left riper than the banana on the right?": two of
+                // one kind, held against each other as "softer than" is.
+                if relation.is_none() && threshold.is_none() && targets == [f.name.as_str()] {
+                    let (mut r, places, end) = relation_at(&words, i, less_ripe, &f.name);
+                    r.ripeness = true;
+                    relation = Some(r);
+                    reference_positions.extend(places);
+                    (consumed_until, reference_end) = (consumed_until.max(end), end);
+                    continue;
+                }
                 ripeness_reference.get_or_insert_with(|| f.name.clone());
             }
             // "softer than the apple": the apple is what the others are held against.
@@ -417,16 +425,16 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             && categories.is_empty()
             && let [kind] = targets.as_slice()
         {
-            if let Some(harder) = threshold::comparison_before(&words, i) {
-                let (r, places, end) = relation_at(&words, i, harder, kind);
+            let by_ripeness = threshold::ripeness_comparison_before(&words, i);
+            if let Some((harder, ripeness)) = threshold::comparison_before(&words, i)
+                .map(|h| (h, false))
+                .or(by_ripeness.map(|h| (h, true)))
+            {
+                let (mut r, places, end) = relation_at(&words, i, harder, kind);
+                r.ripeness = ripeness;
                 relation = Some(r);
                 reference_positions.extend(places);
                 (consumed_until, reference_end) = (consumed_until.max(end), end);
-                continue;
-            }
-            if threshold::ripeness_comparison_before(&words, i) {
-                ripeness_reference.get_or_insert_with(|| kind.clone());
-                ripeness_of_one = true;
                 continue;
             }
         }
@@ -443,7 +451,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         }
         if let Some(n) = lexicon::count_word(w) {
             // "than both the apple and the mango" counts the references, not the fruit asked.
-            let of_references = prev == Some("than");
+            let of_references =
+                prev == Some("than") || (prev == Some("the") && i >= 2 && words[i - 2] == "than");
             if !of_references && (noun_after(i).is_some() || w == "both") {
                 filters.count.get_or_insert(n);
             }
@@ -479,14 +488,19 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             // one", "leftmost"): "is that right?" is not.
             let placed = !matches!(w, "left" | "right")
                 || prev.is_some_and(|p| {
-                    matches!(p, "the" | "on" | "to" | "at" | "far" | "most")
-                        || lexicon::position_word(p).is_some()
+                    matches!(
+                        p,
+                        "the" | "on" | "to" | "at" | "far" | "most" | "your" | "my"
+                    ) || lexicon::position_word(p).is_some()
                 })
                 || at(i + 1).is_some_and(|n| n == "side" || is_noun(n));
             // "than the left banana": the reference's place.
             let of_reference = (i + 1..words.len().min(i + 3))
                 .find(|&j| is_fruit(&words[j]) || words[j] == "one")
-                .is_some_and(|j| threshold::comparison_before(&words, j).is_some());
+                .is_some_and(|j| {
+                    threshold::comparison_before(&words, j).is_some()
+                        || threshold::ripeness_comparison_before(&words, j).is_some()
+                });
             if of_reference {
                 reference_positions.push(p);
             } else if placed && !positions.contains(&p) {
@@ -510,6 +524,21 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let goal = properties.is_empty().then(|| goal::find(&words)).flatten();
     if let Some(g) = &goal {
         properties.push((g.property, Degree::Superlative, g.low));
+    }
+    // "Which fruit is softer than the?": a comparison that names nothing to hold against
+    // would otherwise read as the softest.
+    if let Some(t) = words.iter().rposition(|w| w == "than")
+        && words[t + 1..].iter().all(|w| {
+            matches!(
+                w.as_str(),
+                "the" | "a" | "an" | "that" | "this" | "my" | "your" | BREAK
+            )
+        })
+    {
+        return Err(QueryError::BadThreshold {
+            value: words[t..].join(" "),
+            message: "names nothing to hold the fruit against; say e.g. 'softer than 2 MPa' or 'softer than the apple'".into(),
+        });
     }
     // "Is the mango harder than the avocado?" compares two named fruit, the reference one of
     // them; "Which apple is softer than the lime?" holds the named ones against it.
@@ -553,27 +582,6 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     }
     // "Is the banana riper than the mango?" compares; "Which fruit is riper than the
     // banana?" would hold every fruit against one, which is not read yet.
-    // "Is the banana on the left riper than the one on the right?": the ripeness of two of
-    // one kind is not compared yet (it would be read as a comparison of one banana).
-    let named_twice = |name: &str| {
-        words
-            .iter()
-            .filter(|w| catalog.find_word(w).is_some_and(|f| f.name == name))
-            .count()
-            >= 2
-    };
-    if let Some(name) = &ripeness_reference
-        && targets.len() == 1
-        && targets[0] == *name
-        && (named_twice(name) || ripeness_of_one)
-    {
-        return Err(QueryError::Unsupported {
-            what: format!("the ripeness of one {name} against another"),
-            instead: format!(
-                "ask \"Which {name} is the ripest?\", or whether one is softer than the other"
-            ),
-        });
-    }
     if let Some(name) = ripeness_reference
         && !yes_no
     {
@@ -636,7 +644,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     if let Some(harder) = threshold
         .as_ref()
         .map(|t| t.harder)
-        .or(relation.as_ref().map(|r| r.harder))
+        // Ripeness within one kind is worded as ripeness ("Is the left banana riper ...?").
+        .or(relation.as_ref().filter(|r| !r.ripeness).map(|r| r.harder))
     {
         property = if harder {
             Property::Hardness
@@ -724,6 +733,7 @@ fn relation_at(
         reference: kind.to_string(),
         also: Vec::new(),
         position: None,
+        ripeness: false,
     };
     match place_after(words, i + 1) {
         Some((places, end)) => (relation, places, end),
@@ -745,7 +755,11 @@ fn place_after(words: &[String], i: usize) -> Option<(Vec<&'static str>, usize)>
             return None;
         }
         j += 1;
-        if words.get(j).is_some_and(|w| w == "the") {
+        // "on the left", "on your left" (the one asking stands where the camera looks from).
+        if words
+            .get(j)
+            .is_some_and(|w| matches!(w.as_str(), "the" | "your" | "my"))
+        {
             j += 1;
         }
     }

@@ -17,6 +17,10 @@ pub struct Threshold {
     pub modulus_mpa: f64,
     /// The value as the prompt gave it, with its unit: "2 MPa", "30 Shore A".
     pub said: String,
+    /// Held against another of the same kind by ripeness ("riper than the one on the
+    /// left"): the same bound, worded "riper" or "less ripe".
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub ripeness: bool,
 }
 
 impl Threshold {
@@ -29,9 +33,9 @@ impl Threshold {
         }
     }
 
-    /// "harder" or "softer", as the answer words the relation.
+    /// "harder" or "softer" ("less ripe" or "riper"), as the answer words the relation.
     pub fn relation(&self) -> &'static str {
-        relation_word(self.harder)
+        comparison_word(self.harder, self.ripeness)
     }
 
     /// The value on every scale; None for "rigid".
@@ -71,6 +75,15 @@ pub(crate) fn relation_word(harder: bool) -> &'static str {
     if harder { "harder" } else { "softer" }
 }
 
+/// The relation's word: by ripeness within one kind the harder is the less ripe.
+pub(crate) fn comparison_word(harder: bool, ripeness: bool) -> &'static str {
+    match (ripeness, harder) {
+        (false, _) => relation_word(harder),
+        (true, true) => "less ripe",
+        (true, false) => "riper",
+    }
+}
+
 /// Another object the question holds the fruit against ("softer than the apple"): its
 /// value is the reference's measured hardness, known once it is pressed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -88,12 +101,18 @@ pub struct Relation {
     /// single reference.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub position: Option<String>,
+    /// Ripeness between two of one kind ("Is the banana on the left riper than the one on
+    /// the right?"): every catalog kind softens as it ripens, so within a kind the riper is
+    /// the softer; `harder` then means less ripe. Across kinds stages are not comparable by
+    /// modulus, and such a question is a comparison of the kinds' stages instead.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub ripeness: bool,
 }
 
 impl Relation {
-    /// "harder" or "softer", as the answer words the relation.
+    /// "harder" or "softer" ("less ripe" or "riper"), as the answer words the relation.
     pub fn relation(&self) -> &'static str {
-        relation_word(self.harder)
+        comparison_word(self.harder, self.ripeness)
     }
 
     /// The references' catalog names, in the order named.
@@ -171,24 +190,27 @@ impl Relation {
             harder: self.harder,
             modulus_mpa: bound,
             said,
+            ripeness: self.ripeness,
         })
     }
 }
 
-/// Whether the words just before word `i` compare ripeness with it: "riper than (the) X",
-/// "less ripe than X", "greener than X".
-pub fn ripeness_comparison_before(words: &[String], i: usize) -> bool {
-    let Some(than) = than_before(words, i) else {
-        return false;
+/// Whether the words just before word `i` compare ripeness with it ("riper than (the) X",
+/// "less ripe than X", "greener than X"), and if so whether the fruit asked about is the
+/// less ripe (true: "greener", "less ripe") or the riper.
+pub fn ripeness_comparison_before(words: &[String], i: usize) -> Option<bool> {
+    let k = than_before(words, i)?.checked_sub(1)?;
+    let before = k.checked_sub(1).map(|m| words[m].as_str());
+    let (less_ripe, at) = match (before, words[k].as_str()) {
+        (_, "riper" | "readier") => (false, k),
+        (_, "greener") => (true, k),
+        (Some(more @ ("more" | "less")), base @ ("ripe" | "mature" | "green")) => {
+            ((more == "less") == (base != "green"), k - 1)
+        }
+        _ => return None,
     };
-    let Some(k) = than.checked_sub(1) else {
-        return false;
-    };
-    match words[k].as_str() {
-        "riper" | "greener" | "readier" => true,
-        "ripe" | "mature" | "green" => k > 0 && matches!(words[k - 1].as_str(), "more" | "less"),
-        _ => false,
-    }
+    let negated = at > 0 && matches!(words[at - 1].as_str(), "not" | "no" | "never" | "t");
+    Some(less_ripe != negated)
 }
 
 /// The index of "than" just before word `i`, past articles and what describes the fruit
@@ -214,6 +236,9 @@ fn than_before(words: &[String], i: usize) -> Option<usize> {
             | "of"
     ) || super::lexicon::COLOURS.contains(&words[j].as_str())
         || super::lexicon::position_word(&words[j]).is_some()
+        // "than the two apples" (a numeral there would be a value: "than 2 MPa").
+        || (super::lexicon::count_word(&words[j]).is_some()
+            && words[j].chars().all(char::is_alphabetic))
     {
         j = j.checked_sub(1)?;
     }
@@ -416,6 +441,7 @@ pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
             harder,
             modulus_mpa: value.modulus_mpa().unwrap_or(f64::INFINITY),
             said,
+            ripeness: false,
         });
     }
     Ok(found)
@@ -445,6 +471,16 @@ fn value_at(words: &[String], i: usize) -> Option<Result<(Hardness, String, usiz
         })
     };
     let attached = number.trim_start_matches(|c: char| c.is_ascii_digit() || c == '.' || c == '-');
+    // "2e3 kPa", "1e-400 MPa" (split at its sign): an exponent, which the answer's scales
+    // do not print back; said plainly it is read.
+    if attached
+        .strip_prefix('e')
+        .is_some_and(|rest| rest.chars().all(|c| c.is_ascii_digit()))
+    {
+        return Some(Err(
+            "write the number in plain digits, without an exponent (e.g. 2000 kPa)".into(),
+        ));
+    }
     if !attached.is_empty() {
         // "2mpa", "30a"; "2j", "3rd" are no values at all.
         let h = Hardness::parse(number).ok()?;
@@ -508,12 +544,36 @@ mod tests {
     }
 
     #[test]
+    fn a_ripeness_comparison_says_which_is_the_less_ripe() {
+        let at_end = |t: &str| {
+            let w = words(t);
+            ripeness_comparison_before(&w, w.len() - 1)
+        };
+        assert_eq!(at_end("riper than the banana"), Some(false));
+        assert_eq!(at_end("readier than the banana"), Some(false));
+        assert_eq!(at_end("greener than the banana"), Some(true));
+        assert_eq!(at_end("more ripe than the banana"), Some(false));
+        assert_eq!(at_end("less ripe than the banana"), Some(true));
+        assert_eq!(at_end("less mature than the banana"), Some(true));
+        assert_eq!(at_end("more green than the banana"), Some(true));
+        assert_eq!(at_end("less green than the banana"), Some(false));
+        assert_eq!(at_end("not riper than the banana"), Some(true));
+        assert_eq!(at_end("softer than the banana"), None);
+        assert_eq!(at_end("ripe than the banana"), None);
+        // Worded as the relation's answer.
+        assert_eq!(comparison_word(false, true), "riper");
+        assert_eq!(comparison_word(true, true), "less ripe");
+        assert_eq!(comparison_word(true, false), "harder");
+    }
+
+    #[test]
     fn a_relation_holds_the_fruit_past_every_measured_reference() {
         let softer = Relation {
             position: None,
             harder: false,
             reference: "apple".into(),
             also: Vec::new(),
+            ripeness: false,
         };
         assert_eq!(softer.resolve(&[]), None);
         assert_eq!(softer.resolve(&[("mango", 3.0)]), None);
