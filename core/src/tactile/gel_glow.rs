@@ -319,8 +319,33 @@ fn weighted_sum(out: &mut [f32], taps: &[&[f32]], k: &[f32]) {
     }
 }
 
-/// A term's source over a whole frame, blurred. A one-channel source is blurred alone (a
-/// third of the work) and comes back in channel 0, the others zero, as the shaders hold it.
+/// A term's source over a whole frame, blurred: a one-channel source alone (a third of the
+/// work, and no frame of zeros to mix), the others in all three channels.
+enum BlurredSource {
+    One(Vec<[f32; 1]>),
+    Three(Vec<[f32; 3]>),
+}
+
+fn blur_source(
+    term: &GlowTerm,
+    change: &[[f32; 3]],
+    indentation_mm: &[f32],
+    width: usize,
+    height: usize,
+) -> BlurredSource {
+    let at = change
+        .iter()
+        .zip(indentation_mm)
+        .map(|(&c, &d)| term.source.at(c, d));
+    if term.source.channels() == 1 {
+        let src: Vec<[f32; 1]> = at.map(|v| [v[0]]).collect();
+        BlurredSource::One(blur(&src, width, height, term.sigma_px))
+    } else {
+        BlurredSource::Three(blur(&at.collect::<Vec<_>>(), width, height, term.sigma_px))
+    }
+}
+
+/// `blur_source` in channel 0 of three, the others zero, as the shaders hold it.
 fn blurred_source(
     term: &GlowTerm,
     change: &[[f32; 3]],
@@ -328,18 +353,9 @@ fn blurred_source(
     width: usize,
     height: usize,
 ) -> Vec<[f32; 3]> {
-    let at = change
-        .iter()
-        .zip(indentation_mm)
-        .map(|(&c, &d)| term.source.at(c, d));
-    if term.source.channels() == 1 {
-        let src: Vec<[f32; 1]> = at.map(|v| [v[0]]).collect();
-        blur(&src, width, height, term.sigma_px)
-            .into_iter()
-            .map(|[v]| [v, 0.0, 0.0])
-            .collect()
-    } else {
-        blur(&at.collect::<Vec<_>>(), width, height, term.sigma_px)
+    match blur_source(term, change, indentation_mm, width, height) {
+        BlurredSource::One(b) => b.into_iter().map(|[v]| [v, 0.0, 0.0]).collect(),
+        BlurredSource::Three(b) => b,
     }
 }
 
@@ -488,13 +504,25 @@ impl GelGlow {
         let terms = self.terms();
         // The blurs are independent: made on the cores, summed in the terms' order.
         let blurred = map_on_cores(&terms, |term| {
-            blurred_source(term, change, indentation_mm, width, height)
+            blur_source(term, change, indentation_mm, width, height)
         });
         let mut out = vec![[0.0f32; 3]; change.len()];
         for (term, blurred) in terms.iter().zip(blurred) {
-            for (o, b) in out.iter_mut().zip(&blurred) {
-                for (c, row) in term.mix.iter().enumerate() {
-                    o[c] += row[0] * b[0] + row[1] * b[1] + row[2] * b[2];
+            match blurred {
+                // The shaders' sum with the zero channels left out: the same bits.
+                BlurredSource::One(b) => {
+                    for (o, [v]) in out.iter_mut().zip(&b) {
+                        for (c, row) in term.mix.iter().enumerate() {
+                            o[c] += row[0] * v;
+                        }
+                    }
+                }
+                BlurredSource::Three(b) => {
+                    for (o, b) in out.iter_mut().zip(&b) {
+                        for (c, row) in term.mix.iter().enumerate() {
+                            o[c] += row[0] * b[0] + row[1] * b[1] + row[2] * b[2];
+                        }
+                    }
                 }
             }
         }

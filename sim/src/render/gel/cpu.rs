@@ -180,7 +180,7 @@ fn shading_change(
     p: &RenderParams,
     optics: &SensorOptics,
     heights: &[f32],
-) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+) -> (Arc<Vec<[f32; 3]>>, Vec<[f32; 3]>) {
     let flat = shared_flat_shading(optics);
     let w = p.width as usize;
     let g = slopes(p, heights);
@@ -196,7 +196,7 @@ fn shading_change(
             }
         },
     );
-    (flat.to_vec(), change)
+    (flat, change)
 }
 
 /// Optics whose flat shading was made, and it; a few kept.
@@ -241,7 +241,7 @@ fn glowing(
     }
     let (flat, change) = shading_change(p, optics, heights);
     let mut out = glow.apply(&change, heights, p.width as usize, p.height as usize);
-    for (o, f) in out.iter_mut().zip(&flat) {
+    for (o, f) in out.iter_mut().zip(flat.iter()) {
         *o = std::array::from_fn(|c| f[c] + o[c]);
     }
     out
@@ -436,7 +436,9 @@ impl CpuRenderer {
         optics: &SensorOptics,
         fields: &super::GelImageFields,
     ) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
-        shading_change(&RenderParams::new(optics, 1), optics, &fields.normal_mm)
+        let (flat, change) =
+            shading_change(&RenderParams::new(optics, 1), optics, &fields.normal_mm);
+        (flat.to_vec(), change)
     }
 
     /// The shading stage alone (slopes + shading + vignetting, and the glow when the optics
