@@ -731,6 +731,32 @@ position_m = [0.0, 0.1]
         "{}",
         not["answer"]
     );
+    // A bare place after the comparison is the one there; a place on one side of a question
+    // about two kinds keeps the other kind (it filtered the lime away).
+    let bare = ask_json(scene, "Is the left banana harder than the right?");
+    let x = x_of_selected(&bare);
+    assert!(x.len() == 1 && x[0] < 0.0, "{}", bare["answer"]);
+    let lime = ask_json(scene, "Is the left banana softer than the lime?");
+    let answer = lime["answer"].as_str().unwrap();
+    assert!(answer.contains("is not softer than the lime"), "{answer}");
+}
+
+#[test]
+fn one_of_a_kind_has_no_other_to_hold_against() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("one-banana.toml");
+    std::fs::write(
+        &scene,
+        "name = \"one banana\"\n[[objects]]\nkind = \"banana\"\nposition_m = [-0.13, 0.0]\n\
+         [[objects]]\nkind = \"lime\"\nposition_m = [0.13, 0.0]\n",
+    )
+    .unwrap();
+    let a = ask_json(
+        scene.to_str().unwrap(),
+        "Is the banana on the left riper than the one on the right?",
+    );
+    let answer = a["answer"].as_str().unwrap();
+    assert!(answer.contains("I found one banana only"), "{answer}");
 }
 
 #[test]

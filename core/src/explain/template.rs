@@ -118,8 +118,18 @@ fn past_threshold(
     if selected.is_empty() {
         if asked.is_empty() {
             // The reference alone was on the table (or none of the group asked about).
-            if query.relation.is_some() {
-                parts.push(format!("I found no {kind} to hold against {value}."));
+            match &query.relation {
+                // "Is the banana on the left riper than the one on the right?" with one banana.
+                Some(r)
+                    if query.targets == [r.reference.as_str()]
+                        && objects.iter().filter(|m| m.label == r.reference).count() == 1 =>
+                {
+                    parts.push(format!(
+                        "I found one {kind} only, so there is no other {kind} to hold it against."
+                    ))
+                }
+                Some(_) => parts.push(format!("I found no {kind} to hold against {value}.")),
+                None => {}
             }
             return parts;
         }

@@ -246,6 +246,24 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         }
         let rest: Vec<&str> = words[i..].iter().take(3).map(String::as_str).collect();
         if let Some((category, n)) = catalog.category_at(&rest) {
+            // "Which non-citrus fruit ...?", "a fruit that isn't citrus": read as the group
+            // itself it answered about the citrus.
+            if !excluding && prev.is_some_and(negation) {
+                return Err(QueryError::Unsupported {
+                    what: format!(
+                        "a group turned around by '{}'",
+                        if prev == Some("t") {
+                            "not"
+                        } else {
+                            prev.unwrap_or_default()
+                        }
+                    ),
+                    instead: format!(
+                        "say \"except the {} fruits\", e.g. \"Which fruit except the {} fruits is the softest?\"",
+                        category.name, category.name
+                    ),
+                });
+            }
             // "softer than the citrus fruits": a group to hold against is not read yet.
             if threshold::comparison_before(&words, i).is_some()
                 || (relation.is_some()
@@ -478,6 +496,17 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                     instead: "ask how hard, soft or ripe the fruit are".into(),
                 });
             }
+            // "harder than the smaller apple": the reference picked by size is not read (the
+            // size would pick among the fruit asked about, and answer about one).
+            if picks
+                && (threshold::comparison_before(&words, i).is_some()
+                    || threshold::ripeness_comparison_before(&words, i).is_some())
+            {
+                return Err(QueryError::Unsupported {
+                    what: format!("a fruit to hold against picked by size ('than the {w}')"),
+                    instead: "tell them apart by place, e.g. \"Is the apple on the left harder than the one on the right?\"".into(),
+                });
+            }
             if picks {
                 filters.size.get_or_insert(size);
             }
@@ -501,6 +530,26 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                     threshold::comparison_before(&words, j).is_some()
                         || threshold::ripeness_comparison_before(&words, j).is_some()
                 });
+            // "Is the left banana harder than the right?": a bare place after the comparison
+            // is the one there of the kind asked about.
+            let bare = !of_reference
+                && relation.is_none()
+                && threshold.is_none()
+                && categories.is_empty()
+                && !at(i + 1).is_some_and(|n| is_noun(n) || n == "one");
+            if bare
+                && let [kind] = targets.as_slice()
+                && let Some((harder, ripeness)) = threshold::comparison_before(&words, i)
+                    .map(|h| (h, false))
+                    .or(threshold::ripeness_comparison_before(&words, i).map(|h| (h, true)))
+            {
+                let (mut r, _, end) = relation_at(&words, i, harder, kind);
+                r.ripeness = ripeness;
+                relation = Some(r);
+                reference_positions.push(p);
+                reference_end = end;
+                continue;
+            }
             if of_reference {
                 reference_positions.push(p);
             } else if placed && !positions.contains(&p) {
@@ -509,6 +558,14 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             continue;
         }
         if let Some(pw) = lexicon::property_word(w) {
+            // "Which fruit is not soft?" read as the softest; "not softer than" is read
+            // where the comparison is.
+            if prev.is_some_and(negation) && at(i + 1) != Some("than") {
+                return Err(QueryError::Unsupported {
+                    what: format!("a property turned around ('not {w}')"),
+                    instead: "ask for its opposite, e.g. \"Which fruit is the hardest?\" for \"not soft\"".into(),
+                });
+            }
             let (degree, flipped) = match (pw.degree, prev) {
                 (Degree::Base, Some("most")) => (Degree::Superlative, false),
                 (Degree::Base, Some("least")) => (Degree::Superlative, true),
@@ -518,6 +575,18 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             };
             properties.push((pw.property, degree, pw.inverted ^ flipped));
         }
+    }
+    // "Which banana is riper, the left or the right one?": a choice between the two places
+    // picks among the kind at either, not the one at the first.
+    if targets.len() == 1
+        && relation.is_none()
+        && words.iter().any(|w| w == "or")
+        && matches!(
+            positions.as_slice(),
+            ["left", "right"] | ["right", "left"] | ["front", "back"] | ["back", "front"]
+        )
+    {
+        positions.clear();
     }
     // "Which fruit for a smoothie?": the use names the property when no word does, and is
     // read as its superlative ("the ripest").
@@ -560,9 +629,41 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             "back" => Some("front"),
             _ => None,
         }));
+        // "Is the middle banana harder than the other one?": no place across from it.
+        if !positions.is_empty() && reference_positions.is_empty() {
+            return Err(QueryError::Unsupported {
+                what: format!(
+                    "'the other' beside the {} at the {}",
+                    targets[0],
+                    positions.join(" ")
+                ),
+                instead: format!(
+                    "say where the other stands, e.g. \"than the {} on the left\"",
+                    targets[0]
+                ),
+            });
+        }
     }
     let same_kind_by_place = same_kind && !reference_positions.is_empty();
-    if let Some(r) = relation.take_if(|_| yes_no && !targets.is_empty() && !same_kind_by_place) {
+    // "Is the big apple softer than the other one?": a size picks one among the fruit asked
+    // about, and the other would be the same apple.
+    if same_kind && filters.size.is_some() {
+        return Err(QueryError::Unsupported {
+            what: format!("two {}s told apart by size", targets[0]),
+            instead: format!(
+                "tell them apart by place, e.g. \"Is the {0} on the left harder than the one on the right?\"",
+                targets[0]
+            ),
+        });
+    }
+    // A place on either side of a yes/no question about two kinds ("Is the left banana
+    // softer than the lime?", "Is the lime harder than the banana on the left?") is that
+    // side's alone: it stays a relation, whose reference the place filter leaves alone (as a
+    // comparison of the two, the place filtered the lime away).
+    let placed = !positions.is_empty() || !reference_positions.is_empty();
+    if let Some(r) =
+        relation.take_if(|_| yes_no && !targets.is_empty() && !same_kind_by_place && !placed)
+    {
         // A yes/no question against several ("Is the banana harder than both the tomato
         // and the avocado?") would answer about the first alone.
         if let Some(other) = r.also.first() {
@@ -778,6 +879,11 @@ fn place_after(words: &[String], i: usize) -> Option<(Vec<&'static str>, usize)>
         j += 1;
     }
     Some((places, j))
+}
+
+/// A word that turns what follows around: "not", "non-", the "t" of "isn't", "never".
+fn negation(w: &str) -> bool {
+    matches!(w, "not" | "non" | "t" | "never")
 }
 
 /// A second bound beside a first ("softer than the mango but harder than the banana").

@@ -377,6 +377,22 @@ pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
     let mut read_until = 0;
     for i in 0..words.len() {
         let names_scale = i > 0 && words[i - 1] == "shore";
+        // "NaN MPa", "inf MPa", "two MPa", "２ MPa": a value the number reader does not take,
+        // which would otherwise drop the bound without a word.
+        let w = words[i].as_str();
+        let unreadable = matches!(w, "nan" | "inf" | "infinity")
+            || (super::lexicon::count_word(w).is_some() && w.chars().all(char::is_alphabetic))
+            || w.chars().any(|c| c.is_numeric() && !c.is_ascii_digit());
+        if unreadable
+            && words
+                .get(i + 1)
+                .is_some_and(|u| matches!(u.as_str(), "mpa" | "kpa" | "shore"))
+        {
+            return Err(QueryError::BadThreshold {
+                value: w.to_string(),
+                message: "write the value in plain digits, e.g. 2 MPa or 30 Shore A".into(),
+            });
+        }
         if i < read_until || names_scale || !is_number(&words[i]) {
             continue;
         }
