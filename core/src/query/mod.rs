@@ -457,6 +457,25 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             }
         }
         if lexicon::GENERIC.contains(&w) {
+            // "softer than the fruit on the left", "than the yellow one": a reference named
+            // by place or colour alone read as the softest fruit there.
+            if relation.is_none()
+                && threshold.is_none()
+                && !(w == "one" && targets.len() == 1)
+                // "softer than the others" is the softest, as it read before.
+                && prev != Some("other")
+                && w != "others"
+                && !noun_after(i).is_some_and(is_fruit)
+                && (threshold::comparison_before(&words, i).is_some()
+                    || threshold::ripeness_comparison_before(&words, i).is_some())
+            {
+                return Err(QueryError::Unsupported {
+                    what: format!(
+                        "a fruit to hold against not named by its kind ('than the ... {w}')"
+                    ),
+                    instead: "name it, e.g. \"softer than the banana on the left\"".into(),
+                });
+            }
             // "kiwi fruit", "all bananas", "one of the limes": the word belongs to a fruit
             // name, not to every fruit.
             let after_fruit = prev.is_some_and(is_fruit);
