@@ -443,11 +443,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             && categories.is_empty()
             && let [kind] = targets.as_slice()
         {
-            let by_ripeness = threshold::ripeness_comparison_before(&words, i);
-            if let Some((harder, ripeness)) = threshold::comparison_before(&words, i)
-                .map(|h| (h, false))
-                .or(by_ripeness.map(|h| (h, true)))
-            {
+            if let Some((harder, ripeness)) = threshold::any_comparison_before(&words, i) {
                 let (mut r, places, end) = relation_at(&words, i, harder, kind);
                 r.ripeness = ripeness;
                 relation = Some(r);
@@ -466,8 +462,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                 && prev != Some("other")
                 && w != "others"
                 && !noun_after(i).is_some_and(is_fruit)
-                && (threshold::comparison_before(&words, i).is_some()
-                    || threshold::ripeness_comparison_before(&words, i).is_some())
+                && threshold::any_comparison_before(&words, i).is_some()
             {
                 return Err(QueryError::Unsupported {
                     what: format!(
@@ -517,10 +512,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             }
             // "harder than the smaller apple": the reference picked by size is not read (the
             // size would pick among the fruit asked about, and answer about one).
-            if picks
-                && (threshold::comparison_before(&words, i).is_some()
-                    || threshold::ripeness_comparison_before(&words, i).is_some())
-            {
+            if picks && threshold::any_comparison_before(&words, i).is_some() {
                 return Err(QueryError::Unsupported {
                     what: format!("a fruit to hold against picked by size ('than the {w}')"),
                     instead: "tell them apart by place, e.g. \"Is the apple on the left harder than the one on the right?\"".into(),
@@ -545,10 +537,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             // "than the left banana": the reference's place.
             let of_reference = (i + 1..words.len().min(i + 3))
                 .find(|&j| is_fruit(&words[j]) || words[j] == "one")
-                .is_some_and(|j| {
-                    threshold::comparison_before(&words, j).is_some()
-                        || threshold::ripeness_comparison_before(&words, j).is_some()
-                });
+                .is_some_and(|j| threshold::any_comparison_before(&words, j).is_some());
             // "Is the left banana harder than the right?": a bare place after the comparison
             // is the one there of the kind asked about.
             let bare = !of_reference
@@ -558,9 +547,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                 && !at(i + 1).is_some_and(|n| is_noun(n) || n == "one");
             if bare
                 && let [kind] = targets.as_slice()
-                && let Some((harder, ripeness)) = threshold::comparison_before(&words, i)
-                    .map(|h| (h, false))
-                    .or(threshold::ripeness_comparison_before(&words, i).map(|h| (h, true)))
+                && let Some((harder, ripeness)) = threshold::any_comparison_before(&words, i)
             {
                 let (mut r, _, end) = relation_at(&words, i, harder, kind);
                 r.ripeness = ripeness;

@@ -213,6 +213,13 @@ pub fn ripeness_comparison_before(words: &[String], i: usize) -> Option<bool> {
     Some(less_ripe != negated)
 }
 
+/// Either comparison before word `i`: (harder or less ripe, by ripeness).
+pub fn any_comparison_before(words: &[String], i: usize) -> Option<(bool, bool)> {
+    comparison_before(words, i)
+        .map(|h| (h, false))
+        .or(ripeness_comparison_before(words, i).map(|h| (h, true)))
+}
+
 /// The index of "than" just before word `i`, past articles and what describes the fruit
 /// ("than that ripe yellow banana").
 fn than_before(words: &[String], i: usize) -> Option<usize> {
