@@ -442,15 +442,14 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             && threshold.is_none()
             && categories.is_empty()
             && let [kind] = targets.as_slice()
+            && let Some((harder, ripeness)) = threshold::any_comparison_before(&words, i)
         {
-            if let Some((harder, ripeness)) = threshold::any_comparison_before(&words, i) {
-                let (mut r, places, end) = relation_at(&words, i, harder, kind);
-                r.ripeness = ripeness;
-                relation = Some(r);
-                reference_positions.extend(places);
-                (consumed_until, reference_end) = (consumed_until.max(end), end);
-                continue;
-            }
+            let (mut r, places, end) = relation_at(&words, i, harder, kind);
+            r.ripeness = ripeness;
+            relation = Some(r);
+            reference_positions.extend(places);
+            (consumed_until, reference_end) = (consumed_until.max(end), end);
+            continue;
         }
         if lexicon::GENERIC.contains(&w) {
             // "softer than the fruit on the left", "than the yellow one": a reference named
