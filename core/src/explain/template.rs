@@ -100,7 +100,9 @@ fn past_threshold(
     objects: &[Measured],
     selected: &[usize],
 ) -> Vec<String> {
-    let rel = t.relation();
+    // Against another of the same kind by ripeness ("riper than the one on the left").
+    let by_ripeness = query.relation.as_ref().is_some_and(|r| r.ripeness);
+    let rel = comparison_word(t.harder, by_ripeness);
     let value = t.words();
     // How far past the value a fruit lies: the hardest first after "harder than".
     let past = |i: usize| {
@@ -147,7 +149,7 @@ fn past_threshold(
             .copied()
             .max_by(|&a, &b| past(a).total_cmp(&past(b)));
         if let Some(i) = nearest {
-            let word = match (t.ripeness, t.harder) {
+            let word = match (by_ripeness, t.harder) {
                 (false, true) => "hardest",
                 (false, false) => "softest",
                 (true, true) => "least ripe",

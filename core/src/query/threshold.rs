@@ -17,10 +17,6 @@ pub struct Threshold {
     pub modulus_mpa: f64,
     /// The value as the prompt gave it, with its unit: "2 MPa", "30 Shore A".
     pub said: String,
-    /// Held against another of the same kind by ripeness ("riper than the one on the
-    /// left"): the same bound, worded "riper" or "less ripe".
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub ripeness: bool,
 }
 
 impl Threshold {
@@ -33,9 +29,9 @@ impl Threshold {
         }
     }
 
-    /// "harder" or "softer" ("less ripe" or "riper"), as the answer words the relation.
+    /// "harder" or "softer", as the answer words the relation.
     pub fn relation(&self) -> &'static str {
-        comparison_word(self.harder, self.ripeness)
+        relation_word(self.harder)
     }
 
     /// The value on every scale; None for "rigid".
@@ -190,7 +186,6 @@ impl Relation {
             harder: self.harder,
             modulus_mpa: bound,
             said,
-            ripeness: self.ripeness,
         })
     }
 }
@@ -464,7 +459,6 @@ pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
             harder,
             modulus_mpa: value.modulus_mpa().unwrap_or(f64::INFINITY),
             said,
-            ripeness: false,
         });
     }
     Ok(found)
