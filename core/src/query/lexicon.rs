@@ -90,6 +90,12 @@ pub const COLOURS: &[&str] = &[
 ];
 
 /// Words after which the fruit names are exclusions.
+/// Whether a word turns what follows around: "not", "no", "never", "non-", the "t" of
+/// "isn't" ("not harder than" is softer; "not soft" is refused).
+pub fn negates(w: &str) -> bool {
+    matches!(w, "not" | "no" | "never" | "t" | "non")
+}
+
 pub const EXCLUDING: &[&str] = &["except", "excluding", "without", "besides", "but"];
 
 /// Verbs that ask for every named object's value.

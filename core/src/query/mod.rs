@@ -248,7 +248,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         if let Some((category, n)) = catalog.category_at(&rest) {
             // "Which non-citrus fruit ...?", "a fruit that isn't citrus": read as the group
             // itself it answered about the citrus.
-            if !excluding && prev.is_some_and(negation) {
+            if !excluding && prev.is_some_and(lexicon::negates) {
                 return Err(QueryError::Unsupported {
                     what: format!(
                         "a group turned around by '{}'",
@@ -329,8 +329,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                 // "Is the banana on the left riper than the banana on the right?": two of
                 // one kind, held against each other as "softer than" is.
                 if relation.is_none() && threshold.is_none() && targets == [f.name.as_str()] {
-                    let (mut r, places, end) = relation_at(&words, i, less_ripe, &f.name);
-                    r.ripeness = true;
+                    let (r, places, end) = relation_at(&words, i, (less_ripe, true), &f.name);
                     relation = Some(r);
                     reference_positions.extend(places);
                     (consumed_until, reference_end) = (consumed_until.max(end), end);
@@ -362,7 +361,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                 if let Some(t) = &threshold {
                     return Err(second_bound(&f.name, &t.said));
                 }
-                let (r, places, end) = relation_at(&words, i, harder, &f.name);
+                let (r, places, end) = relation_at(&words, i, (harder, false), &f.name);
                 relation = Some(r);
                 reference_positions.extend(places);
                 (consumed_until, reference_end) = (consumed_until.max(end), end);
@@ -444,8 +443,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
             && let [kind] = targets.as_slice()
             && let Some((harder, ripeness)) = threshold::any_comparison_before(&words, i)
         {
-            let (mut r, places, end) = relation_at(&words, i, harder, kind);
-            r.ripeness = ripeness;
+            let (r, places, end) = relation_at(&words, i, (harder, ripeness), kind);
             relation = Some(r);
             reference_positions.extend(places);
             (consumed_until, reference_end) = (consumed_until.max(end), end);
@@ -548,8 +546,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                 && let [kind] = targets.as_slice()
                 && let Some((harder, ripeness)) = threshold::any_comparison_before(&words, i)
             {
-                let (mut r, _, end) = relation_at(&words, i, harder, kind);
-                r.ripeness = ripeness;
+                let (r, _, end) = relation_at(&words, i, (harder, ripeness), kind);
                 relation = Some(r);
                 reference_positions.push(p);
                 reference_end = end;
@@ -565,7 +562,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         if let Some(pw) = lexicon::property_word(w) {
             // "Which fruit is not soft?" read as the softest; "not softer than" is read
             // where the comparison is.
-            if prev.is_some_and(negation) && at(i + 1) != Some("than") {
+            if prev.is_some_and(lexicon::negates) && at(i + 1) != Some("than") {
                 return Err(QueryError::Unsupported {
                     what: format!("a property turned around ('not {w}')"),
                     instead: "ask for its opposite, e.g. \"Which fruit is the hardest?\" for \"not soft\"".into(),
@@ -825,13 +822,13 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
 
 /// The place words of "on the left", "at the back", "in the front corner" starting at word
 /// `i`, and the index past them; None when no place follows.
-/// A relation to `kind` named at word `i`, the reference's place words ("than the banana on
+/// A relation to `kind` named at word `i` (harder or less ripe, by ripeness), the reference's place words ("than the banana on
 /// the left", "than the apple at the back": the place is the reference's, not a filter on
 /// the fruit asked about) and the word after the reference and its place.
 fn relation_at(
     words: &[String],
     i: usize,
-    harder: bool,
+    (harder, ripeness): (bool, bool),
     kind: &str,
 ) -> (threshold::Relation, Vec<&'static str>, usize) {
     let relation = threshold::Relation {
@@ -839,7 +836,7 @@ fn relation_at(
         reference: kind.to_string(),
         also: Vec::new(),
         position: None,
-        ripeness: false,
+        ripeness,
     };
     match place_after(words, i + 1) {
         Some((places, end)) => (relation, places, end),
@@ -884,11 +881,6 @@ fn place_after(words: &[String], i: usize) -> Option<(Vec<&'static str>, usize)>
         j += 1;
     }
     Some((places, j))
-}
-
-/// A word that turns what follows around: "not", "non-", the "t" of "isn't", "never".
-fn negation(w: &str) -> bool {
-    matches!(w, "not" | "non" | "t" | "never")
 }
 
 /// A second bound beside a first ("softer than the mango but harder than the banana").

@@ -204,7 +204,7 @@ pub fn ripeness_comparison_before(words: &[String], i: usize) -> Option<bool> {
         }
         _ => return None,
     };
-    let negated = at > 0 && matches!(words[at - 1].as_str(), "not" | "no" | "never" | "t");
+    let negated = at > 0 && super::lexicon::negates(&words[at - 1]);
     Some(less_ripe != negated)
 }
 
@@ -265,7 +265,7 @@ pub fn comparison_before(words: &[String], i: usize) -> Option<bool> {
         (_, "more" | "less") => return None,
         _ => (direction(words, k)?, k),
     };
-    let negated = at > 0 && matches!(words[at - 1].as_str(), "not" | "no" | "never" | "t");
+    let negated = at > 0 && super::lexicon::negates(&words[at - 1]);
     Some(harder != negated)
 }
 
@@ -407,8 +407,7 @@ pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
             .find_map(|j| direction(&words, j).map(|d| (j, d)))
             .map(|(j, harder)| {
                 // "not harder than 2 MPa", "no softer than", "isn't firmer than".
-                let negated =
-                    j > 0 && matches!(words[j - 1].as_str(), "not" | "no" | "never" | "t");
+                let negated = j > 0 && super::lexicon::negates(&words[j - 1]);
                 harder != negated
             });
         if words[i].contains(',') {
