@@ -77,6 +77,8 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     let mut threshold = None;
     let mut relation = None;
     let mut goal: Option<String> = None;
+    let mut candidate: Option<String> = None;
+    let mut read: Vec<String> = Vec::new();
     for pair in extras.split(' ').filter(|p| !p.is_empty()) {
         // A word without '=' continues a two-word position.
         let Some((key, value)) = pair.split_once('=') else {
@@ -113,6 +115,9 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
             }
             // goal=for_a_smoothie: the use as the answer says it back, '_' for spaces.
             "goal" => goal = Some(value.replace('_', " ")),
+            "candidate" => candidate = Some(value.to_string()),
+            // A typing slip and the catalog word it reads as: "read=bananna:banana".
+            "read" => read.push(value.to_string()),
             other => panic!("phrasings.tsv: extra {other:?}"),
         }
     }
@@ -182,6 +187,20 @@ fn mismatch(query: &Query, cols: &[&str]) -> Option<String> {
     }
     if query.unknown != unknown {
         wrong.push(format!("unknown {:?}, expected {unknown:?}", query.unknown));
+    }
+    if query.candidate != candidate {
+        wrong.push(format!(
+            "candidate {:?}, expected {candidate:?}",
+            query.candidate
+        ));
+    }
+    let got_read: Vec<String> = query
+        .corrected
+        .iter()
+        .map(|c| format!("{}:{}", c.said, c.read))
+        .collect();
+    if got_read != read {
+        wrong.push(format!("read {got_read:?}, expected {read:?}"));
     }
     (!wrong.is_empty()).then(|| wrong.join("; "))
 }

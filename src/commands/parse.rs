@@ -112,5 +112,8 @@ fn describe(q: &Query) -> String {
     if !q.unknown.is_empty() {
         s += &format!("unknown:  {} (not in the catalog)\n", q.unknown.join(", "));
     }
+    for c in &q.corrected {
+        s += &format!("read:     '{}' as {}\n", c.said, c.read);
+    }
     s
 }

@@ -125,11 +125,25 @@ pub fn select(query: &Query, objects: &[Measured], catalog: &FruitCatalog) -> Ve
             measured
         }
         Intent::Extreme => {
-            let pick = match query.extreme {
-                Some(Extreme::Least) => measured.iter().min_by(|a, b| key(a).total_cmp(&key(b))),
-                _ => measured.iter().max_by(|a, b| key(a).total_cmp(&key(b))),
+            let pick = |among: &mut dyn Iterator<Item = usize>| match query.extreme {
+                Some(Extreme::Least) => among.min_by(|a, b| key(a).total_cmp(&key(b))),
+                _ => among.max_by(|a, b| key(a).total_cmp(&key(b))),
             };
-            pick.copied().into_iter().collect()
+            let best = pick(&mut measured.iter().copied());
+            // "Is the banana the softest?": the banana asked about (its kind's best), then
+            // the fruit that beats it, if one does.
+            let held_up = query.candidate.as_ref().and_then(|kind| {
+                pick(
+                    &mut measured
+                        .iter()
+                        .copied()
+                        .filter(|&i| &objects[i].label == kind),
+                )
+            });
+            match (held_up, best) {
+                (Some(c), Some(b)) if objects[b].label != objects[c].label => vec![c, b],
+                _ => best.into_iter().collect(),
+            }
         }
         _ => measured,
     }

@@ -314,6 +314,20 @@ pub fn explain(
     missing: &[String],
 ) -> String {
     let mut parts = Vec::new();
+    // A fruit name read through a typing slip is said first: the rest of the answer rests
+    // on that reading.
+    if !query.corrected.is_empty() {
+        let read: Vec<String> = query
+            .corrected
+            .iter()
+            .map(|c| format!("'{}' as {}", c.said, c.read))
+            .collect();
+        let said = match read.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            _ => read.join(""),
+        };
+        parts.push(format!("I read {said}."));
+    }
     // The use the question named, and how it was read: "You asked for a fruit for a
     // smoothie: I read that as the ripest fruit."
     if let Some(goal) = &query.goal {
@@ -344,10 +358,25 @@ pub fn explain(
         Intent::Extreme if !selected.is_empty() => {
             let word = superlative(query.property, query.extreme);
             let kind = query.asked_kind();
-            parts.push(format!(
-                "The {word} {kind} is {}.",
-                describe(&objects[selected[0]])
-            ));
+            let best = &objects[selected[selected.len() - 1]];
+            match &query.candidate {
+                // "Is the banana the softest?": yes or no first, then the fruit that is.
+                Some(c) if &best.label == c => {
+                    parts.push(format!("Yes: the {word} {kind} is {}.", describe(best)))
+                }
+                // A banana not found or not measured is said so below, with why.
+                Some(_) => {
+                    parts.push(format!("No: the {word} {kind} is {}.", describe(best)));
+                    if let [held_up, _] = selected {
+                        let m = &objects[*held_up];
+                        // "the banana at the left front, 24 Shore A ..." as a sentence of its own.
+                        let rest = describe(m);
+                        let rest = rest.trim_start_matches(&format!("the {} at the ", m.label));
+                        parts.push(format!("The {} is at the {rest}.", m.label));
+                    }
+                }
+                None => parts.push(format!("The {word} {kind} is {}.", describe(best))),
+            }
             let mut ranked: Vec<&Measured> =
                 objects.iter().filter(|m| m.hardness.is_some()).collect();
             if ranked.len() > 1 {
@@ -589,6 +618,46 @@ mod tests {
         );
         let q = crate::query::parse("Order the fruit by firmness", &c).unwrap();
         assert_eq!(select(&q, &objs, &c), vec![0, 2, 1]);
+    }
+
+    #[test]
+    fn a_fruit_held_up_to_every_other_is_answered_yes_or_no() {
+        let c = FruitCatalog::builtin();
+        let objs = [
+            m("apple", 3.25, 0.1, 0.1),
+            m("banana", 0.8, -0.15, -0.1),
+            m("tomato", 0.45, 0.0, 0.0),
+        ];
+        let q = crate::query::parse("Is the banana softer than the others?", &c).unwrap();
+        let sel = select(&q, &objs, &c);
+        // The banana asked about, then the fruit that beats it.
+        assert_eq!(sel, vec![1, 2]);
+        let text = explain(&q, &objs, &sel, &[]);
+        assert!(
+            text.starts_with("No: the softest fruit is the tomato")
+                && text.contains("The banana is at the"),
+            "{text}"
+        );
+        let q = crate::query::parse("Is the tomato the softest fruit?", &c).unwrap();
+        let sel = select(&q, &objs, &c);
+        assert_eq!(sel, vec![2]);
+        let text = explain(&q, &objs, &sel, &[]);
+        assert!(
+            text.starts_with("Yes: the softest fruit is the tomato"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_misspelt_fruit_is_said_back_as_read() {
+        let c = FruitCatalog::builtin();
+        let q = crate::query::parse("Is the bananna softer than the aple?", &c).unwrap();
+        let objs = [m("apple", 3.25, 0.1, 0.1), m("banana", 0.8, -0.15, -0.1)];
+        let text = explain(&q, &objs, &select(&q, &objs, &c), &[]);
+        assert!(
+            text.starts_with("I read 'bananna' as banana and 'aple' as apple."),
+            "{text}"
+        );
     }
 
     #[test]

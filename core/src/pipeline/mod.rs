@@ -147,6 +147,7 @@ pub fn answer_with_progress<C: RgbdCamera, T: TactileSensor, A: Arm>(
     let not_found: Vec<String> = query
         .targets
         .iter()
+        .chain(&query.candidate)
         .filter(|k| !targets.iter().any(|t| &t.label == *k))
         .cloned()
         .collect();

@@ -305,6 +305,9 @@ impl QueryDraft {
             },
             ranked: self.ranked,
             unknown,
+            // The model reads a slip as it reads any word; the rules' corrections are theirs.
+            corrected: Vec::new(),
+            candidate: None,
             threshold,
             relation,
             goal,

@@ -31,7 +31,20 @@ const THING_AFTER: &[&str] = &["the", "a", "an", "one", "most", "more", "much", 
 const NOT_BEFORE: &[&str] = &["away", "out", "missing"];
 /// Words shortly before a use that deny it ("which should I not keep?"): the use is then
 /// not read, rather than read backwards.
-const NEGATIONS: &[&str] = &["not", "t", "never", "don", "shouldn", "without"];
+const NEGATIONS: &[&str] = &[
+    "not",
+    "t",
+    "never",
+    "don",
+    "shouldn",
+    "without",
+    "worst",
+    "worse",
+    "bad",
+    "unsuitable",
+    "unfit",
+    "avoid",
+];
 
 const fn use_of(
     words: &'static [&'static str],
@@ -152,9 +165,9 @@ pub fn listed(said: &str) -> Option<Goal> {
         })
 }
 
-/// The first use the words name, if any, unless the words around it make it something else
-/// or deny it.
-pub fn find(words: &[String]) -> Option<Goal> {
+/// The first use the words name and where it starts, unless the words around it make it
+/// something else.
+fn named_use(words: &[String]) -> Option<(usize, &'static Use)> {
     let at = |k: usize| words.get(k).map(String::as_str);
     GOALS.iter().find_map(|g| {
         let n = g.words.len();
@@ -166,15 +179,61 @@ pub fn find(words: &[String]) -> Option<Goal> {
                         .is_some_and(|w| THING_AFTER.contains(&w)))
                 && !at(i + n).is_some_and(|w| NOT_BEFORE.contains(&w))
         })?;
-        let denied = words[start.saturating_sub(3)..start]
-            .iter()
-            .any(|w| NEGATIONS.contains(&w.as_str()));
-        (!denied).then(|| Goal {
-            said: g.said.to_string(),
-            property: g.property,
-            low: g.low,
-        })
+        Some((start, g))
     })
+}
+
+/// The word shortly before the use at `start` that denies it or asks for its worst
+/// ("not ... for a smoothie", "worst for a smoothie").
+fn denial(words: &[String], start: usize) -> Option<&str> {
+    words[start.saturating_sub(4)..start]
+        .iter()
+        .map(String::as_str)
+        .find(|w| NEGATIONS.contains(w))
+}
+
+/// The first use the words name, if any, unless the words around it make it something else
+/// or deny it.
+pub fn find(words: &[String]) -> Option<Goal> {
+    let (start, g) = named_use(words)?;
+    denial(words, start).is_none().then(|| Goal {
+        said: g.said.to_string(),
+        property: g.property,
+        low: g.low,
+    })
+}
+
+/// A use the words name and deny, and the word that denies it: "which should I not use for
+/// a smoothie" is not read backwards as the least ripe, nor forwards as the ripest.
+pub fn denied(words: &[String]) -> Option<Denied> {
+    let (start, g) = named_use(words)?;
+    let by = match denial(words, start)? {
+        "t" => "not",
+        "don" => "do not",
+        "shouldn" => "should not",
+        w => w,
+    };
+    // The other end of what serves the use.
+    let opposite = match (g.property, g.low) {
+        (Property::Ripeness, false) => "least ripe",
+        (Property::Ripeness, true) => "ripest",
+        (Property::Hardness | Property::Softness, false) => "softest",
+        (Property::Hardness | Property::Softness, true) => "hardest",
+    };
+    Some(Denied {
+        said: g.said,
+        by: by.to_string(),
+        opposite,
+    })
+}
+
+/// A use the prompt denies: how it is said, the word that denies it, and the superlative of
+/// the other end ("least ripe" for a smoothie).
+#[derive(Debug, PartialEq)]
+pub struct Denied {
+    pub said: &'static str,
+    pub by: String,
+    pub opposite: &'static str,
 }
 
 #[cfg(test)]
@@ -208,9 +267,28 @@ mod tests {
             "which fruit should i keep away from the kids",
             "which fruit is next to the bread",
             "which fruit should i not keep",
+            "which fruit should i not use for a smoothie",
+            "which fruit is worst for a smoothie",
         ] {
             assert_eq!(find(&words(other)), None, "{other}");
         }
+        assert_eq!(
+            denied(&words("which fruit should i not use for a smoothie")),
+            Some(Denied {
+                said: "for a smoothie",
+                by: "not".into(),
+                opposite: "least ripe"
+            })
+        );
+        assert_eq!(
+            denied(&words("which is the worst for slicing")),
+            Some(Denied {
+                said: "for slicing",
+                by: "worst".into(),
+                opposite: "softest"
+            })
+        );
+        assert_eq!(denied(&words("which fruit for a smoothie")), None);
         let listed_smoothie = listed("For a smoothie").unwrap();
         assert_eq!(
             (listed_smoothie.property, listed_smoothie.low),

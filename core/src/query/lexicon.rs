@@ -53,6 +53,8 @@ pub fn property_word(w: &str) -> Option<PropertyWord> {
         "riper" => word(Ripeness, Comparative, false),
         "ripest" => word(Ripeness, Superlative, false),
         "unripe" | "unripened" | "immature" => word(Ripeness, Base, true),
+        "unriper" => word(Ripeness, Comparative, true),
+        "unripest" => word(Ripeness, Superlative, true),
         "greener" => word(Ripeness, Comparative, true),
         "greenest" => word(Ripeness, Superlative, true),
         _ => return None,
@@ -87,6 +89,26 @@ pub const GENERIC_NOUNS: &[&str] = &[
 /// Colour names the filters know, as the detector names observed colours.
 pub const COLOURS: &[&str] = &[
     "red", "orange", "yellow", "green", "brown", "purple", "pink",
+];
+
+/// Colours compared ("yellower than"): the twin reads hardness and ripeness, not colour.
+pub const COLOUR_COMPARATIVES: &[&str] = &[
+    "yellower",
+    "redder",
+    "browner",
+    "oranger",
+    "pinker",
+    "purpler",
+    "yellowest",
+    "reddest",
+    "brownest",
+    "pinkest",
+];
+
+/// Ordinals that would pick an instance by count ("the second banana"): which is first is
+/// not something the camera's view settles.
+pub const ORDINALS: &[&str] = &[
+    "first", "second", "third", "fourth", "fifth", "1st", "2nd", "3rd", "4th", "5th",
 ];
 
 /// Words after which the fruit names are exclusions.
@@ -166,6 +188,18 @@ pub const PHRASES: &[(&str, &str)] = &[
     ("not ripe", "unripe"),
     ("still green", "unripe"),
     ("not as", "less"),
+    // "softer than all the other fruit", "than everything else": every other fruit.
+    ("than all of the others", "than the others"),
+    ("than all the others", "than the others"),
+    ("than all the other", "than the other"),
+    ("than all others", "than the others"),
+    ("than all other", "than the other"),
+    ("than any other", "than the other"),
+    ("than every other", "than the other"),
+    ("than everything else", "than the others"),
+    ("than anything else", "than the others"),
+    ("than all the rest", "than the others"),
+    ("than the rest", "than the others"),
     ("other than", "except"),
     ("apart from", "except"),
     ("but not", "except"),
@@ -180,6 +214,22 @@ pub const PHRASES: &[(&str, &str)] = &[
     ("how about", "tell"),
     ("what about", "tell"),
 ];
+
+/// A Latin letter with its accent taken off ("léft", "açaí", "purée" as typed on a
+/// keyboard set for another language), others as they are.
+pub fn unaccented(c: char) -> char {
+    match c {
+        'à' | 'á' | 'â' | 'ä' | 'ã' | 'å' | 'ā' => 'a',
+        'è' | 'é' | 'ê' | 'ë' | 'ē' => 'e',
+        'ì' | 'í' | 'î' | 'ï' | 'ī' => 'i',
+        'ò' | 'ó' | 'ô' | 'ö' | 'õ' | 'ō' => 'o',
+        'ù' | 'ú' | 'û' | 'ü' | 'ū' => 'u',
+        'ç' => 'c',
+        'ñ' => 'n',
+        'ý' | 'ÿ' => 'y',
+        c => c,
+    }
+}
 
 /// Common fruits the catalog does not know, so that a prompt naming one says so by name
 /// rather than "names no known fruit".

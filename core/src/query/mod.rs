@@ -5,6 +5,7 @@ pub mod goal;
 pub mod lexicon;
 pub mod llm_prompt;
 pub mod reader;
+pub mod spelling;
 pub mod threshold;
 
 use crate::catalog::FruitCatalog;
@@ -104,6 +105,14 @@ pub struct Query {
     pub ranked: bool,
     /// Fruits the prompt names that the catalog does not know ("pineapple").
     pub unknown: Vec<String>,
+    /// The kind a yes/no question holds up to every fruit ("Is the banana the softest?",
+    /// "Is the banana softer than the others?"): the extreme is over every fruit, and the
+    /// answer says whether it is of this kind.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub candidate: Option<String>,
+    /// Typing slips of fruit names read as the catalog's ("bananna" as banana), said back.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub corrected: Vec<spelling::Correction>,
     /// A value the objects are held against ("harder than 2 MPa"), for `Intent::Threshold`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub threshold: Option<threshold::Threshold>,
@@ -144,6 +153,7 @@ fn words_of(prompt: &str) -> (Vec<String>, Vec<bool>) {
     let spaced: String = prompt
         .to_lowercase()
         .chars()
+        .map(lexicon::unaccented)
         .map(|c| match c {
             c if c.is_alphanumeric() => c.to_string(),
             ',' | ';' | ':' | '/' | '&' => format!(" {BREAK} "),
@@ -194,6 +204,7 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let trimmed = checked_prompt(prompt)?;
     let threshold = threshold::find(trimmed)?;
     let (words, breaks) = words_of(trimmed);
+    let (words, corrected) = spelling::corrected(words, catalog);
     let at = |i: usize| words.get(i).map(String::as_str);
     let is_fruit = |w: &str| catalog.find_word(w).is_some();
     let is_noun = |w: &str| is_fruit(w) || lexicon::GENERIC_NOUNS.contains(&w);
@@ -243,6 +254,25 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         if lexicon::EXCLUDING.contains(&w) {
             excluding = true;
             continue;
+        }
+        if lexicon::COLOUR_COMPARATIVES.contains(&w) {
+            return Err(QueryError::Unsupported {
+                what: format!("colour held against colour ('{w}')"),
+                instead: "ask how ripe or how hard, e.g. \"Is the apple riper than the banana?\""
+                    .into(),
+            });
+        }
+        // "the second banana", "the first one": an instance by count.
+        if lexicon::ORDINALS.contains(&w)
+            && words[i + 1..]
+                .iter()
+                .take(2)
+                .any(|n| is_noun(n) && n != "fruit" || n == "ones")
+        {
+            return Err(QueryError::Unsupported {
+                what: format!("a fruit picked by count ('{w}')"),
+                instead: "tell them apart by place, e.g. \"Is the banana on the left riper than the one on the right?\"".into(),
+            });
         }
         let rest: Vec<&str> = words[i..].iter().take(3).map(String::as_str).collect();
         if let Some((category, n)) = catalog.category_at(&rest) {
@@ -568,7 +598,10 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
                     instead: "ask for its opposite, e.g. \"Which fruit is the hardest?\" for \"not soft\"".into(),
                 });
             }
+            // "as hard as the mango" compares the two, as "harder than" does.
+            let as_as = prev == Some("as") && at(i + 1) == Some("as");
             let (degree, flipped) = match (pw.degree, prev) {
+                (Degree::Base, _) if as_as => (Degree::Comparative, false),
                 (Degree::Base, Some("most")) => (Degree::Superlative, false),
                 (Degree::Base, Some("least")) => (Degree::Superlative, true),
                 (Degree::Base, Some("more")) => (Degree::Comparative, false),
@@ -593,6 +626,17 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     // "Which fruit for a smoothie?": the use names the property when no word does, and is
     // read as its superlative ("the ripest").
     let goal = properties.is_empty().then(|| goal::find(&words)).flatten();
+    if properties.is_empty()
+        && let Some(d) = goal::denied(&words)
+    {
+        return Err(QueryError::Unsupported {
+            what: format!("a use turned around ('{}' ... '{}')", d.by, d.said),
+            instead: format!(
+                "ask for the fruit that suits it, e.g. \"Which fruit is best {}?\", or name the property, e.g. \"Which fruit is the {}?\"",
+                d.said, d.opposite
+            ),
+        });
+    }
     if let Some(g) = &goal {
         properties.push((g.property, Degree::Superlative, g.low));
     }
@@ -649,6 +693,17 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let same_kind_by_place = same_kind && !reference_positions.is_empty();
     // "Is the big apple softer than the other one?": a size picks one among the fruit asked
     // about, and the other would be the same apple.
+    // "Is the green banana riper than the brown one?": the colour filter would keep the
+    // green one alone, and the comparison have nothing to hold it against.
+    if same_kind && let Some(colour) = &filters.color {
+        return Err(QueryError::Unsupported {
+            what: format!("two {}s told apart by colour ('{colour}')", targets[0]),
+            instead: format!(
+                "tell them apart by place, e.g. \"Is the {0} on the left riper than the one on the right?\"",
+                targets[0]
+            ),
+        });
+    }
     if same_kind && filters.size.is_some() {
         return Err(QueryError::Unsupported {
             what: format!("two {}s told apart by size", targets[0]),
@@ -800,8 +855,33 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     }
     // Named kinds bound an extreme, a comparison or an identification ("which fruit is
     // softer, the kiwi or the peach"); a summary may add "all other fruits" to named ones.
-    let all =
+    let mut all =
         all && (matches!(intent, Intent::Summarize | Intent::Threshold) || targets.is_empty());
+    // "Is the banana the softest?", "Is the banana softer than the others?": the fruit named
+    // before the property word, and no fruit after it ("Is the banana the softest banana?"
+    // stays among the bananas), is held up to every fruit. A place, colour, count, size or
+    // group would pick among instances, which this reading does not.
+    let first_property = words
+        .iter()
+        .position(|w| lexicon::property_word(w).is_some());
+    let candidate = match (intent, targets.as_slice(), first_property) {
+        (Intent::Extreme, [kind], Some(p))
+            if yes_no
+                && goal.is_none()
+                && categories.is_empty()
+                && filters == Filters::default()
+                && positions.is_empty()
+                && words[..p].iter().any(|w| is_fruit(w))
+                && !words[p..].iter().any(|w| is_fruit(w)) =>
+        {
+            Some(kind.clone())
+        }
+        _ => None,
+    };
+    if candidate.is_some() {
+        targets.clear();
+        all = true;
+    }
     Ok(Query {
         intent,
         property,
@@ -813,6 +893,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         filters,
         ranked,
         unknown,
+        candidate,
+        corrected,
         threshold,
         relation,
         // A use names an end: a comparison of two or one fruit's reading has none to say.

@@ -272,7 +272,11 @@ pub fn comparison_before(words: &[String], i: usize) -> Option<bool> {
 /// Lower-cased words, a number kept whole with its sign and decimal point ("-2", ".5",
 /// "2.5"; "2,5" too, to be refused by name), and ">", "<" read as "above", "below".
 fn tokens(prompt: &str) -> Vec<String> {
-    let chars: Vec<char> = prompt.to_lowercase().chars().collect();
+    let chars: Vec<char> = prompt
+        .to_lowercase()
+        .chars()
+        .map(super::lexicon::unaccented)
+        .collect();
     let mut out = Vec::new();
     let mut word = String::new();
     for (i, &c) in chars.iter().enumerate() {
@@ -373,6 +377,25 @@ fn compares(words: &[String], i: usize) -> bool {
 /// compares against without a unit, in a unit not read, off its scale, without saying which
 /// way, or beside a second value.
 pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
+    // "mPa", as written, is the millipascal: a slip for MPa, but not one to guess.
+    if let Some(at) = prompt.match_indices("mPa").map(|(k, _)| k).find(|&k| {
+        !prompt[..k].ends_with(char::is_alphabetic)
+            && !prompt[k + 3..].starts_with(char::is_alphanumeric)
+    }) {
+        let number: String = prompt[..at]
+            .trim_end()
+            .chars()
+            .rev()
+            .take_while(|c| c.is_ascii_digit() || *c == '.')
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect();
+        return Err(QueryError::BadThreshold {
+            value: format!("{number} mPa").trim().to_string(),
+            message: "mPa is the millipascal; write MPa for megapascals (2 MPa) or kPa".into(),
+        });
+    }
     let words = tokens(prompt);
     let mut found: Option<Threshold> = None;
     // Words read as a value's unit ("60 Shore 00": the "00" is not a second number).
@@ -410,8 +433,21 @@ pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
                 let negated = j > 0 && super::lexicon::negates(&words[j - 1]);
                 harder != negated
             });
-        if words[i].contains(',') {
-            return Err(bad("write the number with a decimal point (2.5 MPa)".into()));
+        if let Some((whole, rest)) = words[i].split_once(',') {
+            // "1,000 kPa" groups thousands, or is 1.000 written the European way.
+            let grouped = !whole.is_empty()
+                && rest
+                    .split(',')
+                    .all(|g| g.len() == 3 && g.chars().all(|c| c.is_ascii_digit()));
+            return Err(bad(if grouped {
+                format!(
+                    "reads as {} or as {}: write it without the comma",
+                    words[i].replace(',', ""),
+                    words[i].replacen(',', ".", 1)
+                )
+            } else {
+                "write the number with a decimal point (2.5 MPa)".into()
+            }));
         }
         let (value, said, end) = match value_at(&words, i) {
             Some(Ok(found)) => found,
@@ -468,8 +504,11 @@ pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
 /// ("Shore A above 40"). None: no unit; Err: not a hardness, or off its scale.
 fn value_at(words: &[String], i: usize) -> Option<Result<(Hardness, String, usize), String>> {
     let number = &words[i];
-    let unit_after: Vec<&str> = words[i + 1..].iter().take(2).map(String::as_str).collect();
+    let unit_after: Vec<&str> = words[i + 1..].iter().take(3).map(String::as_str).collect();
     let after = match unit_after.as_slice() {
+        // N/mm2 is the megapascal.
+        ["n", "mm2" | "mm²", ..] => Some(("mpa".to_string(), i + 2)),
+        ["n", "mm", "2", ..] => Some(("mpa".to_string(), i + 3)),
         ["shore", s, ..] if matches!(*s, "a" | "00" | "oo") => Some((format!("shore {s}"), i + 2)),
         ["shorea", ..] => Some(("shore a".to_string(), i + 1)),
         ["shore00" | "shoreoo", ..] => Some(("shore 00".to_string(), i + 1)),
