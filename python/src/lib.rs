@@ -9,17 +9,22 @@
 
 use anyhow::Context;
 use clap::Parser;
+use glam::DVec3;
 use numpy::ndarray::{Array2, Array3, Array4};
-use numpy::{IntoPyArray, PyArray4};
+use numpy::{IntoPyArray, PyArray4, PyReadonlyArray2};
 use pyo3::exceptions::{PyFileNotFoundError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
 use tactex::app::error_kind::ErrorKind;
+use tactex::app::single_press::{PressRequest, PressShape};
 use tactex::app::tactile_samples::{TactileSample, TactileSampleSource};
 use tactex::cli::{Cli, Command, error_line};
+use tactex::commands::press::PressArgs;
 use tactex_sim::contact::ContactSolver;
+use tactex_sim::contact::HeightMap;
+use tactex_sim::mesh::TriMesh;
 use tactex_sim::render::gel::open_renderer;
 
 /// The thread pool native calls run on. rayon's global pool does not survive a fork (a
@@ -88,17 +93,108 @@ fn field_array(values: &[f64], nx: usize, ny: usize) -> Array2<f32> {
         .expect("a field has one value per grid cell")
 }
 
-/// One press: `argv` are `tactex press` flags. Returns the report (JSON text), the pressed
-/// frame and the no-contact frame (H x W x 3 uint8), and the gel's fields over the pad and
-/// the pressure over the solver grid (float32, rows x columns) with their grids.
+/// The caller's own geometry, from numpy: a mesh (vertices N x 3 in its units, z up; faces
+/// M x 3 indices) or a height map (H x W mm, larger nearer the gel, NaN where absent).
+/// Checked here so that an error names the Python keyword. A dict with every key (None where
+/// not given).
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct Geometry<'py> {
+    vertices: Option<PyReadonlyArray2<'py, f64>>,
+    faces: Option<PyReadonlyArray2<'py, i64>>,
+    mesh_scale: Option<f64>,
+    height_map_mm: Option<PyReadonlyArray2<'py, f64>>,
+    mm_per_px: Option<f64>,
+}
+
+impl Geometry<'_> {
+    fn shape(&self) -> PyResult<Option<PressShape>> {
+        let bad = |m: String| Err(PyValueError::new_err(m));
+        if let Some(map) = &self.height_map_mm {
+            let map = map.as_array();
+            let (height, width) = map.dim();
+            let Some(mm_per_px) = self.mm_per_px else {
+                return bad("mm_per_px: needed with height_map_mm".into());
+            };
+            return Ok(Some(PressShape::HeightMap(HeightMap {
+                heights_mm: map.iter().copied().collect(),
+                width,
+                height,
+                mm_per_px,
+            })));
+        }
+        let (Some(vertices), Some(faces)) = (&self.vertices, &self.faces) else {
+            return Ok(None);
+        };
+        let (vertices, faces) = (vertices.as_array(), faces.as_array());
+        if vertices.ncols() != 3 {
+            return bad(format!(
+                "mesh: vertices must be N x 3, got {:?}",
+                vertices.dim()
+            ));
+        }
+        if faces.ncols() != 3 {
+            return bad(format!(
+                "mesh: faces must be M x 3 (triangles), got {:?}",
+                faces.dim()
+            ));
+        }
+        let n = vertices.nrows() as i64;
+        if let Some(i) = faces.iter().find(|&&i| i < 0 || i >= n) {
+            return bad(format!("mesh: face index {i} is outside the {n} vertices"));
+        }
+        let scale = self.mesh_scale.unwrap_or(1.0);
+        if !(scale.is_finite() && scale > 0.0 && scale <= 1000.0) {
+            return bad(format!(
+                "mesh_scale: must be above 0 up to 1000, got {scale}"
+            ));
+        }
+        Ok(Some(PressShape::Triangles {
+            mesh: TriMesh {
+                vertices: vertices
+                    .rows()
+                    .into_iter()
+                    .map(|v| DVec3::new(v[0], v[1], v[2]))
+                    .collect(),
+                triangles: faces
+                    .rows()
+                    .into_iter()
+                    .map(|f| [f[0] as u32, f[1] as u32, f[2] as u32])
+                    .collect(),
+            },
+            scale,
+            name: "mesh".into(),
+        }))
+    }
+}
+
+/// The press the flags describe, on the caller's geometry when it gave one.
+fn press_request(args: &PressArgs, shape: Option<PressShape>) -> anyhow::Result<PressRequest> {
+    let mut request = tactex::commands::press::request(args)?;
+    if let Some(shape) = shape {
+        request.shape = shape;
+    }
+    Ok(request)
+}
+
+/// One press: `argv` are `tactex press` flags, `geometry` the caller's own object if any.
+/// Returns the report (JSON text), the pressed frame and the no-contact frame (H x W x 3
+/// uint8), and the gel's fields over the pad and the pressure over the solver grid (float32,
+/// rows x columns) with their grids.
 #[pyfunction]
-fn press(py: Python<'_>, argv: Vec<String>) -> PyResult<Bound<'_, PyDict>> {
+#[pyo3(signature = (argv, geometry=None))]
+fn press<'py>(
+    py: Python<'py>,
+    argv: Vec<String>,
+    geometry: Option<Geometry<'py>>,
+) -> PyResult<Bound<'py, PyDict>> {
     let Command::Press(args) = parse(std::iter::once("press".into()).chain(argv).collect())? else {
         unreachable!("the argv starts with press")
     };
+    let shape = geometry.map(|g| g.shape()).transpose()?.flatten();
     let device = args.device();
     let solved = off_the_gil(py, || -> anyhow::Result<_> {
-        let request = tactex::commands::press::request(&args)?;
+        let request = press_request(&args, shape)?;
         let mut press = request.solve()?;
         let mut renderer = open_renderer(device)?.renderer;
         let fields = press.pad_fields();
@@ -151,21 +247,24 @@ fn press(py: Python<'_>, argv: Vec<String>) -> PyResult<Bound<'_, PyDict>> {
 /// required there but the protocol decides the travel): frames [9, H, W, 3] uint8 (the
 /// no-contact reference, then the 8 recorded frames) and the press's facts (JSON text).
 #[pyfunction]
+#[pyo3(signature = (argv, phase_mm, geometry=None))]
 fn press_sequence<'py>(
     py: Python<'py>,
     argv: Vec<String>,
     phase_mm: f64,
+    geometry: Option<Geometry<'py>>,
 ) -> PyResult<(Bound<'py, PyArray4<u8>>, String)> {
     let Command::Press(args) = parse(std::iter::once("press".into()).chain(argv).collect())? else {
         unreachable!("the argv starts with press")
     };
+    let shape = geometry.map(|g| g.shape()).transpose()?.flatten();
     if !(phase_mm.is_finite() && (0.0..0.25).contains(&phase_mm)) {
         return Err(PyValueError::new_err(format!(
             "phase_mm: {phase_mm} is outside [0, 0.25): first touch falls within one 0.25 mm step"
         )));
     }
     let done = off_the_gil(py, || -> anyhow::Result<(Array4<u8>, String)> {
-        let request = tactex::commands::press::request(&args)?;
+        let request = press_request(&args, shape)?;
         let (press, images) = request.press_sequence(phase_mm)?;
         let f = &press.frames;
         let facts = serde_json::json!({

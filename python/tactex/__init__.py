@@ -71,6 +71,52 @@ def _flags(**values: Any) -> List[str]:
     return out
 
 
+def _geometry(
+    mesh: Any = None,
+    mesh_scale: Optional[float] = None,
+    height_map_mm: Any = None,
+    mm_per_px: Optional[float] = None,
+) -> Optional[Dict[str, Any]]:
+    """The caller's own object for the native press: a mesh as ``(vertices, faces)`` or any
+    object with ``vertices`` and ``faces`` (a ``trimesh.Trimesh``), or a height map; None
+    when the object is a named shape or a mesh file."""
+    geometry: Dict[str, Any] = {
+        "vertices": None,
+        "faces": None,
+        "mesh_scale": None if mesh_scale is None else float(mesh_scale),
+        "height_map_mm": None,
+        "mm_per_px": None if mm_per_px is None else float(mm_per_px),
+    }
+    if height_map_mm is not None:
+        h = np.asarray(height_map_mm, dtype=np.float64)
+        if h.ndim != 2:
+            raise ValueError(f"height_map_mm: must be 2-D (rows, columns), got shape {h.shape}")
+        geometry["height_map_mm"] = np.ascontiguousarray(h)
+        return geometry
+    if mesh is None or isinstance(mesh, (str, os.PathLike)):
+        return None
+    if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
+        vertices, faces = mesh.vertices, mesh.faces
+    else:
+        try:
+            vertices, faces = mesh
+        except (TypeError, ValueError):
+            raise ValueError(
+                "mesh: give a file path, (vertices, faces) arrays or a trimesh.Trimesh"
+            ) from None
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces)
+    if v.ndim != 2 or f.ndim != 2:
+        raise ValueError(
+            f"mesh: vertices and faces must be 2-D (N x 3, M x 3), got {v.shape} and {f.shape}"
+        )
+    if f.dtype.kind not in "iu":
+        raise ValueError(f"mesh: faces must be integer indices, got {f.dtype}")
+    geometry["vertices"] = np.ascontiguousarray(v)
+    geometry["faces"] = np.ascontiguousarray(f.astype(np.int64))
+    return geometry
+
+
 def _pose_flags(pose: Optional[Tuple[float, float, float]]) -> Dict[str, Any]:
     """``pose=(x_mm, y_mm, yaw_deg)`` as ``tactex press``'s --at-mm and --yaw-deg."""
     if pose is None:
@@ -166,7 +212,7 @@ class Sensor:
         radius_mm: Optional[float] = None,
         size_mm: Optional[Sequence[float]] = None,
         pose: Optional[Tuple[float, float, float]] = None,
-        mesh: Optional[PathLike] = None,
+        mesh: Any = None,
         mesh_scale: Optional[float] = None,
         hardness: Optional[str] = None,
         modulus_mpa: Optional[float] = None,
@@ -185,14 +231,17 @@ class Sensor:
         (local SSIM against the no-contact frame, or marker motion), then 8 frames from
         the first contact frame, 0.25 mm apart. First touch falls ``phase_mm`` (0 to 0.25)
         before a step. Rendered on the CPU; ``seed`` seeds every frame's camera noise."""
+        if mesh is not None and shape == "sphere":
+            shape = "mesh"
+        geometry = _geometry(mesh, mesh_scale)
         argv = self._press_flags(
-            shape,
+            "sphere" if geometry is not None else shape,
             0.0,
             radius_mm=radius_mm,
             size_mm=size_mm,
             **_pose_flags(pose),
-            mesh=mesh,
-            mesh_scale=mesh_scale,
+            mesh=None if geometry is not None else mesh,
+            mesh_scale=None if geometry is not None else mesh_scale,
             hardness=hardness,
             modulus_mpa=modulus_mpa,
             object_poisson=object_poisson,
@@ -204,7 +253,7 @@ class Sensor:
             marker_pitch_mm=marker_pitch_mm,
             seed=seed,
         )
-        frames, facts = _tactex.press_sequence(argv, float(phase_mm))
+        frames, facts = _tactex.press_sequence(argv, float(phase_mm), geometry)
         return PressSequence(reference=frames[0], frames=frames[1:], labels=json.loads(facts))
 
     def press(
@@ -215,7 +264,7 @@ class Sensor:
         radius_mm: Optional[float] = None,
         size_mm: Optional[Sequence[float]] = None,
         pose: Optional[Tuple[float, float, float]] = None,
-        mesh: Optional[PathLike] = None,
+        mesh: Any = None,
         mesh_scale: Optional[float] = None,
         hardness: Optional[str] = None,
         modulus_mpa: Optional[float] = None,
@@ -239,15 +288,24 @@ class Sensor:
         that reaches past the pad's edge is cut there (``warnings`` says so). ``seed`` seeds
         the frame's camera noise. Same arguments as ``tactex press`` (``pose`` is its
         ``--at-mm X,Y --yaw-deg YAW``); the frame equals its ``tactile.png``.
+
+        ``mesh`` is a file path, ``(vertices, faces)`` arrays (N x 3 in the mesh's units,
+        z up; M x 3 indices) or a ``trimesh.Trimesh``, in metres unless ``mesh_scale`` says
+        the unit; given a mesh, ``shape`` may be left out. A mesh from arrays presses exactly
+        as the same mesh from a file.
         """
-        argv = self._press_flags(
-            shape,
-            depth_mm,
+        if mesh is not None and shape == "sphere":
+            shape = "mesh"
+        geometry = _geometry(mesh, mesh_scale)
+        return self._press(
+            "sphere" if geometry is not None else shape,
+            geometry,
+            depth_mm=depth_mm,
+            pose=pose,
             radius_mm=radius_mm,
             size_mm=size_mm,
-            **_pose_flags(pose),
-            mesh=mesh,
-            mesh_scale=mesh_scale,
+            mesh=None if geometry is not None else mesh,
+            mesh_scale=None if geometry is not None else mesh_scale,
             hardness=hardness,
             modulus_mpa=modulus_mpa,
             object_poisson=object_poisson,
@@ -261,7 +319,72 @@ class Sensor:
             seed=seed,
             device=device,
         )
-        out = _tactex.press(argv)
+
+    def render(
+        self,
+        height_map_mm: Any,
+        *,
+        depth_mm: float,
+        mm_per_px: Optional[float] = None,
+        pose: Optional[Tuple[float, float, float]] = None,
+        hardness: Optional[str] = None,
+        modulus_mpa: Optional[float] = None,
+        object_poisson: Optional[float] = None,
+        fidelity: str = "layer",
+        grid_mm: Optional[float] = None,
+        tolerance: Optional[float] = None,
+        seed: int = 0,
+        device: str = "cpu",
+    ) -> Press:
+        """A frame of an object whose surface you computed (Taxim's contract), pressed
+        ``depth_mm`` past first touch through the sensor's contact physics (``fidelity``) and
+        optics, of ``hardness`` ("rigid", "35A") or ``modulus_mpa``.
+
+        ``height_map_mm`` is (rows, columns) float: the object's surface height in mm, larger
+        nearer the gel, so its highest point touches first; NaN where the object is absent.
+        Its points lie ``mm_per_px`` apart (default the sensor's, so a frame-sized map lines
+        up with the frame's pixels), centred on the pad, or on ``pose`` ``(x_mm, y_mm,
+        yaw_deg)``. A sphere's cap as a height map renders as :meth:`press` of that sphere.
+
+        >>> s = Sensor()
+        >>> ys, xs = np.mgrid[0:240, 0:320]
+        >>> r2 = ((xs + 0.5 - 160) ** 2 + (ys + 0.5 - 120) ** 2) * s.mm_per_px ** 2
+        >>> cap = np.sqrt(np.maximum(15.0**2 - r2, 0.0))
+        >>> s.render(cap, depth_mm=0.5, hardness="rigid", fidelity="rigid").frame.shape
+        (240, 320, 3)
+        """
+        geometry = _geometry(
+            height_map_mm=height_map_mm,
+            mm_per_px=self.mm_per_px if mm_per_px is None else mm_per_px,
+        )
+        return self._press(
+            "sphere",
+            geometry,
+            depth_mm=depth_mm,
+            pose=pose,
+            hardness=hardness,
+            modulus_mpa=modulus_mpa,
+            object_poisson=object_poisson,
+            fidelity=fidelity,
+            grid_mm=grid_mm,
+            tolerance=tolerance,
+            seed=seed,
+            device=device,
+        )
+
+    def _press(
+        self,
+        shape: str,
+        geometry: Optional[Dict[str, Any]],
+        *,
+        depth_mm: float,
+        pose: Optional[Tuple[float, float, float]] = None,
+        **flags: Any,
+    ) -> Press:
+        """One press from ``tactex press`` flags, on ``geometry`` when the caller gave its
+        own object (the flags then name a placeholder shape the geometry replaces)."""
+        argv = self._press_flags(shape, depth_mm, **_pose_flags(pose), **flags)
+        out = _tactex.press(argv, geometry)
         return Press(
             frame=out["frame"],
             reference=out["reference"],

@@ -6,13 +6,16 @@ import numpy as np
 
 __version__: str
 
-def press(argv: List[str]) -> Dict[str, Any]:
-    """One press from ``tactex press`` flags: report (JSON text), frame, reference, fields,
-    field_grid, pressure_grid."""
+def press(argv: List[str], geometry: Optional[Dict[str, Any]] = None) -> Dict[str, Any]:
+    """One press from ``tactex press`` flags, on the caller's own object when ``geometry``
+    (vertices, faces, mesh_scale, height_map_mm, mm_per_px; None where not given) holds one:
+    report (JSON text), frame, reference, fields, field_grid, pressure_grid."""
 
-def press_sequence(argv: List[str], phase_mm: float) -> Tuple[np.ndarray, str]:
-    """The paper's press protocol from ``tactex press`` flags: frames (9, H, W, 3) uint8 and
-    the press's facts (JSON text)."""
+def press_sequence(
+    argv: List[str], phase_mm: float, geometry: Optional[Dict[str, Any]] = None
+) -> Tuple[np.ndarray, str]:
+    """The paper's press protocol from ``tactex press`` flags (and ``geometry`` as for
+    ``press``): frames (9, H, W, 3) uint8 and the press's facts (JSON text)."""
 
 def generate_samples(
     fidelity: str, shapes: List[str], sensor: Optional[str], seed: int, indices: List[int]

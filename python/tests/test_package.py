@@ -56,6 +56,52 @@ def test_the_press_fields_are_the_gels_displacement_over_the_pad():
     assert cols * cell >= 320 * 0.0634 - cell and rows * cell >= 240 * 0.0634 - cell
 
 
+def _obj(path):
+    """An OBJ file's vertices and triangles, read here as a user's own code would."""
+    vertices, faces = [], []
+    for line in Path(path).read_text().splitlines():
+        parts = line.split()
+        if parts and parts[0] == "v":
+            vertices.append([float(v) for v in parts[1:4]])
+        elif parts and parts[0] == "f":
+            faces.append([int(p.split("/")[0]) - 1 for p in parts[1:4]])
+    return np.array(vertices), np.array(faces)
+
+
+def test_a_height_map_of_a_sphere_renders_as_the_press_of_that_sphere():
+    """Taxim's contract (the object's surface over the pad, larger nearer the gel) against
+    the twin's own sphere: the same frame to a grey level, through both contact models."""
+    sensor = tactex.Sensor()
+    w, h = sensor.size
+    ys, xs = np.mgrid[0:h, 0:w]
+    r2 = ((xs + 0.5 - w / 2) ** 2 + (ys + 0.5 - h / 2) ** 2) * sensor.mm_per_px**2
+    cap = np.where(r2 <= 36.0, np.sqrt(np.maximum(36.0 - r2, 0.0)), np.nan)
+    for fidelity in ["rigid", "layer"]:
+        rendered = sensor.render(cap, depth_mm=0.9, hardness="40A", fidelity=fidelity, seed=5)
+        pressed = sensor.press("sphere", radius_mm=6, depth_mm=0.9, hardness="40A", fidelity=fidelity, seed=5)
+        diff = np.abs(rendered.frame.astype(int) - pressed.frame.astype(int))
+        assert diff.max() <= 1, (fidelity, diff.max())
+        assert abs(rendered.force_n - pressed.force_n) < 1e-3 * pressed.force_n
+        assert rendered.report["shape"] == "height map"
+
+
+def test_a_mesh_given_as_arrays_presses_as_the_same_mesh_from_its_file():
+    pear = ROOT / "scenes/meshes/pear.obj"
+    vertices, faces = _obj(pear)
+    sensor = tactex.Sensor()
+    from_arrays = sensor.press(mesh=(vertices, faces), depth_mm=0.8, hardness="40A", seed=1)
+    from_file = sensor.press("mesh", mesh=pear, depth_mm=0.8, hardness="40A", seed=1)
+    assert np.array_equal(from_arrays.frame, from_file.frame)
+    assert abs(from_arrays.force_n - from_file.force_n) < 1e-6 * from_file.force_n
+
+    class Trimesh:  # what trimesh.Trimesh offers the package: vertices and faces
+        def __init__(self, v, f):
+            self.vertices, self.faces = v, f
+
+    sequence = sensor.press_sequence(mesh=Trimesh(vertices, faces), hardness="40A", seed=1)
+    assert sequence.frames.shape == (8, 240, 320, 3)
+
+
 def test_a_press_imprint_stands_where_the_pose_puts_the_object():
     for x, y in [(0.0, 0.0), (3.0, -2.0), (-6.5, 4.0)]:
         press = tactex.Sensor().press("sphere", radius_mm=4, modulus_mpa=1.0, depth_mm=0.4, pose=(x, y, 0))
@@ -198,6 +244,17 @@ def test_compare_rebuilds_a_recorded_session_as_the_cli_does(cli, tmp_path):
         (lambda: tactex.Sensor().press(depth_mm=1, modulus_mpa=1, pose=(30, 0, 0)), ValueError, "--at-mm"),
         (lambda: tactex.Sensor().press(depth_mm=1, modulus_mpa=1, pose=(1, 2)), ValueError, "pose"),
         (lambda: tactex.Sensor().press("mesh", depth_mm=1, mesh="no/such.obj", hardness="40A"), FileNotFoundError, "no/such.obj"),
+        (lambda: tactex.Sensor().render(np.full((3, 3), np.inf), depth_mm=0.5, hardness="rigid"), ValueError,
+         "height_map_mm"),
+        (lambda: tactex.Sensor().render(np.zeros(5), depth_mm=0.5, hardness="rigid"), ValueError, "height_map_mm"),
+        (lambda: tactex.Sensor().render(np.zeros((4, 4)), depth_mm=0.5, hardness="rigid", mm_per_px=-1), ValueError,
+         "mm_per_px"),
+        (lambda: tactex.Sensor().press(mesh=(np.zeros((4, 3)), [[0, 1, 9]]), depth_mm=0.5, hardness="40A"),
+         ValueError, "mesh"),
+        (lambda: tactex.Sensor().press(mesh=(np.zeros((4, 2)), [[0, 1, 2]]), depth_mm=0.5, hardness="40A"),
+         ValueError, "mesh"),
+        (lambda: tactex.Sensor().press(mesh=(np.zeros((4, 3)), [[0, 1, 2]]), depth_mm=0.5, hardness="40A"),
+         ValueError, "mesh"),
         (lambda: list(tactex.generate(2, fidelity="soft")), ValueError, "--fidelity"),
         (lambda: list(tactex.generate(2, shapes=["cube"])), ValueError, "--shapes"),
         (lambda: list(tactex.generate(2, shard=(2, 2))), ValueError, "shard"),

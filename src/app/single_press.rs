@@ -12,10 +12,11 @@ use tactex_core::hertz::Elastic;
 use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_sim::contact::{
-    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, ObjectSurface, Rect,
-    field_pooling, mesh_top,
+    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, HeightMap,
+    ObjectSurface, Rect, field_pooling, mesh_top,
 };
 use tactex_sim::datagen::press_protocol::{PlannedPress, PressSetup, plan_press};
+use tactex_sim::mesh::TriMesh;
 use tactex_sim::render::gel::{
     CpuRenderer, GelImageFields, GelRenderer, PressFrame, SensorOptics, image_fields,
 };
@@ -38,6 +39,16 @@ pub enum PressShape {
         path: PathBuf,
         scale: f64,
     },
+    /// A mesh the caller made (vertices in its units, z up; triangles), pressed as a file's
+    /// would be; `name` is how errors name it (Python's `mesh`).
+    Triangles {
+        mesh: TriMesh,
+        scale: f64,
+        name: String,
+    },
+    /// A surface the caller computed (Taxim's contract, see `HeightMap`), centred on the
+    /// pose: its highest point touches first.
+    HeightMap(HeightMap),
 }
 
 /// Where the object stands on the pad: its lowest point (a mesh: the middle of its top) at
@@ -54,7 +65,8 @@ impl PressShape {
             PressShape::Sphere { .. } => "sphere",
             PressShape::Ellipsoid { .. } => "ellipsoid",
             PressShape::Box { .. } => "box",
-            PressShape::Mesh { .. } => "mesh",
+            PressShape::Mesh { .. } | PressShape::Triangles { .. } => "mesh",
+            PressShape::HeightMap(_) => "height map",
         }
     }
 
@@ -79,23 +91,44 @@ impl PressShape {
             },
             PressShape::Mesh { path, scale } => {
                 let mesh = tactex_sim::mesh::load(path)?;
-                mesh.validate(&path.display().to_string())?;
-                if let Some(size_m) = mesh.size_off_table_m(*scale) {
-                    let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
-                    anyhow::bail!(
-                        "--mesh {}: {} m across at --mesh-scale {}, not a size an object on a table has ({least} to {most} m); set --mesh-scale to the mesh's unit in metres",
-                        path.display(),
-                        tactex_core::printable::short_number(size_m),
-                        tactex_core::printable::short_number(*scale)
-                    );
-                }
-                ObjectSurface::Mesh(
-                    mesh_top(&mesh, scale * 1e3)
-                        .transformed(DQuat::from_rotation_z(yaw_rad), centre_mm.extend(0.0)),
-                )
+                let name = format!("--mesh {}", path.display());
+                placed_mesh(&mesh, &name, "--mesh-scale", *scale, pose)?
             }
+            PressShape::Triangles { mesh, scale, name } => {
+                placed_mesh(mesh, name, "mesh_scale", *scale, pose)?
+            }
+            PressShape::HeightMap(map) => ObjectSurface::Mesh(
+                map.sheet()?
+                    .transformed(DQuat::from_rotation_z(yaw_rad), centre_mm.extend(0.0)),
+            ),
         })
     }
+}
+
+/// A mesh in its own units, checked as a solid of a table's size, pressed at the middle of
+/// its top at `pose`: a file's and a caller's mesh alike.
+fn placed_mesh(
+    mesh: &TriMesh,
+    name: &str,
+    scale_name: &str,
+    scale: f64,
+    pose: PressPose,
+) -> Result<ObjectSurface> {
+    mesh.validate(name.trim_start_matches("--mesh "))?;
+    if let Some(size_m) = mesh.size_off_table_m(scale) {
+        let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
+        bail!(
+            "{name}: {} m across at {scale_name} {}, not a size an object on a table has ({least} to {most} m); set {scale_name} to the mesh's unit in metres",
+            tactex_core::printable::short_number(size_m),
+            tactex_core::printable::short_number(scale)
+        );
+    }
+    Ok(ObjectSurface::Mesh(
+        mesh_top(mesh, scale * 1e3).transformed(
+            DQuat::from_rotation_z(pose.yaw_deg.to_radians()),
+            DVec2::from_array(pose.at_mm).extend(0.0),
+        ),
+    ))
 }
 
 /// One press: the object, how far past first touch, the physics, and the sensor (its gel

@@ -112,6 +112,9 @@ fn describe(q: &Query) -> String {
     if !q.unknown.is_empty() {
         s += &format!("unknown:  {} (not in the catalog)\n", q.unknown.join(", "));
     }
+    if let Some(c) = &q.candidate {
+        s += &format!("held up:  the {c}, against every fruit (yes or no)\n");
+    }
     for c in &q.corrected {
         s += &format!("read:     '{}' as {}\n", c.said, c.read);
     }

@@ -44,6 +44,13 @@ const NEGATIONS: &[&str] = &[
     "unsuitable",
     "unfit",
     "avoid",
+    "least",
+    "no",
+    "terrible",
+    "awful",
+    "poor",
+    "unsuited",
+    "leave",
 ];
 
 const fn use_of(
@@ -269,6 +276,9 @@ mod tests {
             "which fruit should i not keep",
             "which fruit should i not use for a smoothie",
             "which fruit is worst for a smoothie",
+            "which fruit is least suitable for a smoothie",
+            "which fruit is no good for a smoothie",
+            "which fruit should i leave out of the smoothie",
         ] {
             assert_eq!(find(&words(other)), None, "{other}");
         }

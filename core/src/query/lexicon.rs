@@ -103,12 +103,14 @@ pub const COLOUR_COMPARATIVES: &[&str] = &[
     "reddest",
     "brownest",
     "pinkest",
+    "orangest",
+    "purplest",
 ];
 
 /// Ordinals that would pick an instance by count ("the second banana"): which is first is
 /// not something the camera's view settles.
 pub const ORDINALS: &[&str] = &[
-    "first", "second", "third", "fourth", "fifth", "1st", "2nd", "3rd", "4th", "5th",
+    "first", "second", "third", "fourth", "fifth", "1st", "2nd", "3rd", "4th", "5th", "last",
 ];
 
 /// Words after which the fruit names are exclusions.
@@ -188,6 +190,13 @@ pub const PHRASES: &[(&str, &str)] = &[
     ("not ripe", "unripe"),
     ("still green", "unripe"),
     ("not as", "less"),
+    // "the hardest fruit that is not the avocado", "for a smoothie, not the banana": the
+    // fruit after is left out.
+    ("that is not", "except"),
+    ("that isn t", "except"),
+    ("which is not", "except"),
+    ("which isn t", "except"),
+    ("| not the", "| except the"),
     // "softer than all the other fruit", "than everything else": every other fruit.
     ("than all of the others", "than the others"),
     ("than all the others", "than the others"),

@@ -245,6 +245,8 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let mut plural = false;
     // (property, degree, points to the low end)
     let mut properties: Vec<(Property, Degree, bool)> = Vec::new();
+    // "as hard as the mango": a comparison of equals.
+    let mut as_much = false;
     for (i, w) in words.iter().enumerate() {
         let w = w.as_str();
         let prev = if i > 0 { at(i - 1) } else { None };
@@ -264,10 +266,13 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         }
         // "the second banana", "the first one": an instance by count.
         if lexicon::ORDINALS.contains(&w)
-            && words[i + 1..]
-                .iter()
-                .take(2)
-                .any(|n| is_noun(n) && n != "fruit" || n == "ones")
+            && words[i + 1..].iter().take(2).any(|n| {
+                (is_noun(n) && n != "fruit")
+                    || n == "ones"
+                    || (w != "last"
+                        && lexicon::property_word(n)
+                            .is_some_and(|p| p.degree == Degree::Superlative))
+            })
         {
             return Err(QueryError::Unsupported {
                 what: format!("a fruit picked by count ('{w}')"),
@@ -592,14 +597,29 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         if let Some(pw) = lexicon::property_word(w) {
             // "Which fruit is not soft?" read as the softest; "not softer than" is read
             // where the comparison is.
-            if prev.is_some_and(lexicon::negates) && at(i + 1) != Some("than") {
+            // "not the softest", "isn't too hard": a negation a few filler words back.
+            let negated = words[..i]
+                .iter()
+                .rev()
+                .take(4)
+                .find(|w| {
+                    !matches!(
+                        w.as_str(),
+                        "the" | "too" | "so" | "very" | "most" | "least" | "quite" | "really"
+                    )
+                })
+                .is_some_and(|w| lexicon::negates(w));
+            if negated && at(i + 1) != Some("than") {
                 return Err(QueryError::Unsupported {
                     what: format!("a property turned around ('not {w}')"),
                     instead: "ask for its opposite, e.g. \"Which fruit is the hardest?\" for \"not soft\"".into(),
                 });
             }
             // "as hard as the mango" compares the two, as "harder than" does.
-            let as_as = prev == Some("as") && at(i + 1) == Some("as");
+            let as_as = prev == Some("as")
+                && at(i + 1) == Some("as")
+                && words[i + 2..].iter().take(3).any(|w| is_fruit(w));
+            as_much |= as_as;
             let (degree, flipped) = match (pw.degree, prev) {
                 (Degree::Base, _) if as_as => (Degree::Comparative, false),
                 (Degree::Base, Some("most")) => (Degree::Superlative, false),
@@ -657,9 +677,12 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     }
     // "Is the mango harder than the avocado?" compares two named fruit, the reference one of
     // them; "Which apple is softer than the lime?" holds the named ones against it.
-    let yes_no = words
-        .first()
-        .is_some_and(|w| matches!(w.as_str(), "is" | "are" | "was" | "does" | "do" | "can"));
+    let yes_no = words.first().is_some_and(|w| {
+        matches!(
+            w.as_str(),
+            "is" | "are" | "was" | "does" | "do" | "can" | "isn" | "aren" | "wasn"
+        )
+    });
     // "Is the banana on the right softer than the banana on the left?": two of one kind, told
     // apart by place, stay the fruit asked about (at its place) held against the one at the
     // reference's place.
@@ -794,11 +817,14 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         || (superlatives >= 2 && has(&["from"]) && has(&["to"]));
     // The property and direction come from the first property word: "from softest to
     // hardest" ranks by softness.
-    let (mut property, _, flipped) =
-        properties
-            .first()
-            .copied()
-            .unwrap_or((Property::Hardness, Degree::Base, false));
+    // A superlative names what is asked before a passing word ("Don't press too hard:
+    // which fruit is softest?").
+    let (mut property, _, flipped) = properties
+        .iter()
+        .find(|p| p.1 == Degree::Superlative && !ranked)
+        .or(properties.first())
+        .copied()
+        .unwrap_or((Property::Hardness, Degree::Base, false));
     if let Some(harder) = threshold
         .as_ref()
         .map(|t| t.harder)
@@ -864,13 +890,16 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
     let first_property = words
         .iter()
         .position(|w| lexicon::property_word(w).is_some());
+    // "softer than the others": every other fruit, as a superlative is.
+    let than_others = words
+        .windows(3)
+        .any(|w| w[0] == "than" && w[1] == "the" && matches!(w[2].as_str(), "others" | "other"));
     let candidate = match (intent, targets.as_slice(), first_property) {
         (Intent::Extreme, [kind], Some(p))
             if yes_no
+                && (superlatives > 0 || than_others)
                 && goal.is_none()
                 && categories.is_empty()
-                && filters == Filters::default()
-                && positions.is_empty()
                 && words[..p].iter().any(|w| is_fruit(w))
                 && !words[p..].iter().any(|w| is_fruit(w)) =>
         {
@@ -878,9 +907,34 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         }
         _ => None,
     };
-    if candidate.is_some() {
+    if let Some(kind) = &candidate {
+        // A place, colour, count or size picks among instances, and several asked at once
+        // leave open which must win: neither is held up to the rest yet.
+        if filters != Filters::default() || plural {
+            return Err(QueryError::Unsupported {
+                what: if plural {
+                    format!("several {kind}s held up to every other fruit")
+                } else {
+                    format!(
+                        "one {kind} picked by place, colour or size held up to every other fruit"
+                    )
+                },
+                instead: format!(
+                    "ask \"Which fruit is the {}?\" and read where the {kind} stands",
+                    superlative_word(property, extreme)
+                ),
+            });
+        }
         targets.clear();
         all = true;
+    }
+    // "Which fruit is as hard as the apple?": fruit alike within the uncertainty is no set
+    // the answer picks yet; "Is the apple as hard as the mango?" compares the two.
+    if as_much && intent != Intent::Compare {
+        return Err(QueryError::Unsupported {
+            what: "fruit as hard (soft, ripe) as another".into(),
+            instead: "compare two by name, e.g. \"Is the apple as hard as the mango?\", or ask \"Which fruit is harder than the apple?\"".into(),
+        });
     }
     Ok(Query {
         intent,
@@ -900,6 +954,17 @@ pub fn parse(prompt: &str, catalog: &FruitCatalog) -> Result<Query, QueryError> 
         // A use names an end: a comparison of two or one fruit's reading has none to say.
         goal: goal.filter(|_| !matches!(intent, Intent::Compare | Intent::Identify)),
     })
+}
+
+/// How a refusal names the superlative asked for: "softest", "least ripe".
+fn superlative_word(property: Property, extreme: Option<Extreme>) -> &'static str {
+    let least = extreme == Some(Extreme::Least);
+    match (property, least) {
+        (Property::Hardness, false) | (Property::Softness, true) => "hardest",
+        (Property::Softness, false) | (Property::Hardness, true) => "softest",
+        (Property::Ripeness, false) => "ripest",
+        (Property::Ripeness, true) => "least ripe",
+    }
 }
 
 /// The place words of "on the left", "at the back", "in the front corner" starting at word

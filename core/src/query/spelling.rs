@@ -17,7 +17,8 @@ pub struct Correction {
 const ENGLISH: &[&str] = &[
     "apply", "ample", "ampler", "applied", "peace", "perch", "poach", "pooch", "lines", "liked",
     "likes", "limbs", "mange", "manga", "mangy", "bandana", "bandanas", "lemony", "orangy", "line",
-    "like", "limb", "lima", "time", "peaces", "lemma", "lemmas",
+    "like", "limb", "lima", "time", "peaces", "lemma", "lemmas", "peachy", "mangle", "mangles",
+    "mangled", "applet", "applets", "limey", "orangey",
 ];
 
 /// The catalog word `word` is a typing slip of, if exactly one is that near.
@@ -26,6 +27,8 @@ pub fn slip_of(word: &str, catalog: &FruitCatalog) -> Option<String> {
         || !word.chars().all(|c| c.is_ascii_lowercase())
         || catalog.find_word(word).is_some()
         || super::lexicon::OTHER_FRUITS.contains(&word)
+        || super::lexicon::COLOUR_COMPARATIVES.contains(&word)
+        || super::lexicon::property_word(word).is_some()
         || ENGLISH.contains(&word)
     {
         return None;

@@ -433,6 +433,30 @@ pub fn find(prompt: &str) -> Result<Option<Threshold>, QueryError> {
                 let negated = j > 0 && super::lexicon::negates(&words[j - 1]);
                 harder != negated
             });
+        // "1 000 kPa", "1'000 kPa": digit groups split into two numbers, the first of which
+        // would be read alone.
+        let group = |w: &str| w.len() == 3 && w.chars().all(|c| c.is_ascii_digit());
+        if words[i].chars().all(|c| c.is_ascii_digit())
+            && words.get(i + 1).is_some_and(|w| group(w))
+        {
+            let mut end = i + 1;
+            while words.get(end + 1).is_some_and(|w| group(w)) {
+                end += 1;
+            }
+            return Err(QueryError::BadThreshold {
+                value: words[i..=end].join(" "),
+                message: format!(
+                    "write the number without spaces or marks between its digits ({})",
+                    words[i..=end].concat()
+                ),
+            });
+        }
+        if words[i].contains(',') && words[i].contains('.') {
+            return Err(bad(format!(
+                "write it without the comma ({})",
+                words[i].replace(',', "")
+            )));
+        }
         if let Some((whole, rest)) = words[i].split_once(',') {
             // "1,000 kPa" groups thousands, or is 1.000 written the European way.
             let grouped = !whole.is_empty()

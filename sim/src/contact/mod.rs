@@ -42,4 +42,4 @@ pub use solution::{ContactSolution, GelFields};
 pub use solver::{
     ContactSolver, DEFAULT_CELLS_ACROSS, DEFAULT_MAX_CELLS, MAX_CELLS, field_pooling,
 };
-pub use surface::{ObjectSurface, mesh_top};
+pub use surface::{HeightMap, ObjectSurface, mesh_top};

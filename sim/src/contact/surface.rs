@@ -4,6 +4,7 @@
 //! works, the catalog fruits included.
 
 use super::grid::{Grid, Rect};
+use super::problem::{ContactError, invalid};
 use crate::mesh::TriMesh;
 use glam::{DVec2, DVec3};
 
@@ -59,6 +60,129 @@ pub fn mesh_top(mesh: &TriMesh, scale_to_mm: f64) -> TriMesh {
             .map(|v| DVec3::new(v.x - centre.x, -(v.y - centre.y), hi.z - v.z) * scale_to_mm)
             .collect(),
         triangles: mesh.triangles.clone(),
+    }
+}
+
+/// An object's surface given as a height map over a grid of points (Taxim's contract): the
+/// surface's height in mm, larger nearer the gel (the part that touches first is the
+/// highest), row-major `width` x `height` at `mm_per_px` spacing, the grid centred on the
+/// origin with its points at pixel centres as a frame's are. NaN where the object is absent.
+#[derive(Clone, Debug)]
+pub struct HeightMap {
+    pub heights_mm: Vec<f64>,
+    pub width: usize,
+    pub height: usize,
+    pub mm_per_px: f64,
+}
+
+impl HeightMap {
+    /// Why no surface can be made of it, naming the field: sizes, spacing, values.
+    pub fn validate(&self) -> Result<(), ContactError> {
+        if self.width < 2 || self.height < 2 {
+            return Err(invalid(
+                "height_map_mm",
+                format!(
+                    "{} x {} points; a surface needs at least 2 x 2",
+                    self.height, self.width
+                ),
+            ));
+        }
+        if self.heights_mm.len() != self.width * self.height {
+            return Err(invalid(
+                "height_map_mm",
+                format!(
+                    "{} values for {} x {} points",
+                    self.heights_mm.len(),
+                    self.height,
+                    self.width
+                ),
+            ));
+        }
+        if !(self.mm_per_px.is_finite() && self.mm_per_px > 0.0) {
+            return Err(invalid(
+                "mm_per_px",
+                format!("must be a positive finite number, got {}", self.mm_per_px),
+            ));
+        }
+        if let Some(k) = self.heights_mm.iter().position(|h| h.is_infinite()) {
+            return Err(invalid(
+                "height_map_mm",
+                format!(
+                    "infinite at row {}, column {} (NaN marks where the object is absent)",
+                    k / self.width,
+                    k % self.width
+                ),
+            ));
+        }
+        if self.heights_mm.iter().all(|h| h.is_nan()) {
+            return Err(invalid(
+                "height_map_mm",
+                "every value is NaN; there is no surface",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The surface as the pad sees it: a sheet of two triangles per grid cell whose four
+    /// corners are all present, z measured down from the highest point (which touches the gel
+    /// first), in the pad frame.
+    pub fn sheet(&self) -> Result<TriMesh, ContactError> {
+        self.validate()?;
+        let top = self
+            .heights_mm
+            .iter()
+            .copied()
+            .filter(|h| !h.is_nan())
+            .fold(f64::NEG_INFINITY, f64::max);
+        let (w, h) = (self.width, self.height);
+        let vertices = self
+            .heights_mm
+            .iter()
+            .enumerate()
+            .map(|(k, z)| {
+                let (i, j) = ((k % w) as f64, (k / w) as f64);
+                DVec3::new(
+                    (i + 0.5 - w as f64 / 2.0) * self.mm_per_px,
+                    (j + 0.5 - h as f64 / 2.0) * self.mm_per_px,
+                    top - z,
+                )
+            })
+            .collect::<Vec<_>>();
+        let mut triangles = Vec::with_capacity(2 * (w - 1) * (h - 1));
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let at = |di: usize, dj: usize| ((j + dj) * w + i + di) as u32;
+                let corners = [at(0, 0), at(1, 0), at(0, 1), at(1, 1)];
+                if corners.iter().any(|&c| vertices[c as usize].z.is_nan()) {
+                    continue;
+                }
+                triangles.push([corners[0], corners[1], corners[3]]);
+                triangles.push([corners[0], corners[3], corners[2]]);
+            }
+        }
+        if triangles.is_empty() {
+            return Err(invalid(
+                "height_map_mm",
+                "no grid cell has all four corners present (not NaN)",
+            ));
+        }
+        // Only the points triangles use: an absent (NaN) point is no vertex.
+        let mut index = vec![u32::MAX; vertices.len()];
+        let mut kept = Vec::new();
+        for t in &mut triangles {
+            for v in t.iter_mut() {
+                let k = *v as usize;
+                if index[k] == u32::MAX {
+                    index[k] = kept.len() as u32;
+                    kept.push(vertices[k]);
+                }
+                *v = index[k];
+            }
+        }
+        Ok(TriMesh {
+            vertices: kept,
+            triangles,
+        })
     }
 }
 
@@ -496,6 +620,68 @@ mod tests {
             lowest <= sampled + 1e-9 && sampled - lowest < 0.05,
             "{lowest} vs {sampled}"
         );
+    }
+
+    #[test]
+    fn a_height_map_of_a_sphere_is_the_sphere() {
+        let (r, w, h, px) = (20.0f64, 40usize, 30usize, 0.2f64);
+        let heights_mm = (0..w * h)
+            .map(|k| {
+                let x = ((k % w) as f64 + 0.5 - w as f64 / 2.0) * px;
+                let y = ((k / w) as f64 + 0.5 - h as f64 / 2.0) * px;
+                (r * r - x * x - y * y).sqrt()
+            })
+            .collect();
+        let map = HeightMap {
+            heights_mm,
+            width: w,
+            height: h,
+            mm_per_px: px,
+        };
+        let sheet = ObjectSurface::Mesh(map.sheet().unwrap());
+        let sphere = ObjectSurface::Sphere {
+            radius_mm: r,
+            centre_mm: DVec2::ZERO,
+        };
+        let grid = Grid {
+            origin_mm: DVec2::new(-2.0, -1.5),
+            cell_mm: 0.13,
+            nx: 30,
+            ny: 23,
+        };
+        // The sheet's points are at pixel centres; the sphere's top (0.1 mm off the nearest)
+        // is 0.1^2 / 2R = 2.5e-4 mm below its highest point.
+        for (a, b) in sheet.heights(&grid).iter().zip(sphere.heights(&grid)) {
+            assert!((a - b).abs() < 1e-3, "{a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn a_height_map_that_cannot_be_a_surface_names_why() {
+        let map = |heights_mm: Vec<f64>, width, height, mm_per_px| HeightMap {
+            heights_mm,
+            width,
+            height,
+            mm_per_px,
+        };
+        let bad = [
+            (map(vec![0.0; 3], 3, 1, 0.1), "at least 2 x 2"),
+            (map(vec![0.0; 5], 2, 2, 0.1), "5 values"),
+            (map(vec![0.0; 4], 2, 2, f64::NAN), "mm_per_px"),
+            (
+                map(vec![0.0, f64::INFINITY, 0.0, 0.0], 2, 2, 0.1),
+                "infinite at row 0, column 1",
+            ),
+            (map(vec![f64::NAN; 4], 2, 2, 0.1), "every value is NaN"),
+            (
+                map(vec![0.0, f64::NAN, 0.0, 0.0], 2, 2, 0.1),
+                "four corners",
+            ),
+        ];
+        for (m, says) in bad {
+            let e = m.sheet().unwrap_err().to_string();
+            assert!(e.contains(says), "{e}");
+        }
     }
 
     #[test]
