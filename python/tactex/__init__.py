@@ -4,10 +4,10 @@ pipeline, and a real sensor's calibration and sim-to-real comparison.
 
 Everything here runs the same Rust library as the ``tactex`` command line: a press, a sample
 or an answer is the same bytes from Python as from the CLI at the same seed. Arguments are
-checked by the CLI's own parser; a bad one raises ``ValueError`` (a missing file
-``FileNotFoundError``, a failure of the machinery ``RuntimeError``) with the CLI's one-line
-message, which names the flag (``--depth-mm``) that the keyword argument (``depth_mm``)
-stands for.
+checked by the library the CLI runs; every error is a ``tactex.TactexError``: a bad argument
+``tactex.InvalidArgument`` (a ``ValueError``), a missing file ``tactex.MissingFile`` (a
+``FileNotFoundError``), a failure of the machinery ``tactex.Failure`` (a ``RuntimeError``),
+with a one-line message that names the keyword (``depth_mm``).
 
     >>> import tactex
     >>> press = tactex.Sensor().press("sphere", radius_mm=6, hardness="40A", depth_mm=1.0)
@@ -24,9 +24,25 @@ from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import _tactex
+from . import _tactex as _raw
+from .errors import Failure, InvalidArgument, MissingFile, TactexError, translated
+
+
+class _Native:
+    """The native module with its errors raised as this package's, in Python's words."""
+
+    def __getattr__(self, name: str) -> Any:
+        value = getattr(_raw, name)
+        return translated(value) if callable(value) else value
+
+
+_tactex = _Native()
 
 __all__ = [
+    "TactexError",
+    "InvalidArgument",
+    "MissingFile",
+    "Failure",
     "Sensor",
     "Press",
     "PressSequence",
@@ -90,7 +106,7 @@ def _geometry(
     if height_map_mm is not None:
         h = np.asarray(height_map_mm, dtype=np.float64)
         if h.ndim != 2:
-            raise ValueError(f"height_map_mm: must be 2-D (rows, columns), got shape {h.shape}")
+            raise InvalidArgument(f"height_map_mm: must be 2-D (rows, columns), got shape {h.shape}")
         geometry["height_map_mm"] = np.ascontiguousarray(h)
         return geometry
     if mesh is None or isinstance(mesh, (str, os.PathLike)):
@@ -101,17 +117,17 @@ def _geometry(
         try:
             vertices, faces = mesh
         except (TypeError, ValueError):
-            raise ValueError(
+            raise InvalidArgument(
                 "mesh: give a file path, (vertices, faces) arrays or a trimesh.Trimesh"
             ) from None
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     if v.ndim != 2 or f.ndim != 2:
-        raise ValueError(
+        raise InvalidArgument(
             f"mesh: vertices and faces must be 2-D (N x 3, M x 3), got {v.shape} and {f.shape}"
         )
     if f.dtype.kind not in "iu":
-        raise ValueError(f"mesh: faces must be integer indices, got {f.dtype}")
+        raise InvalidArgument(f"mesh: faces must be integer indices, got {f.dtype}")
     geometry["vertices"] = np.ascontiguousarray(v)
     geometry["faces"] = np.ascontiguousarray(f.astype(np.int64))
     return geometry
@@ -124,7 +140,7 @@ def _pose_flags(pose: Optional[Tuple[float, float, float]]) -> Dict[str, Any]:
     try:
         x, y, yaw = (float(v) for v in pose)
     except (TypeError, ValueError):
-        raise ValueError(f"pose: give (x_mm, y_mm, yaw_deg), got {pose!r}") from None
+        raise InvalidArgument(f"pose: give (x_mm, y_mm, yaw_deg), got {pose!r}") from None
     return {"at_mm": (x, y), "yaw_deg": yaw}
 
 
@@ -459,9 +475,9 @@ def shard_indices(count: int, shard: Tuple[int, int] = (0, 1), start: int = 0) -
     from ``start`` on, as ``datagen tactile --shard i/n`` takes them."""
     i, n = shard
     if not (isinstance(n, int) and isinstance(i, int) and n >= 1 and 0 <= i < n):
-        raise ValueError(f"shard: {shard!r} is not (i, n) with 0 <= i < n")
+        raise InvalidArgument(f"shard: {shard!r} is not (i, n) with 0 <= i < n")
     if count < 0 or start < 0:
-        raise ValueError(f"count and start must be at least 0, got {count} and {start}")
+        raise InvalidArgument(f"count and start must be at least 0, got {count} and {start}")
     first = start + (i - start) % n
     return range(first, count, n)
 
@@ -472,7 +488,7 @@ def worker_shard(shard: Tuple[int, int], worker: int, workers: int) -> Tuple[int
     data-loader workers drawing their own shard yield each sample exactly once."""
     i, n = shard
     if not (isinstance(workers, int) and workers >= 1 and 0 <= worker < workers):
-        raise ValueError(f"worker {worker} of {workers}: not 0 <= worker < workers")
+        raise InvalidArgument(f"worker {worker} of {workers}: not 0 <= worker < workers")
     return (i + worker * n, n * workers)
 
 
@@ -498,7 +514,7 @@ def generate(
     indices = shard_indices(count, shard, start)
     step = batch if batch is not None else 4 * _tactex.threads()
     if step < 1:
-        raise ValueError(f"batch: must be at least 1, got {step}")
+        raise InvalidArgument(f"batch: must be at least 1, got {step}")
     for k in range(0, len(indices), step):
         chunk = list(indices[k : k + step])
         drawn = _tactex.generate_samples(fidelity, shape_list, profile, seed, chunk)

@@ -22,6 +22,7 @@ import torch
 from torch.utils.data import Dataset, IterableDataset, get_worker_info
 
 from . import Sample, generate, shard_indices, worker_shard
+from .errors import MissingFile
 
 Target = Callable[[Dict[str, Any]], float]
 
@@ -91,7 +92,7 @@ class TactileFolder(Dataset):
         try:
             self.info: Dict[str, Any] = json.loads(info_path.read_text())
         except FileNotFoundError:
-            raise FileNotFoundError(f"{info_path}: not a tactex data set (no dataset.json)") from None
+            raise MissingFile(f"{info_path}: not a tactex data set (no dataset.json)") from None
         lines: List[Dict[str, Any]] = []
         for manifest in sorted(self.root.glob("shard-*-of-*.jsonl")):
             with open(manifest) as f:
