@@ -10,17 +10,73 @@ use tactex_core::hardness::indentation_estimator::IndentationEstimator;
 use tactex_core::hardness::interval_calibration::{Calibrated, IntervalCalibration};
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 
+pub type BoxedEstimator = Box<dyn HardnessEstimator + Send + Sync>;
+
+/// An estimator chosen by name (`--estimator NAME`).
+#[derive(Debug)]
+pub struct NamedEstimator {
+    pub name: &'static str,
+    /// Other spellings `--estimator` takes.
+    pub aliases: &'static [&'static str],
+    /// A trained model built into the binary (`eval hardness --no-builtin-model` leaves it
+    /// out), not a geometric reading.
+    pub trained: bool,
+    pub open: fn() -> Result<BoxedEstimator>,
+}
+
+/// Every estimator chosen by name: the one place a new one is registered. `ask`, `serve`,
+/// `compare --session` and the evaluations take it by name from here, and `eval hardness`
+/// scores every one, in this order.
+pub const ESTIMATORS: &[NamedEstimator] = &[
+    NamedEstimator {
+        name: "hertz",
+        aliases: &["hertz-slopes", "hertz_slopes"],
+        trained: false,
+        open: || Ok(Box::new(HertzSlopeEstimator::default())),
+    },
+    NamedEstimator {
+        name: "indentation",
+        aliases: &[],
+        trained: false,
+        open: || Ok(Box::new(IndentationEstimator::default())),
+    },
+    NamedEstimator {
+        name: "learned",
+        aliases: &[],
+        trained: true,
+        open: || Ok(Box::new(tactex_learned::builtin::builtin_small()?)),
+    },
+];
+
 /// A hardness estimator by name, or a trained model file.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum EstimatorChoice {
-    /// The built-in trained CNN (models/hardness-small.onnx).
-    Learned,
-    /// Layer-aware split of the gel's integrated indentation (any shape, bonded gel).
-    Indentation,
-    /// Hertz half-space fit of the slope field.
-    Hertz,
+    /// One of `ESTIMATORS`: the built-in trained CNN (learned), the layer-aware split of the
+    /// gel's integrated indentation (indentation), the Hertz half-space fit of the slope
+    /// field (hertz).
+    Named(&'static NamedEstimator),
     /// A trained model of the same contract (NAME.onnx with its card NAME.json beside it).
     Model(PathBuf),
+}
+
+impl PartialEq for EstimatorChoice {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Self::Named(a), Self::Named(b)) => a.name == b.name,
+            (Self::Model(a), Self::Model(b)) => a == b,
+            _ => false,
+        }
+    }
+}
+
+impl EstimatorChoice {
+    /// The registered estimator called `name`.
+    pub fn named(name: &str) -> Option<Self> {
+        ESTIMATORS
+            .iter()
+            .find(|e| e.name == name || e.aliases.contains(&name))
+            .map(Self::Named)
+    }
 }
 
 /// What `--estimator` takes, for help texts and errors.
@@ -52,21 +108,16 @@ const BUILTIN_INTERVALS: &[(&str, &str, &str, &str)] = &[
 impl FromStr for EstimatorChoice {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s.trim() {
-            "learned" => Ok(Self::Learned),
-            "indentation" => Ok(Self::Indentation),
-            "hertz" | "hertz-slopes" | "hertz_slopes" => Ok(Self::Hertz),
-            path if path.to_ascii_lowercase().ends_with(".onnx") => {
-                Ok(Self::Model(PathBuf::from(path)))
-            }
-            other => Err(format!(
-                "unknown estimator {other:?} (use {ESTIMATOR_VALUES})"
-            )),
+        let s = s.trim();
+        if let Some(named) = Self::named(s) {
+            return Ok(named);
         }
+        if s.to_ascii_lowercase().ends_with(".onnx") {
+            return Ok(Self::Model(PathBuf::from(s)));
+        }
+        Err(format!("unknown estimator {s:?} (use {ESTIMATOR_VALUES})"))
     }
 }
-
-pub type BoxedEstimator = Box<dyn HardnessEstimator + Send + Sync>;
 
 /// Why `estimator` cannot read the presses `sensor` makes (the protocol's frames), if it
 /// cannot.
@@ -92,9 +143,7 @@ impl EstimatorChoice {
     /// The value of `--estimator` that names this choice.
     pub fn flag_value(&self) -> String {
         match self {
-            Self::Learned => "learned".into(),
-            Self::Indentation => "indentation".into(),
-            Self::Hertz => "hertz".into(),
+            Self::Named(e) => e.name.into(),
             Self::Model(path) => path.display().to_string(),
         }
     }
@@ -103,9 +152,7 @@ impl EstimatorChoice {
     /// `flag` names the option in errors.
     pub fn open_uncalibrated(&self, flag: &str, sensor: &SensorProfile) -> Result<BoxedEstimator> {
         let estimator: BoxedEstimator = match self {
-            Self::Learned => Box::new(tactex_learned::builtin::builtin_small()?),
-            Self::Indentation => Box::new(IndentationEstimator::default()),
-            Self::Hertz => Box::new(HertzSlopeEstimator::default()),
+            Self::Named(e) => (e.open)()?,
             Self::Model(path) => {
                 if !path.is_file() {
                     bail!("{flag} {}: no such model file", path.display());
@@ -340,7 +387,7 @@ mod tests {
             name: "mine".into(),
             sha256: "ab".repeat(32),
         };
-        let choice = EstimatorChoice::Indentation;
+        let choice = EstimatorChoice::named("indentation").unwrap();
         let beside = profile_intervals_path(&profile, &choice, "layer");
         assert_eq!(
             beside.file_name().and_then(|n| n.to_str()),

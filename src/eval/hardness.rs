@@ -3,7 +3,7 @@
 //! by RMSE, R2 and Spearman's rho (core's stats, checked against scipy), with the paper's
 //! Fig. 5 (predicted against true hardness) as a PNG.
 
-use crate::app::estimator_choice::{check_reads, unreadable};
+use crate::app::estimator_choice::{ESTIMATORS, check_reads, unreadable};
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::report::plot::{self, ScatterSeries};
 use anyhow::{Context, Result};
@@ -13,8 +13,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::hardness::estimate::{Evidence, HardnessEstimator, HertzSlopeEstimator};
-use tactex_core::hardness::indentation_estimator::IndentationEstimator;
+use tactex_core::hardness::estimate::{Evidence, HardnessEstimator};
 use tactex_core::hardness::scale::shore_a_to_modulus_mpa;
 use tactex_core::stats::{r_squared, rmse, spearman};
 use tactex_sim::contact::ContactSolver;
@@ -109,18 +108,19 @@ pub fn run(args: &HardnessEvalArgs) -> Result<()> {
     let sensor_id = space.sensor.id();
     space.modulus_mpa = SHORE_A_RANGE.map(|s| shore_a_to_modulus_mpa(s).expect("below 100"));
     let catalog = FruitCatalog::builtin();
-    let mut estimators: Vec<Box<dyn HardnessEstimator + Sync>> = vec![
-        Box::new(HertzSlopeEstimator::default()),
-        Box::new(IndentationEstimator::default()),
-    ];
-    if !args.no_builtin_model {
-        let builtin = tactex_learned::builtin::builtin_small()?;
-        // Through a profile of another frame size the built-in model reads nothing: it is
-        // left out with why, and the geometric estimators are scored.
-        match unreadable(&builtin, &space.sensor) {
-            None => estimators.push(Box::new(builtin)),
+    let mut estimators: Vec<Box<dyn HardnessEstimator + Sync>> = Vec::new();
+    for named in ESTIMATORS {
+        if named.trained && args.no_builtin_model {
+            continue;
+        }
+        let estimator = (named.open)()?;
+        // Through a profile of another frame size a built-in model reads nothing: it is left
+        // out with why, and the others are scored.
+        match unreadable(estimator.as_ref(), &space.sensor) {
+            None => estimators.push(estimator),
             Some(why) => eprintln!(
-                "note: the built-in model is left out: {why} (--model scores one trained on it)"
+                "note: the built-in {} estimator is left out: {why} (--model scores one trained on this sensor)",
+                named.name
             ),
         }
     }
