@@ -87,6 +87,25 @@ def _flags(**values: Any) -> List[str]:
     return out
 
 
+def _number(name: str, value: Any) -> Optional[float]:
+    """A keyword's number, or None; anything else is an InvalidArgument naming it."""
+    if value is None:
+        return None
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise InvalidArgument(f"{name}: give a number, got {value!r}") from None
+
+
+def _array(name: str, value: Any, dtype: Any) -> np.ndarray:
+    """A keyword's array of ``dtype``, C-contiguous; what numpy cannot make one of is an
+    InvalidArgument naming the keyword."""
+    try:
+        return np.ascontiguousarray(np.asarray(value, dtype=dtype))
+    except (TypeError, ValueError) as e:
+        raise InvalidArgument(f"{name}: not an array of numbers ({e})") from None
+
+
 def _geometry(
     mesh: Any = None,
     mesh_scale: Optional[float] = None,
@@ -99,36 +118,47 @@ def _geometry(
     geometry: Dict[str, Any] = {
         "vertices": None,
         "faces": None,
-        "mesh_scale": None if mesh_scale is None else float(mesh_scale),
+        "mesh_scale": _number("mesh_scale", mesh_scale),
         "height_map_mm": None,
-        "mm_per_px": None if mm_per_px is None else float(mm_per_px),
+        "mm_per_px": _number("mm_per_px", mm_per_px),
     }
     if height_map_mm is not None:
-        h = np.asarray(height_map_mm, dtype=np.float64)
+        try:
+            h = np.asarray(height_map_mm)
+        except (TypeError, ValueError) as e:
+            raise InvalidArgument(f"height_map_mm: not an array of numbers ({e})") from None
+        if h.dtype.kind not in "iuf":
+            raise InvalidArgument(f"height_map_mm: must hold real numbers, got dtype {h.dtype}")
+        h = _array("height_map_mm", h, np.float64)
         if h.ndim != 2:
             raise InvalidArgument(f"height_map_mm: must be 2-D (rows, columns), got shape {h.shape}")
-        geometry["height_map_mm"] = np.ascontiguousarray(h)
+        geometry["height_map_mm"] = h
         return geometry
     if mesh is None or isinstance(mesh, (str, os.PathLike)):
         return None
     if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
         vertices, faces = mesh.vertices, mesh.faces
+    elif isinstance(mesh, (tuple, list)) and len(mesh) == 2:
+        vertices, faces = mesh
     else:
-        try:
-            vertices, faces = mesh
-        except (TypeError, ValueError):
-            raise InvalidArgument(
-                "mesh: give a file path, (vertices, faces) arrays or a trimesh.Trimesh"
-            ) from None
-    v = np.asarray(vertices, dtype=np.float64)
-    f = np.asarray(faces)
+        raise InvalidArgument(
+            "mesh: give a file path, (vertices, faces) arrays or an object with vertices and "
+            f"faces (a trimesh.Trimesh), got {type(mesh).__name__}"
+        )
+    v = _array("mesh", vertices, np.float64)
+    try:
+        f = np.asarray(faces)
+    except (TypeError, ValueError) as e:
+        raise InvalidArgument(f"mesh: faces are not an array of indices ({e})") from None
     if v.ndim != 2 or f.ndim != 2:
         raise InvalidArgument(
             f"mesh: vertices and faces must be 2-D (N x 3, M x 3), got {v.shape} and {f.shape}"
         )
     if f.dtype.kind not in "iu":
         raise InvalidArgument(f"mesh: faces must be integer indices, got {f.dtype}")
-    geometry["vertices"] = np.ascontiguousarray(v)
+    if f.dtype.kind == "u" and f.size and f.max() > np.iinfo(np.int64).max:
+        raise InvalidArgument(f"mesh: face index {f.max()} is outside the {len(v)} vertices")
+    geometry["vertices"] = v
     geometry["faces"] = np.ascontiguousarray(f.astype(np.int64))
     return geometry
 
@@ -369,6 +399,8 @@ class Sensor:
         >>> s.render(cap, depth_mm=0.5, hardness="rigid", fidelity="rigid").frame.shape
         (240, 320, 3)
         """
+        if height_map_mm is None:
+            raise InvalidArgument("height_map_mm: give the object's surface, a 2-D array of heights in mm")
         geometry = _geometry(
             height_map_mm=height_map_mm,
             mm_per_px=self.mm_per_px if mm_per_px is None else mm_per_px,

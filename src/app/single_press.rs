@@ -12,8 +12,8 @@ use tactex_core::hertz::Elastic;
 use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
 use tactex_sim::contact::{
-    ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid, HeightMap,
-    ObjectSurface, Rect, field_pooling, mesh_top,
+    ContactError, ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid,
+    HeightMap, ObjectSurface, Rect, field_pooling, mesh_top,
 };
 use tactex_sim::datagen::press_protocol::{PlannedPress, PressSetup, plan_press};
 use tactex_sim::mesh::TriMesh;
@@ -117,11 +117,16 @@ fn placed_mesh(
     mesh.validate(name.trim_start_matches("--mesh "))?;
     if let Some(size_m) = mesh.size_off_table_m(scale) {
         let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
-        bail!(
-            "{name}: {} m across at {scale_name} {}, not a size an object on a table has ({least} to {most} m); set {scale_name} to the mesh's unit in metres",
-            tactex_core::printable::short_number(size_m),
-            tactex_core::printable::short_number(scale)
-        );
+        // A contact error: bad input, named as the caller named the mesh.
+        return Err(ContactError {
+            field: name.to_string(),
+            message: format!(
+                "{} m across at {scale_name} {}, not a size an object on a table has ({least} to {most} m); set {scale_name} to the mesh's unit in metres",
+                tactex_core::printable::short_number(size_m),
+                tactex_core::printable::short_number(scale)
+            ),
+        }
+        .into());
     }
     Ok(ObjectSurface::Mesh(
         mesh_top(mesh, scale * 1e3).transformed(

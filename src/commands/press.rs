@@ -170,7 +170,9 @@ fn object(args: &PressArgs) -> Result<Hardness> {
     match (&args.hardness, args.modulus_mpa) {
         (Some(text), _) => Hardness::parse(text).with_context(|| format!("--hardness {text:?}")),
         (None, Some(e)) => Ok(Hardness::ModulusMpa(e)),
-        (None, None) => bail!("give the object's --hardness (e.g. \"35A\") or --modulus-mpa"),
+        (None, None) => bail!(
+            "--hardness: give the object's hardness (e.g. \"35A\", \"rigid\") or --modulus-mpa"
+        ),
     }
 }
 

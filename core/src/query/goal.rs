@@ -118,6 +118,43 @@ const GOALS: &[Use] = &[
     ),
     use_of(&["eat", "first"], "to eat first", Property::Ripeness, false),
     use_of(
+        &["eat", "soonest"],
+        "to eat soonest",
+        Property::Ripeness,
+        false,
+    ),
+    use_of(
+        &["eating", "soonest"],
+        "to eat soonest",
+        Property::Ripeness,
+        false,
+    ),
+    use_of(
+        &["spoil", "first"],
+        "to use before it spoils",
+        Property::Ripeness,
+        false,
+    ),
+    use_of(
+        &["go", "off", "first"],
+        "to use before it spoils",
+        Property::Ripeness,
+        false,
+    ),
+    use_of(
+        &["go", "bad", "first"],
+        "to use before it spoils",
+        Property::Ripeness,
+        false,
+    ),
+    use_of(&["eat", "last"], "to eat last", Property::Ripeness, true),
+    use_of(
+        &["pack", "for", "lunch"],
+        "for a lunchbox",
+        Property::Ripeness,
+        true,
+    ),
+    use_of(
         &["next", "week"],
         "to keep for next week",
         Property::Ripeness,

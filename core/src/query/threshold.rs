@@ -318,20 +318,7 @@ fn is_number(w: &str) -> bool {
 
 /// Units of hardness or pressure the answer does not read, as they follow a number.
 const OTHER_UNITS: &[&str] = &[
-    "pa",
-    "gpa",
-    "psi",
-    "ksi",
-    "bar",
-    "pascal",
-    "pascals",
-    "kilopascal",
-    "kilopascals",
-    "megapascal",
-    "megapascals",
-    "n",
-    "newton",
-    "newtons",
+    "pa", "gpa", "psi", "ksi", "bar", "pascal", "pascals", "n", "newton", "newtons",
 ];
 
 /// The direction said after a value: "3 MPa or more", "1 MPa and below".
@@ -530,9 +517,11 @@ fn value_at(words: &[String], i: usize) -> Option<Result<(Hardness, String, usiz
     let number = &words[i];
     let unit_after: Vec<&str> = words[i + 1..].iter().take(3).map(String::as_str).collect();
     let after = match unit_after.as_slice() {
-        // N/mm2 is the megapascal.
+        // N/mm2 is the megapascal; the units spelt out are read as their symbols.
         ["n", "mm2" | "mm²", ..] => Some(("mpa".to_string(), i + 2)),
-        ["n", "mm", "2", ..] => Some(("mpa".to_string(), i + 3)),
+        ["n", "mm", "2", ..] | ["n", "per", "mm2" | "mm²"] => Some(("mpa".to_string(), i + 3)),
+        ["megapascal" | "megapascals", ..] => Some(("mpa".to_string(), i + 1)),
+        ["kilopascal" | "kilopascals", ..] => Some(("kpa".to_string(), i + 1)),
         ["shore", s, ..] if matches!(*s, "a" | "00" | "oo") => Some((format!("shore {s}"), i + 2)),
         ["shorea", ..] => Some(("shore a".to_string(), i + 1)),
         ["shore00" | "shoreoo", ..] => Some(("shore 00".to_string(), i + 1)),

@@ -114,6 +114,47 @@ impl HeightMap {
                 ),
             ));
         }
+        // A sheet of more triangles than a mesh may have, or wider or deeper than any object
+        // on a table, is a mistake of units or sampling, not a surface to rasterise for minutes.
+        let triangles = 2 * (self.width - 1) * (self.height - 1);
+        if triangles > crate::mesh::MAX_TRIANGLES {
+            return Err(invalid(
+                "height_map_mm",
+                format!(
+                    "{} x {} points make {triangles} triangles, over the {} a surface may have; sample it coarser (a larger mm_per_px)",
+                    self.height,
+                    self.width,
+                    crate::mesh::MAX_TRIANGLES
+                ),
+            ));
+        }
+        let most_mm = tactex_core::scene::OBJECT_SIZE_M[1] * 1e3;
+        let span_mm = self.width.max(self.height) as f64 * self.mm_per_px;
+        if span_mm > most_mm {
+            return Err(invalid(
+                "mm_per_px",
+                format!(
+                    "{} mm a point makes the map {span_mm:.0} mm across, wider than an object on a table ({most_mm:.0} mm)",
+                    self.mm_per_px
+                ),
+            ));
+        }
+        let (lo, hi) = self
+            .heights_mm
+            .iter()
+            .filter(|h| !h.is_nan())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &h| {
+                (lo.min(h), hi.max(h))
+            });
+        if hi - lo > most_mm {
+            return Err(invalid(
+                "height_map_mm",
+                format!(
+                    "heights span {:.3e} mm, deeper than an object on a table ({most_mm:.0} mm); give them in mm",
+                    hi - lo
+                ),
+            ));
+        }
         if self.heights_mm.iter().all(|h| h.is_nan()) {
             return Err(invalid(
                 "height_map_mm",
