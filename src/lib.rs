@@ -9,12 +9,16 @@
 //! Dependencies point one way: products -> app -> tactex-{core,sim,hw,learned}.
 
 pub mod app;
+#[cfg(feature = "plots")]
 pub mod bench;
 pub mod cli;
 pub mod commands;
 pub mod datagen;
+#[cfg(feature = "plots")]
 pub mod eval;
 pub mod report;
+#[cfg(feature = "servers")]
 pub mod serve;
 pub mod sim2real;
+#[cfg(feature = "servers")]
 pub mod xarm_twin;

@@ -96,16 +96,19 @@ impl LlmConfig {
     }
 }
 
+#[cfg(feature = "llm")]
 #[derive(Deserialize)]
 struct Completion {
     choices: Vec<Choice>,
 }
 
+#[cfg(feature = "llm")]
 #[derive(Deserialize)]
 struct Choice {
     message: Message,
 }
 
+#[cfg(feature = "llm")]
 #[derive(Deserialize)]
 struct Message {
     content: Option<String>,
@@ -136,17 +139,23 @@ fn read_small(path: &Path) -> Result<String> {
 /// says.
 pub struct LlmChat {
     pub config: LlmConfig,
+    #[cfg(feature = "llm")]
     agent: ureq::Agent,
 }
 
 impl LlmChat {
     pub fn new(config: LlmConfig) -> Self {
+        #[cfg(feature = "llm")]
         let agent = ureq::Agent::config_builder()
             .timeout_global(Some(config.timeout))
             .http_status_as_error(false)
             .build()
             .into();
-        Self { config, agent }
+        Self {
+            config,
+            #[cfg(feature = "llm")]
+            agent,
+        }
     }
 
     /// "llm:<model>": who wrote a reply.
@@ -154,7 +163,22 @@ impl LlmChat {
         format!("llm:{}", self.config.model)
     }
 
+    /// Built without the client (the Python extension), there is never a reply: callers
+    /// fall back to the template and the rules with a notice, as for an endpoint that is down.
+    #[cfg(not(feature = "llm"))]
+    pub fn complete(
+        &self,
+        _messages: serde_json::Value,
+        _temperature: f64,
+    ) -> Result<String, String> {
+        Err(format!(
+            "{}: this build has no LLM client (the `llm` feature of the tactex library)",
+            self.config.base_url
+        ))
+    }
+
     /// The model's reply text to `messages`, or why there is none.
+    #[cfg(feature = "llm")]
     pub fn complete(
         &self,
         messages: serde_json::Value,

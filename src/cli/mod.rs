@@ -3,7 +3,11 @@
 
 pub mod process;
 
-use crate::{bench, commands, datagen, eval, serve, sim2real, xarm_twin};
+#[cfg(feature = "plots")]
+use crate::{bench, eval};
+use crate::{commands, datagen, sim2real};
+#[cfg(feature = "servers")]
+use crate::{serve, xarm_twin};
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -25,12 +29,14 @@ pub enum Command {
     Ask(commands::ask::AskArgs),
     /// The chat page: live camera view with detections, questions answered with progress,
     /// tactile frames, hardness and ripeness of each touched fruit, latency per stage.
+    #[cfg(feature = "servers")]
     Serve(serve::ServeArgs),
     /// A real uFactory xArm (or the vendor's simulator) over its TCP protocol: pose, move,
     /// home.
     Arm(commands::arm::ArmArgs),
     /// The twin as an xArm 850 controller: programs written against the vendor's Python SDK
     /// move the GelSight pad through the simulated table; its frames come over HTTP.
+    #[cfg(feature = "servers")]
     Twin(xarm_twin::TwinArgs),
     /// What the prompt parser reads from a question (intent, property, targets, filters).
     Parse(commands::parse::ParseArgs),
@@ -59,6 +65,7 @@ pub enum Command {
     /// A YOLOv8-seg ONNX model on one colour image: boxes, scores, masks, an overlay PNG.
     Detect(commands::detect::DetectArgs),
     /// Evaluations on the twin.
+    #[cfg(feature = "plots")]
     Eval {
         #[command(subcommand)]
         command: EvalCommand,
@@ -69,6 +76,7 @@ pub enum Command {
         command: DatagenCommand,
     },
     /// Benchmarks (run them on a release build).
+    #[cfg(feature = "plots")]
     Bench {
         #[command(subcommand)]
         command: BenchCommand,
@@ -80,6 +88,7 @@ pub enum Command {
     },
 }
 
+#[cfg(feature = "plots")]
 #[derive(Subcommand)]
 pub enum BenchCommand {
     /// Speed and accuracy of each contact fidelity level and solver cell.
@@ -95,6 +104,7 @@ pub enum BenchCommand {
     Ask(bench::ask::AskBenchArgs),
 }
 
+#[cfg(feature = "plots")]
 #[derive(Subcommand)]
 pub enum EvalCommand {
     /// The paper's grounding protocol: detectors' success, IoU and centroid error.
@@ -136,7 +146,9 @@ pub enum SceneCommand {
 pub fn run(command: Command) -> Result<()> {
     match command {
         Command::Ask(args) => commands::ask::run(&args),
+        #[cfg(feature = "servers")]
         Command::Serve(args) => serve::run(&args),
+        #[cfg(feature = "servers")]
         Command::Twin(args) => xarm_twin::run(&args),
         Command::Arm(args) => commands::arm::run(&args),
         Command::Parse(args) => commands::parse::run(&args),
@@ -148,21 +160,27 @@ pub fn run(command: Command) -> Result<()> {
         Command::Contact(args) => commands::contact::run(&args),
         Command::Read(args) => commands::read::run(&args),
         Command::Detect(args) => commands::detect::run(&args),
+        #[cfg(feature = "plots")]
         Command::Eval {
             command: EvalCommand::Grounding(args),
         } => eval::grounding::run(&args),
+        #[cfg(feature = "plots")]
         Command::Eval {
             command: EvalCommand::Hardness(args),
         } => eval::hardness::run(&args),
+        #[cfg(feature = "plots")]
         Command::Eval {
             command: EvalCommand::Scenarios(args),
         } => eval::scenarios::run(&args),
+        #[cfg(feature = "plots")]
         Command::Eval {
             command: EvalCommand::Fruits(args),
         } => eval::fruits::run(&args),
+        #[cfg(feature = "plots")]
         Command::Eval {
             command: EvalCommand::Explanations(args),
         } => eval::explanations::run(&args),
+        #[cfg(feature = "plots")]
         Command::Eval {
             command: EvalCommand::Ripeness(args),
         } => eval::ripeness::run(&args),
@@ -175,18 +193,23 @@ pub fn run(command: Command) -> Result<()> {
         Command::Datagen {
             command: DatagenCommand::BallPresses(args),
         } => datagen::ball_presses::run(&args),
+        #[cfg(feature = "plots")]
         Command::Bench {
             command: BenchCommand::Contact(args),
         } => bench::contact::run(&args),
+        #[cfg(feature = "plots")]
         Command::Bench {
             command: BenchCommand::Render(args),
         } => bench::render::run(&args),
+        #[cfg(feature = "plots")]
         Command::Bench {
             command: BenchCommand::Datagen(args),
         } => bench::datagen::run(&args),
+        #[cfg(feature = "plots")]
         Command::Bench {
             command: BenchCommand::Scene(args),
         } => bench::scene::run(&args),
+        #[cfg(feature = "plots")]
         Command::Bench {
             command: BenchCommand::Ask(args),
         } => bench::ask::run(&args),

@@ -15,8 +15,11 @@
 //! rest, so an interrupted run resumes and gives the same bytes as an uninterrupted one.
 
 use crate::app::tactile_samples::{TactileSample, TactileSampleSource};
+#[cfg(feature = "npz")]
 use crate::report::npz::{NpyArray, npz_bytes};
-use crate::report::output::{write_bytes_atomic, write_json_atomic};
+#[cfg(feature = "npz")]
+use crate::report::output::write_bytes_atomic;
+use crate::report::output::write_json_atomic;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -163,6 +166,12 @@ fn write_sample(dir: &Path, format: SampleFormat, s: &TactileSample) -> Result<V
             })?;
             Ok(names.iter().map(|n| format!("{stem}/{n}")).collect())
         }
+        #[cfg(not(feature = "npz"))]
+        SampleFormat::Npz => {
+            let _ = (dir, stem, s);
+            bail!("--format npz: this build has no NumPy archive writer (the `npz` feature)")
+        }
+        #[cfg(feature = "npz")]
         SampleFormat::Npz => {
             let (w, h) = images[0].dimensions();
             let (w, h) = (w as usize, h as usize);

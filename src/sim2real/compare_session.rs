@@ -10,6 +10,7 @@
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::app::{load_sensor, with_gel_modulus};
 use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic};
+#[cfg(feature = "plots")]
 use crate::report::plot::{self, BarSeries};
 use crate::report::side_by_side::side_by_side;
 use anyhow::{Context, Result, bail};
@@ -551,11 +552,14 @@ fn write_outputs(
         let path: PathBuf = dir.join(format!("press-{:02}.png", press.press));
         write_png_atomic(&path, &side_by_side(&recorded[i].image, &rebuilt[i].image))?;
     }
+    // Built without plots (the Python extension), the chart is left out; the JSON is whole.
+    #[cfg(feature = "plots")]
     let measured: Vec<&PressReport> = report
         .presses
         .iter()
         .filter(|p| p.hardness.is_some())
         .collect();
+    #[cfg(feature = "plots")]
     if !measured.is_empty() {
         let shore = |pick: fn(&HardnessAgreement) -> f64| -> Vec<f64> {
             measured
