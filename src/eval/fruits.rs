@@ -388,19 +388,10 @@ fn nearest(answer: &tactex_core::pipeline::Answer, c: [f64; 3]) -> Option<String
     ))
 }
 
-/// The median, where a rigid reading of a soft fruit counts as an infinite error.
+/// The median, where a rigid reading of a soft fruit counts as an infinite error (an
+/// infinite middle value makes the median infinite).
 fn median(mut v: Vec<f64>) -> Option<f64> {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    match n {
-        0 => None,
-        _ if n % 2 == 1 => Some(v[n / 2]),
-        _ => Some(if v[n / 2].is_finite() {
-            (v[n / 2 - 1] + v[n / 2]) / 2.0
-        } else {
-            v[n / 2]
-        }),
-    }
+    tactex_core::stats::median(&mut v)
 }
 
 fn rate(rows: &[&FruitRow], pick: impl Fn(&FruitRow) -> Option<bool>) -> Option<f64> {

@@ -261,11 +261,7 @@ fn horizontal_mm(estimate: DVec3, truth: DVec3) -> f64 {
 }
 
 fn mean(v: &[f64]) -> f64 {
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v.iter().sum::<f64>() / v.len() as f64
-    }
+    tactex_core::stats::mean(v).unwrap_or(f64::NAN)
 }
 
 fn summarise(name: &str, trials: &[Trial]) -> Result<DetectorSummary> {

@@ -10,7 +10,7 @@ use clap::Args;
 use image::RgbImage;
 use serde::Serialize;
 use std::path::PathBuf;
-use tactex_core::ground::centroid::median;
+use tactex_core::stats::median;
 use tactex_core::tactile::ball_calibration::{
     BallPress, SampleRule, camera_noise_sigma, samples_from_ball_press,
 };

@@ -389,9 +389,9 @@ fn compare_press(
         frames_at_spot: run.len(),
         contact_frame: contact,
         contact: evidence,
-        mean_ssim: mean(&ssims).unwrap_or(f64::NAN),
+        mean_ssim: tactex_core::stats::mean(&ssims).unwrap_or(f64::NAN),
         min_ssim: ssims.iter().copied().fold(f64::NAN, f64::min),
-        mean_marker_error_px: mean(&errors),
+        mean_marker_error_px: tactex_core::stats::mean(&errors),
         frames,
         hardness,
         warnings,
@@ -400,10 +400,6 @@ fn compare_press(
 
 fn markers_lost(frames: &[FrameComparison]) -> bool {
     !frames.is_empty() && frames.iter().all(|f| f.markers_compared == 0)
-}
-
-fn mean(values: &[f64]) -> Option<f64> {
-    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
 }
 
 /// Rebuilds every press of the session in the twin and scores recorded against rebuilt,
@@ -501,15 +497,15 @@ pub fn compare_session(args: &SessionCompare) -> Result<SessionComparison> {
         twin_gel_modulus_mpa: spec.gel.modulus_mpa,
         fidelity: args.fidelity.name().into(),
         estimator: estimator.name().into(),
-        mean_ssim: mean(&press_ssims).unwrap_or(f64::NAN),
+        mean_ssim: tactex_core::stats::mean(&press_ssims).unwrap_or(f64::NAN),
         min_ssim: press_ssims.iter().copied().fold(f64::NAN, f64::min),
-        mean_marker_error_px: mean(&errors),
+        mean_marker_error_px: tactex_core::stats::mean(&errors),
         max_shore_a_difference: presses
             .iter()
             .filter_map(|p| p.hardness.as_ref().map(|h| h.shore_a_difference.abs()))
             .reduce(f64::max),
         frames: all.len(),
-        all_frames_mean_ssim: mean(&all).unwrap_or(f64::NAN),
+        all_frames_mean_ssim: tactex_core::stats::mean(&all).unwrap_or(f64::NAN),
         presses,
     };
     if let Some(dir) = args.out {

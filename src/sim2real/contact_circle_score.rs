@@ -3,7 +3,7 @@
 
 use image::RgbImage;
 use serde::Serialize;
-use tactex_core::ground::centroid::median;
+use tactex_core::stats::median;
 use tactex_core::tactile::ball_calibration::BallPress;
 use tactex_core::tactile::contact_circle::estimate_contact_circle;
 

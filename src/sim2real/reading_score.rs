@@ -6,7 +6,7 @@
 
 use image::RgbImage;
 use serde::Serialize;
-use tactex_core::ground::centroid::median;
+use tactex_core::stats::median;
 use tactex_core::tactile::ball_calibration::BallPress;
 use tactex_core::tactile::frame_reading::read_frame;
 use tactex_core::tactile::spec::TactileSpec;

@@ -6,7 +6,7 @@ use image::RgbImage;
 use std::path::{Path, PathBuf};
 
 use crate::cli::{json, tactex};
-use tactex_core::ground::centroid::median;
+use tactex_core::stats::median;
 use tactex_core::tactile::ball_calibration::read_annotations;
 use tactex_core::tactile::contact::{ContactRule, contact_evidence};
 use tactex_core::tactile::contact_circle::estimate_contact_circle;

@@ -40,19 +40,6 @@ fn median_f32(v: &mut [f32]) -> f32 {
     }
 }
 
-pub fn median(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    })
-}
-
 /// World points of the mask's pixels with valid depth.
 pub fn back_project_mask(
     mask: &GrayImage,
@@ -72,7 +59,8 @@ pub fn back_project_mask(
 
 /// Component-wise median of points.
 pub fn median_point(points: &[DVec3]) -> Option<DVec3> {
-    let axis = |f: fn(&DVec3) -> f64| median(&mut points.iter().map(f).collect::<Vec<_>>());
+    let axis =
+        |f: fn(&DVec3) -> f64| crate::stats::median(&mut points.iter().map(f).collect::<Vec<_>>());
     Some(DVec3::new(axis(|p| p.x)?, axis(|p| p.y)?, axis(|p| p.z)?))
 }
 

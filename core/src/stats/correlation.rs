@@ -3,7 +3,7 @@
 //! metrics RMSE and R^2 (1 - residual / total sum of squares, sklearn's r2_score).
 
 use super::ranks::average_ranks;
-use super::{StatsError, TestResult, check, mean};
+use super::{StatsError, TestResult, check, sample_mean};
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
 fn same_length(x: &[f64], y: &[f64]) -> Result<(), StatsError> {
@@ -21,7 +21,7 @@ pub fn spearman(x: &[f64], y: &[f64]) -> Result<TestResult, StatsError> {
     check("y", y, 3)?;
     same_length(x, y)?;
     let (rx, ry) = (average_ranks(x), average_ranks(y));
-    let (mx, my) = (mean(&rx), mean(&ry));
+    let (mx, my) = (sample_mean(&rx), sample_mean(&ry));
     let cov: f64 = rx.iter().zip(&ry).map(|(a, b)| (a - mx) * (b - my)).sum();
     let vx: f64 = rx.iter().map(|a| (a - mx).powi(2)).sum();
     let vy: f64 = ry.iter().map(|b| (b - my).powi(2)).sum();
@@ -66,7 +66,7 @@ pub fn r_squared(truth: &[f64], predicted: &[f64]) -> Result<f64, StatsError> {
     check("truth", truth, 2)?;
     check("predicted", predicted, 2)?;
     same_length(truth, predicted)?;
-    let m = mean(truth);
+    let m = sample_mean(truth);
     let total: f64 = truth.iter().map(|t| (t - m).powi(2)).sum();
     if total == 0.0 {
         return Err(StatsError {

@@ -59,12 +59,34 @@ pub(crate) fn check(what: &'static str, x: &[f64], min_len: usize) -> Result<(),
     Ok(())
 }
 
-pub(crate) fn mean(x: &[f64]) -> f64 {
+/// The mean of `values`; None for none. The one definition the library's figures use.
+pub fn mean(values: &[f64]) -> Option<f64> {
+    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+}
+
+/// The median of `values` (the mean of the middle two for an even count), sorting them in
+/// place; None for none. The one definition the library's figures use (a robust "middle
+/// element" pick inside a reading, such as a marker spacing, is its own thing).
+pub fn median(values: &mut [f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    Some(if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    })
+}
+
+/// The mean of a sample the tests here have already checked is not empty.
+pub(crate) fn sample_mean(x: &[f64]) -> f64 {
     x.iter().sum::<f64>() / x.len() as f64
 }
 
 /// Sample variance (n - 1 in the denominator).
 pub(crate) fn variance(x: &[f64]) -> f64 {
-    let m = mean(x);
+    let m = sample_mean(x);
     x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (x.len() - 1) as f64
 }

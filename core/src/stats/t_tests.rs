@@ -1,7 +1,7 @@
 //! Student t-tests as scipy.stats computes them: Welch's two-sample test (unequal variances,
 //! Welch-Satterthwaite degrees of freedom) and the one-sample test.
 
-use super::{Alternative, StatsError, TestResult, check, mean, variance};
+use super::{Alternative, StatsError, TestResult, check, sample_mean, variance};
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
 fn p_value(t: f64, df: f64, alternative: Alternative) -> Result<f64, StatsError> {
@@ -27,7 +27,7 @@ pub fn welch_t(x: &[f64], y: &[f64], alternative: Alternative) -> Result<TestRes
             message: "both samples are constant".into(),
         });
     }
-    let t = (mean(x) - mean(y)) / (a + b).sqrt();
+    let t = (sample_mean(x) - sample_mean(y)) / (a + b).sqrt();
     let df = (a + b).powi(2) / (a * a / (x.len() - 1) as f64 + b * b / (y.len() - 1) as f64);
     Ok(TestResult {
         statistic: t,
@@ -51,7 +51,7 @@ pub fn one_sample_t(
         });
     }
     let df = (x.len() - 1) as f64;
-    let t = (mean(x) - mu) / (v / x.len() as f64).sqrt();
+    let t = (sample_mean(x) - mu) / (v / x.len() as f64).sqrt();
     Ok(TestResult {
         statistic: t,
         p_value: p_value(t, df, alternative)?,

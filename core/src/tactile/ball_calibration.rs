@@ -237,9 +237,9 @@ pub fn camera_noise_sigma(
     }
     // Whole grey levels make the median absolute deviation jump in steps: it only sets the
     // cut for the odd outlier; the spread is the standard deviation of what stays.
-    let mid = crate::ground::centroid::median(&mut steps.clone())?;
+    let mid = crate::stats::median(&mut steps.clone())?;
     let mut dev: Vec<f64> = steps.iter().map(|e| (e - mid).abs()).collect();
-    let cut = 5.0 * (1.4826 * crate::ground::centroid::median(&mut dev)?).max(1.0);
+    let cut = 5.0 * (1.4826 * crate::stats::median(&mut dev)?).max(1.0);
     let kept: Vec<f64> = steps
         .into_iter()
         .filter(|e| (e - mid).abs() <= cut)
