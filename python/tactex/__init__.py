@@ -184,7 +184,8 @@ class Press:
     ``gel_lateral_y_mm``; grid in ``field_grid``) and the contact pressure over the solver
     grid (``pressure_mpa``; grid in ``pressure_grid``). A grid is ``(cell_mm, (x0_mm,
     y0_mm))``, the first cell's corner in the pad frame. ``report`` is what ``tactex press
-    --json`` prints.
+    --json`` prints; ``library_s`` the library's own wall time for the press (checked,
+    solved, rendered), against which the binding's cost is measured.
     """
 
     frame: np.ndarray
@@ -193,6 +194,7 @@ class Press:
     field_grid: Tuple[float, Tuple[float, float]]
     pressure_grid: Tuple[float, Tuple[float, float]]
     report: Dict[str, Any]
+    library_s: float = field(default=0.0, repr=False, compare=False)
 
     @property
     def force_n(self) -> float:
@@ -440,6 +442,7 @@ class Sensor:
             field_grid=_grid(out["field_grid"]),
             pressure_grid=_grid(out["pressure_grid"]),
             report=json.loads(out["report"]),
+            library_s=float(out["library_s"]),
         )
 
 
