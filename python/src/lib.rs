@@ -82,28 +82,6 @@ fn parse(argv: Vec<String>) -> PyResult<Command> {
     }
 }
 
-/// `tactex press`'s flags alone: building the whole CLI's parser for every press was most of
-/// what a small press cost from Python beyond the library's own time.
-#[derive(Parser)]
-#[command(name = "tactex press", allow_negative_numbers = true)]
-struct PressFlags {
-    #[command(flatten)]
-    args: PressArgs,
-}
-
-/// `argv` as `tactex press`'s flags; an error is one line, as `tactex press` prints it.
-fn parse_press(argv: Vec<String>) -> PyResult<PressArgs> {
-    let all = std::iter::once("tactex press".to_string()).chain(argv);
-    match PressFlags::try_parse_from(all) {
-        Ok(flags) => Ok(flags.args),
-        Err(e) => Err(PyValueError::new_err(
-            tactex::cli::usage_error_line(&e)
-                .trim_start_matches("error: ")
-                .to_string(),
-        )),
-    }
-}
-
 fn frame_array(image: image::RgbImage) -> Array3<u8> {
     let (w, h) = image.dimensions();
     Array3::from_shape_vec((h as usize, w as usize, 3), image.into_raw())
@@ -210,7 +188,9 @@ fn press<'py>(
     argv: Vec<String>,
     geometry: Option<Geometry<'py>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let args = parse_press(argv)?;
+    let Command::Press(args) = parse(std::iter::once("press".into()).chain(argv).collect())? else {
+        unreachable!("the argv starts with press")
+    };
     let shape = geometry.map(|g| g.shape()).transpose()?.flatten();
     let device = args.device();
     let solved = off_the_gil(py, || -> anyhow::Result<_> {
@@ -280,7 +260,9 @@ fn press_sequence<'py>(
     phase_mm: f64,
     geometry: Option<Geometry<'py>>,
 ) -> PyResult<(Bound<'py, PyArray4<u8>>, String)> {
-    let args = parse_press(argv)?;
+    let Command::Press(args) = parse(std::iter::once("press".into()).chain(argv).collect())? else {
+        unreachable!("the argv starts with press")
+    };
     let shape = geometry.map(|g| g.shape()).transpose()?.flatten();
     if !(phase_mm.is_finite() && (0.0..0.25).contains(&phase_mm)) {
         return Err(PyValueError::new_err(format!(

@@ -79,8 +79,11 @@ impl EstimatorChoice {
     }
 }
 
-/// What `--estimator` takes, for help texts and errors.
-pub const ESTIMATOR_VALUES: &str = "learned, indentation, hertz or FILE.onnx";
+/// What `--estimator` takes, for errors: the registered names, or a model file.
+fn estimator_values() -> String {
+    let names: Vec<&str> = ESTIMATORS.iter().map(|e| e.name).collect();
+    format!("{} or FILE.onnx", names.join(", "))
+}
 
 /// Interval calibrations shipped with the binary, made by `tactex eval fruits --calibrate`
 /// on held-out presses: (`--estimator` value, fidelity, file name, text).
@@ -115,7 +118,10 @@ impl FromStr for EstimatorChoice {
         if s.to_ascii_lowercase().ends_with(".onnx") {
             return Ok(Self::Model(PathBuf::from(s)));
         }
-        Err(format!("unknown estimator {s:?} (use {ESTIMATOR_VALUES})"))
+        Err(format!(
+            "unknown estimator {s:?} (use {})",
+            estimator_values()
+        ))
     }
 }
 

@@ -91,11 +91,21 @@ impl PressShape {
             },
             PressShape::Mesh { path, scale } => {
                 let mesh = tactex_sim::mesh::load(path)?;
-                let name = format!("--mesh {}", path.display());
-                placed_mesh(&mesh, &name, "--mesh-scale", *scale, pose)?
+                let path = path.display().to_string();
+                let named = MeshNames {
+                    mesh: &path,
+                    flag: &format!("--mesh {path}"),
+                    scale: "--mesh-scale",
+                };
+                placed_mesh(&mesh, named, *scale, pose)?
             }
             PressShape::Triangles { mesh, scale, name } => {
-                placed_mesh(mesh, name, "mesh_scale", *scale, pose)?
+                let named = MeshNames {
+                    mesh: name,
+                    flag: name,
+                    scale: "mesh_scale",
+                };
+                placed_mesh(mesh, named, *scale, pose)?
             }
             PressShape::HeightMap(map) => ObjectSurface::Mesh(
                 map.sheet()?
@@ -105,21 +115,33 @@ impl PressShape {
     }
 }
 
+/// How errors name a mesh: as the mesh itself (its path), as the option that gave it, and
+/// the option that sets its unit.
+struct MeshNames<'a> {
+    mesh: &'a str,
+    flag: &'a str,
+    scale: &'a str,
+}
+
 /// A mesh in its own units, checked as a solid of a table's size, pressed at the middle of
 /// its top at `pose`: a file's and a caller's mesh alike.
 fn placed_mesh(
     mesh: &TriMesh,
-    name: &str,
-    scale_name: &str,
+    names: MeshNames,
     scale: f64,
     pose: PressPose,
 ) -> Result<ObjectSurface> {
-    mesh.validate(name.trim_start_matches("--mesh "))?;
+    let MeshNames {
+        mesh: name,
+        flag,
+        scale: scale_name,
+    } = names;
+    mesh.validate(name)?;
     if let Some(size_m) = mesh.size_off_table_m(scale) {
         let [least, most] = tactex_core::scene::OBJECT_SIZE_M;
         // A contact error: bad input, named as the caller named the mesh.
         return Err(ContactError {
-            field: name.to_string(),
+            field: flag.to_string(),
             message: format!(
                 "{} m across at {scale_name} {}, not a size an object on a table has ({least} to {most} m); set {scale_name} to the mesh's unit in metres",
                 tactex_core::printable::short_number(size_m),
