@@ -2,10 +2,11 @@
 //! tactex library that the command line runs, so that a press, a generated sample or an
 //! answer is the same from Python as from the CLI, byte for byte.
 //!
-//! Arguments arrive as the CLI's own flags (the Python layer, python/tactex/, builds them
-//! from keyword arguments), so they are checked by the same parser with the same one-line
-//! messages. Long calls release the GIL and run on the Rust thread pool; frames are handed
-//! to numpy without a copy.
+//! A press arrives as typed keywords checked by the library (`PressOptions::request`)
+//! against the same ranges as the CLI's flags, through a `Profile` loaded once; the
+//! other commands (ask, calibrate, compare, read) still arrive as the CLI's own flags,
+//! parsed by its parser. Long calls release the GIL and run on the Rust thread pool;
+//! frames are handed to numpy without a copy.
 
 use anyhow::Context;
 use clap::Parser;
@@ -18,14 +19,22 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
 use tactex::app::error_kind::ErrorKind;
-use tactex::app::single_press::{PressRequest, PressShape};
+use tactex::app::flag_range::FieldError;
+use tactex::app::press_options::PressOptions;
+use tactex::app::single_press::PressShape;
 use tactex::app::tactile_samples::{TactileSample, TactileSampleSource};
 use tactex::cli::{Cli, Command, error_line};
-use tactex::commands::press::PressArgs;
+use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_sim::contact::ContactSolver;
 use tactex_sim::contact::HeightMap;
 use tactex_sim::mesh::TriMesh;
-use tactex_sim::render::gel::open_renderer;
+use tactex_sim::render::gel::{DeviceChoice, open_renderer};
+
+// As in the `tactex` binary: frames and fields are allocated and freed by the hundred per
+// press, and glibc hands blocks this size back to the kernel on each free, to fault them in
+// again on the next press (python/bench/press_overhead.py measures the difference).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 /// The thread pool native calls run on. rayon's global pool does not survive a fork (a
 /// DataLoader worker is a forked copy of the training process, whose pool threads are not
@@ -143,12 +152,8 @@ impl Geometry<'_> {
         if let Some(i) = faces.iter().find(|&&i| i < 0 || i >= n) {
             return bad(format!("mesh: face index {i} is outside the {n} vertices"));
         }
+        // Checked with the press (`PressOptions::request`), as a file's --mesh-scale is.
         let scale = self.mesh_scale.unwrap_or(1.0);
-        if !(scale.is_finite() && scale > 0.0 && scale <= 1000.0) {
-            return bad(format!(
-                "mesh_scale: must be above 0 up to 1000, got {scale}"
-            ));
-        }
         Ok(Some(PressShape::Triangles {
             mesh: TriMesh {
                 vertices: vertices
@@ -168,36 +173,163 @@ impl Geometry<'_> {
     }
 }
 
-/// The press the flags describe, on the caller's geometry when it gave one.
-fn press_request(args: &PressArgs, shape: Option<PressShape>) -> anyhow::Result<PressRequest> {
-    let mut request = tactex::commands::press::request(args)?;
-    if let Some(shape) = shape {
-        request.shape = shape;
-    }
-    Ok(request)
+/// A sensor profile loaded once: the built-in GelSight Mini, or a profile file (TOML, as
+/// `tactex calibrate` writes it). Presses through it do not read the file again.
+#[pyclass(frozen, module = "tactex._tactex")]
+struct Profile {
+    sensor: Arc<SensorProfile>,
 }
 
-/// One press: `argv` are `tactex press` flags, `geometry` the caller's own object if any.
-/// Returns the report (JSON text), the pressed frame and the no-contact frame (H x W x 3
-/// uint8), and the gel's fields over the pad and the pressure over the solver grid (float32,
-/// rows x columns) with their grids.
+#[pymethods]
+impl Profile {
+    #[new]
+    #[pyo3(signature = (path=None))]
+    fn new(path: Option<std::path::PathBuf>) -> PyResult<Self> {
+        let sensor = tactex::app::load_sensor(path.as_deref()).map_err(to_py)?;
+        Ok(Self {
+            sensor: Arc::new(sensor),
+        })
+    }
+
+    /// The profile's name and content hash, as every output names it.
+    #[getter]
+    fn id(&self) -> String {
+        self.sensor.id().to_string()
+    }
+
+    /// The profile's name and SHA-256 as data sets and model cards record them (JSON text).
+    #[getter]
+    fn profile_id(&self) -> PyResult<String> {
+        serde_json::to_string(&self.sensor.id()).map_err(|e| PyRuntimeError::new_err(e.to_string()))
+    }
+
+    #[getter]
+    fn name(&self) -> String {
+        self.sensor.name().to_string()
+    }
+
+    /// Frame size (width, height) in pixels.
+    #[getter]
+    fn size(&self) -> (u32, u32) {
+        (self.sensor.spec.width_px, self.sensor.spec.height_px)
+    }
+
+    #[getter]
+    fn mm_per_px(&self) -> f64 {
+        self.sensor.spec.mm_per_px
+    }
+
+    #[getter]
+    fn gel_modulus_mpa(&self) -> f64 {
+        self.sensor.spec.gel.modulus_mpa
+    }
+
+    #[getter]
+    fn gel_thickness_mm(&self) -> f64 {
+        self.sensor.spec.gel.thickness_mm
+    }
+
+    /// Marker grid (columns, rows).
+    #[getter]
+    fn markers(&self) -> (u32, u32) {
+        (self.sensor.spec.markers.cols, self.sensor.spec.markers.rows)
+    }
+}
+
+/// `Sensor.press`'s keywords, each already a number, text or path (python/tactex makes them
+/// so, naming the keyword when it cannot); the library checks their values
+/// (`PressOptions::request`). A dict with every key, None where not given.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct PressKeywords {
+    shape: String,
+    radius_mm: Option<f64>,
+    size_mm: Option<Vec<f64>>,
+    mesh: Option<std::path::PathBuf>,
+    mesh_scale: Option<f64>,
+    at_mm: Option<Vec<f64>>,
+    yaw_deg: Option<f64>,
+    hardness: Option<String>,
+    modulus_mpa: Option<f64>,
+    object_poisson: Option<f64>,
+    depth_mm: f64,
+    fidelity: String,
+    grid_mm: Option<f64>,
+    tolerance: Option<f64>,
+    gel_thickness_mm: Option<f64>,
+    gel_modulus_mpa: Option<f64>,
+    marker_grid: Option<String>,
+    marker_pitch_mm: Option<f64>,
+    seed: u32,
+}
+
+impl PressKeywords {
+    /// The library's press options, with the caller's own object when it gave one.
+    fn options(self, object: Option<PressShape>) -> PyResult<PressOptions> {
+        let defaults = PressOptions::default();
+        let shape = self
+            .shape
+            .parse()
+            .map_err(|e: FieldError| PyValueError::new_err(e.to_string()))?;
+        Ok(PressOptions {
+            shape,
+            radius_mm: self.radius_mm,
+            size_mm: self.size_mm,
+            mesh: self.mesh,
+            mesh_scale: if object.is_some() {
+                None
+            } else {
+                self.mesh_scale
+            },
+            object,
+            at_mm: self.at_mm,
+            yaw_deg: self.yaw_deg.unwrap_or(defaults.yaw_deg),
+            hardness: self.hardness,
+            modulus_mpa: self.modulus_mpa,
+            object_poisson: self.object_poisson.unwrap_or(defaults.object_poisson),
+            depth_mm: self.depth_mm,
+            fidelity: self.fidelity,
+            grid_mm: self.grid_mm,
+            tolerance: self.tolerance.unwrap_or(defaults.tolerance),
+            gel_thickness_mm: self.gel_thickness_mm,
+            gel_modulus_mpa: self.gel_modulus_mpa,
+            marker_grid: self.marker_grid,
+            marker_pitch_mm: self.marker_pitch_mm,
+            seed: self.seed,
+        })
+    }
+}
+
+/// The press `options` describe, on the caller's own object when it gave one.
+fn press_options(options: PressKeywords, geometry: Option<Geometry<'_>>) -> PyResult<PressOptions> {
+    let object = geometry.map(|g| g.shape()).transpose()?.flatten();
+    options.options(object)
+}
+
+/// One press through `profile`: `options` are `Sensor.press`'s keywords, `geometry` the
+/// caller's own object if any, `device` the renderer (auto, gpu, cpu). Returns the report
+/// (JSON text), the pressed frame and the no-contact frame (H x W x 3 uint8), and the gel's
+/// fields over the pad and the pressure over the solver grid (float32, rows x columns) with
+/// their grids.
 #[pyfunction]
-#[pyo3(signature = (argv, geometry=None))]
+#[pyo3(signature = (profile, options, device, geometry=None))]
 fn press<'py>(
     py: Python<'py>,
-    argv: Vec<String>,
+    profile: PyRef<'py, Profile>,
+    options: PressKeywords,
+    device: &str,
     geometry: Option<Geometry<'py>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let Command::Press(args) = parse(std::iter::once("press".into()).chain(argv).collect())? else {
-        unreachable!("the argv starts with press")
-    };
-    let shape = geometry.map(|g| g.shape()).transpose()?.flatten();
-    let device = args.device();
+    let device: DeviceChoice = device
+        .parse()
+        .map_err(|e: String| PyValueError::new_err(format!("device: {e}")))?;
+    let options = press_options(options, geometry)?;
+    let sensor = profile.sensor.clone();
     let solved = off_the_gil(py, || -> anyhow::Result<_> {
         // The library's own time for the press (the request checked, solved and rendered),
         // against which the binding's cost is measured (python/bench/press_overhead.py).
         let started = std::time::Instant::now();
-        let request = press_request(&args, shape)?;
+        let request = options.request(sensor)?;
         let mut press = request.solve()?;
         let mut renderer = open_renderer(device)?.renderer;
         let fields = press.pad_fields();
@@ -249,28 +381,23 @@ fn press<'py>(
     Ok(out)
 }
 
-/// The paper's press protocol on one object (`argv`: `tactex press` flags; `--depth-mm` is
-/// required there but the protocol decides the travel): frames [9, H, W, 3] uint8 (the
-/// no-contact reference, then the 8 recorded frames) and the press's facts (JSON text).
+/// The paper's press protocol on one object through `profile` (`options`: `Sensor.press`'s
+/// keywords; `depth_mm` is not read, the protocol decides the travel): frames [9, H, W, 3]
+/// uint8 (the no-contact reference, then the 8 recorded frames) and the press's facts (JSON
+/// text).
 #[pyfunction]
-#[pyo3(signature = (argv, phase_mm, geometry=None))]
+#[pyo3(signature = (profile, options, phase_mm, geometry=None))]
 fn press_sequence<'py>(
     py: Python<'py>,
-    argv: Vec<String>,
+    profile: PyRef<'py, Profile>,
+    options: PressKeywords,
     phase_mm: f64,
     geometry: Option<Geometry<'py>>,
 ) -> PyResult<(Bound<'py, PyArray4<u8>>, String)> {
-    let Command::Press(args) = parse(std::iter::once("press".into()).chain(argv).collect())? else {
-        unreachable!("the argv starts with press")
-    };
-    let shape = geometry.map(|g| g.shape()).transpose()?.flatten();
-    if !(phase_mm.is_finite() && (0.0..0.25).contains(&phase_mm)) {
-        return Err(PyValueError::new_err(format!(
-            "phase_mm: {phase_mm} is outside [0, 0.25): first touch falls within one 0.25 mm step"
-        )));
-    }
+    let options = press_options(options, geometry)?;
+    let sensor = profile.sensor.clone();
     let done = off_the_gil(py, || -> anyhow::Result<(Array4<u8>, String)> {
-        let request = press_request(&args, shape)?;
+        let request = options.request(sensor)?;
         let (press, images) = request.press_sequence(phase_mm)?;
         let f = &press.frames;
         let facts = serde_json::json!({
@@ -405,28 +532,6 @@ fn read(py: Python<'_>, argv: Vec<String>) -> PyResult<Bound<'_, PyDict>> {
     Ok(out)
 }
 
-/// A sensor profile's identity and geometry: the built-in GelSight Mini, or the profile
-/// file at `path`.
-#[pyfunction]
-#[pyo3(signature = (path=None))]
-fn sensor_info(py: Python<'_>, path: Option<std::path::PathBuf>) -> PyResult<Bound<'_, PyDict>> {
-    let profile = tactex::app::load_sensor(path.as_deref()).map_err(to_py)?;
-    let out = PyDict::new(py);
-    let spec = &profile.spec;
-    out.set_item("id", profile.id().to_string())?;
-    let id =
-        serde_json::to_string(&profile.id()).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-    out.set_item("profile_id", id)?;
-    out.set_item("name", profile.name())?;
-    out.set_item("width", spec.width_px)?;
-    out.set_item("height", spec.height_px)?;
-    out.set_item("mm_per_px", spec.mm_per_px)?;
-    out.set_item("gel_modulus_mpa", spec.gel.modulus_mpa)?;
-    out.set_item("gel_thickness_mm", spec.gel.thickness_mm)?;
-    out.set_item("markers", (spec.markers.cols, spec.markers.rows))?;
-    Ok(out)
-}
-
 /// Threads of the Rust pool that draws samples (RAYON_NUM_THREADS, else one per core).
 #[pyfunction]
 fn threads() -> PyResult<usize> {
@@ -442,7 +547,7 @@ fn _tactex(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
-    m.add_function(wrap_pyfunction!(sensor_info, m)?)?;
+    m.add_class::<Profile>()?;
     m.add_function(wrap_pyfunction!(threads, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

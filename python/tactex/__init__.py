@@ -163,15 +163,85 @@ def _geometry(
     return geometry
 
 
-def _pose_flags(pose: Optional[Tuple[float, float, float]]) -> Dict[str, Any]:
-    """``pose=(x_mm, y_mm, yaw_deg)`` as ``tactex press``'s --at-mm and --yaw-deg."""
-    if pose is None:
-        return {}
+def _text(name: str, value: Any) -> str:
+    """A keyword's text; anything else is an InvalidArgument naming it."""
+    if not isinstance(value, str):
+        raise InvalidArgument(f"{name}: give text, got {value!r}")
+    return value
+
+
+def _numbers(name: str, value: Any) -> Optional[List[float]]:
+    """A keyword's sequence of numbers, or None."""
+    if value is None:
+        return None
+    if isinstance(value, (str, bytes)):
+        raise InvalidArgument(f"{name}: give a sequence of numbers, got {value!r}")
     try:
-        x, y, yaw = (float(v) for v in pose)
+        return [float(v) for v in value]
     except (TypeError, ValueError):
-        raise InvalidArgument(f"pose: give (x_mm, y_mm, yaw_deg), got {pose!r}") from None
-    return {"at_mm": (x, y), "yaw_deg": yaw}
+        raise InvalidArgument(f"{name}: give a sequence of numbers, got {value!r}") from None
+
+
+def _seed(value: Any) -> int:
+    """A camera-noise seed: a whole number in [0, 2**32)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InvalidArgument(f"seed: give a whole number, got {value!r}")
+    if not 0 <= int(value) < 2**32:
+        raise InvalidArgument(f"seed: {value} is outside [0, 4294967295]")
+    return int(value)
+
+
+# Press keywords that are numbers; the others are text, paths or sequences.
+_PRESS_NUMBERS = (
+    "radius_mm",
+    "mesh_scale",
+    "modulus_mpa",
+    "object_poisson",
+    "grid_mm",
+    "tolerance",
+    "gel_modulus_mpa",
+    "gel_thickness_mm",
+    "marker_pitch_mm",
+)
+
+
+def _press_keywords(
+    shape: Any, depth_mm: Any, pose: Optional[Tuple[float, float, float]], **kw: Any
+) -> Dict[str, Any]:
+    """A press's keywords as the native press takes them, each of its type (a number, text,
+    a path), every key present; a value of the wrong type is an InvalidArgument naming its
+    keyword. The library checks the values."""
+    out: Dict[str, Any] = {name: _number(name, kw.get(name)) for name in _PRESS_NUMBERS}
+    depth = _number("depth_mm", depth_mm)
+    if depth is None:
+        raise InvalidArgument("depth_mm: give the press's depth past first touch in mm")
+    at_mm: Optional[List[float]] = None
+    yaw: Optional[float] = None
+    if pose is not None:
+        try:
+            x, y, yaw = (float(v) for v in pose)
+        except (TypeError, ValueError):
+            raise InvalidArgument(f"pose: give (x_mm, y_mm, yaw_deg), got {pose!r}") from None
+        at_mm = [x, y]
+    mesh = kw.get("mesh")
+    if mesh is not None and not isinstance(mesh, (str, os.PathLike)):
+        raise InvalidArgument(f"mesh: give a file path, got {type(mesh).__name__}")
+    for name in ("hardness", "marker_grid"):
+        if kw.get(name) is not None:
+            _text(name, kw[name])
+    out.update(
+        shape=_text("shape", shape),
+        depth_mm=depth,
+        size_mm=_numbers("size_mm", kw.get("size_mm")),
+        mesh=None if mesh is None else os.fspath(mesh),
+        at_mm=at_mm,
+        yaw_deg=yaw,
+        hardness=kw.get("hardness"),
+        fidelity=_text("fidelity", kw.get("fidelity", "layer")),
+        marker_grid=kw.get("marker_grid"),
+        seed=_seed(kw.get("seed", 0)),
+    )
+    return out
 
 
 @dataclass(frozen=True)
@@ -232,26 +302,23 @@ class Sensor:
 
     def __init__(self, profile: Optional[PathLike] = None) -> None:
         self.profile: Optional[str] = None if profile is None else os.fspath(profile)
-        info = _tactex.sensor_info(self.profile)
+        # Loaded once: every press through this sensor reuses it.
+        self._native = _tactex.Profile(self.profile)
         #: The profile's name and content hash, as every output names it.
-        self.id: str = info["id"]
+        self.id: str = self._native.id
         #: The profile's name and SHA-256, as data sets and model cards record it.
-        self.profile_id: Dict[str, Any] = json.loads(info["profile_id"])
-        self.name: str = info["name"]
+        self.profile_id: Dict[str, Any] = json.loads(self._native.profile_id)
+        self.name: str = self._native.name
         #: Frame size (width, height) in pixels, and the scale.
-        self.size: Tuple[int, int] = (info["width"], info["height"])
-        self.mm_per_px: float = info["mm_per_px"]
-        self.gel_modulus_mpa: float = info["gel_modulus_mpa"]
-        self.gel_thickness_mm: float = info["gel_thickness_mm"]
+        self.size: Tuple[int, int] = tuple(self._native.size)  # type: ignore[assignment]
+        self.mm_per_px: float = self._native.mm_per_px
+        self.gel_modulus_mpa: float = self._native.gel_modulus_mpa
+        self.gel_thickness_mm: float = self._native.gel_thickness_mm
         #: Marker grid (columns, rows).
-        self.markers: Tuple[int, int] = tuple(info["markers"])  # type: ignore[assignment]
+        self.markers: Tuple[int, int] = tuple(self._native.markers)  # type: ignore[assignment]
 
     def __repr__(self) -> str:
         return f"Sensor({self.id!r}, {self.size[0]}x{self.size[1]} px)"
-
-    def _press_flags(self, shape: str, depth_mm: float, **kw: Any) -> List[str]:
-        """``tactex press`` flags for this sensor: one place that names the profile."""
-        return _flags(shape=shape, depth_mm=depth_mm, sensor=self.profile, **kw)
 
     def press_sequence(
         self,
@@ -282,14 +349,14 @@ class Sensor:
         if mesh is not None and shape == "sphere":
             shape = "mesh"
         geometry = _geometry(mesh, mesh_scale)
-        argv = self._press_flags(
+        keywords = _press_keywords(
             "sphere" if geometry is not None else shape,
             0.0,
+            pose,
             radius_mm=radius_mm,
             size_mm=size_mm,
-            **_pose_flags(pose),
             mesh=None if geometry is not None else mesh,
-            mesh_scale=None if geometry is not None else mesh_scale,
+            mesh_scale=mesh_scale,
             hardness=hardness,
             modulus_mpa=modulus_mpa,
             object_poisson=object_poisson,
@@ -301,7 +368,8 @@ class Sensor:
             marker_pitch_mm=marker_pitch_mm,
             seed=seed,
         )
-        frames, facts = _tactex.press_sequence(argv, float(phase_mm), geometry)
+        phase = _number("phase_mm", phase_mm)
+        frames, facts = _tactex.press_sequence(self._native, keywords, phase, geometry)
         return PressSequence(reference=frames[0], frames=frames[1:], labels=json.loads(facts))
 
     def press(
@@ -353,7 +421,7 @@ class Sensor:
             radius_mm=radius_mm,
             size_mm=size_mm,
             mesh=None if geometry is not None else mesh,
-            mesh_scale=None if geometry is not None else mesh_scale,
+            mesh_scale=mesh_scale,
             hardness=hardness,
             modulus_mpa=modulus_mpa,
             object_poisson=object_poisson,
@@ -429,12 +497,13 @@ class Sensor:
         *,
         depth_mm: float,
         pose: Optional[Tuple[float, float, float]] = None,
+        device: str = "cpu",
         **flags: Any,
     ) -> Press:
-        """One press from ``tactex press`` flags, on ``geometry`` when the caller gave its
-        own object (the flags then name a placeholder shape the geometry replaces)."""
-        argv = self._press_flags(shape, depth_mm, **_pose_flags(pose), **flags)
-        out = _tactex.press(argv, geometry)
+        """One press from ``Sensor.press``'s keywords, on ``geometry`` when the caller gave
+        its own object (``shape`` then names a placeholder the geometry replaces)."""
+        keywords = _press_keywords(shape, depth_mm, pose, **flags)
+        out = _tactex.press(self._native, keywords, _text("device", device), geometry)
         return Press(
             frame=out["frame"],
             reference=out["reference"],

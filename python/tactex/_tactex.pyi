@@ -6,15 +6,46 @@ import numpy as np
 
 __version__: str
 
-def press(argv: List[str], geometry: Optional[Dict[str, Any]] = None) -> Dict[str, Any]:
-    """One press from ``tactex press`` flags, on the caller's own object when ``geometry``
-    (vertices, faces, mesh_scale, height_map_mm, mm_per_px; None where not given) holds one:
-    report (JSON text), frame, reference, fields, field_grid, pressure_grid."""
+class Profile:
+    """A sensor profile loaded once: the built-in GelSight Mini (``path`` None) or a profile
+    file; presses through it do not read the file again."""
+
+    def __init__(self, path: Optional[str] = None) -> None: ...
+    @property
+    def id(self) -> str: ...
+    @property
+    def profile_id(self) -> str: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def size(self) -> Tuple[int, int]: ...
+    @property
+    def mm_per_px(self) -> float: ...
+    @property
+    def gel_modulus_mpa(self) -> float: ...
+    @property
+    def gel_thickness_mm(self) -> float: ...
+    @property
+    def markers(self) -> Tuple[int, int]: ...
+
+def press(
+    profile: Profile,
+    options: Dict[str, Any],
+    device: str,
+    geometry: Optional[Dict[str, Any]] = None,
+) -> Dict[str, Any]:
+    """One press through ``profile``: ``options`` are ``Sensor.press``'s keywords, every key
+    present (None where not given), checked by the library; ``geometry`` (vertices, faces,
+    mesh_scale, height_map_mm, mm_per_px) the caller's own object. Returns report (JSON
+    text), library_s, frame, reference, fields, field_grid, pressure_grid."""
 
 def press_sequence(
-    argv: List[str], phase_mm: float, geometry: Optional[Dict[str, Any]] = None
+    profile: Profile,
+    options: Dict[str, Any],
+    phase_mm: float,
+    geometry: Optional[Dict[str, Any]] = None,
 ) -> Tuple[np.ndarray, str]:
-    """The paper's press protocol from ``tactex press`` flags (and ``geometry`` as for
+    """The paper's press protocol through ``profile`` (``options`` and ``geometry`` as for
     ``press``): frames (9, H, W, 3) uint8 and the press's facts (JSON text)."""
 
 def generate_samples(
@@ -35,9 +66,6 @@ def compare(argv: List[str]) -> str:
 def read(argv: List[str]) -> Dict[str, Any]:
     """``tactex read`` from its flags: ``report`` (JSON text) and ``indentation_mm`` (H x W
     float32)."""
-
-def sensor_info(path: Optional[str] = None) -> Dict[str, Any]:
-    """A profile's id, name, width, height, mm_per_px, gel and markers."""
 
 def threads() -> int:
     """Threads of the Rust pool that draws samples."""

@@ -2,6 +2,7 @@
 //! Python package raises FileNotFoundError, ValueError or RuntimeError), judged by the error
 //! types in its chain rather than by its words.
 
+use crate::app::flag_range::FieldError;
 use tactex_core::catalog::CatalogError;
 use tactex_core::hardness::interval_calibration::CalibrationError;
 use tactex_core::hardness::scale::HardnessError;
@@ -58,6 +59,7 @@ fn is_missing(cause: &(dyn std::error::Error + 'static)) -> bool {
 /// and the formats they are written in.
 fn is_bad_input(cause: &(dyn std::error::Error + 'static)) -> bool {
     cause.is::<QueryError>()
+        || cause.is::<FieldError>()
         || cause.is::<SceneError>()
         || cause.is::<ProfileError>()
         || cause.is::<CatalogError>()

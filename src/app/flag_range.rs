@@ -1,40 +1,114 @@
-//! Numeric flags checked where clap reads them: finite, within the range the flag's help
-//! states, the range named in the error (clap names the flag). One parser for every
-//! physical quantity a user types, so that NaN, infinities and 1e300 never reach a solver.
+//! The numbers a request takes, each with the range its help states: one `Field` per
+//! quantity, checked by the same code where clap reads the CLI's flag and where the library
+//! checks a request built in code (Python, a user's program), so that NaN, infinities and
+//! 1e300 never reach a solver and the range is written once.
 
 /// A number shown short: 1e300 as "1e300", not 301 digits.
 pub use tactex_core::printable::short_number as show;
 
-fn parse(text: &str, span: &str) -> Result<f64, String> {
-    text.trim()
-        .parse::<f64>()
-        .map_err(|_| format!("expected a number in {span}"))
+/// A request's field that is out of range or ill-formed. `field` is the request's own name
+/// for it (`depth_mm`); each front end says it in its caller's words (`--depth-mm` on the
+/// command line, as `Display` does; `depth_mm` in Python).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{}: {problem}", flag(field))]
+pub struct FieldError {
+    pub field: String,
+    pub problem: String,
 }
 
-/// A value in [lo, hi].
+impl FieldError {
+    pub fn new(field: &str, problem: impl Into<String>) -> Self {
+        Self {
+            field: field.into(),
+            problem: problem.into(),
+        }
+    }
+}
+
+/// A field as the command line names it: `depth_mm` -> `--depth-mm`.
+pub fn flag(field: &str) -> String {
+    format!("--{}", field.replace('_', "-"))
+}
+
+/// A number a request takes and the range it may lie in: [lo, hi], or (lo, hi] where a
+/// value must be above lo (a length, a modulus).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Field {
+    pub name: &'static str,
+    lo: f64,
+    hi: f64,
+    open_below: bool,
+}
+
+impl Field {
+    /// A value in [lo, hi].
+    pub const fn within(name: &'static str, lo: f64, hi: f64) -> Self {
+        Self {
+            name,
+            lo,
+            hi,
+            open_below: false,
+        }
+    }
+
+    /// A value in (lo, hi].
+    pub const fn above(name: &'static str, lo: f64, hi: f64) -> Self {
+        Self {
+            name,
+            lo,
+            hi,
+            open_below: true,
+        }
+    }
+
+    /// The range as the errors and help write it: "[0, 30]", "(0, 1000]".
+    pub fn span(&self) -> String {
+        let open = if self.open_below { '(' } else { '[' };
+        format!("{open}{}, {}]", show(self.lo), show(self.hi))
+    }
+
+    fn holds(&self, v: f64) -> bool {
+        let above_lo = if self.open_below {
+            v > self.lo
+        } else {
+            v >= self.lo
+        };
+        v.is_finite() && above_lo && v <= self.hi
+    }
+
+    /// `v` when it lies in the range; else the error naming the field and the range.
+    pub fn check(&self, v: f64) -> Result<f64, FieldError> {
+        if self.holds(v) {
+            Ok(v)
+        } else {
+            Err(FieldError::new(
+                self.name,
+                format!("{} is outside {}", show(v), self.span()),
+            ))
+        }
+    }
+
+    /// Clap's parser for the field's flag: the same check, the message without the name
+    /// (clap names the flag).
+    pub fn parser(self) -> impl Fn(&str) -> Result<f64, String> + Clone {
+        move |text| {
+            let v = text
+                .trim()
+                .parse::<f64>()
+                .map_err(|_| format!("expected a number in {}", self.span()))?;
+            self.check(v).map_err(|e| e.problem)
+        }
+    }
+}
+
+/// Clap's parser for a value in [lo, hi], for a flag with no request field of its own.
 pub fn within(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
-    move |text| {
-        let span = format!("[{}, {}]", show(lo), show(hi));
-        let v = parse(text, &span)?;
-        if v.is_finite() && (lo..=hi).contains(&v) {
-            Ok(v)
-        } else {
-            Err(format!("{} is outside {span}", show(v)))
-        }
-    }
+    Field::within("", lo, hi).parser()
 }
 
-/// A value in (lo, hi]: above lo, e.g. a length or modulus above zero.
+/// Clap's parser for a value in (lo, hi]: above lo, e.g. a length or modulus above zero.
 pub fn above(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
-    move |text| {
-        let span = format!("({}, {}]", show(lo), show(hi));
-        let v = parse(text, &span)?;
-        if v.is_finite() && v > lo && v <= hi {
-            Ok(v)
-        } else {
-            Err(format!("{} is outside {span}", show(v)))
-        }
-    }
+    Field::above("", lo, hi).parser()
 }
 
 /// A whole number in [lo, hi]: a count, a repetition, a table's nodes.
@@ -77,5 +151,15 @@ mod tests {
         assert_eq!(c("0").unwrap_err(), "0 is outside [1, 1000]");
         assert!(c("-1").unwrap_err().contains("[1, 1000]"));
         assert!(c("1e3").unwrap_err().contains("whole number"));
+    }
+
+    #[test]
+    fn a_field_checked_in_code_is_named_as_the_flag_that_sets_it() {
+        let depth = Field::within("depth_mm", 0.0, 30.0);
+        assert_eq!(depth.check(30.0), Ok(30.0));
+        let e = depth.check(f64::NAN).unwrap_err();
+        assert_eq!(e.field, "depth_mm");
+        assert_eq!(e.to_string(), "--depth-mm: NaN is outside [0, 30]");
+        assert_eq!(depth.parser()("31").unwrap_err(), "31 is outside [0, 30]");
     }
 }

@@ -14,6 +14,7 @@ pub mod hardware;
 pub mod image_input;
 pub mod llm_chat;
 pub mod parser_choice;
+pub mod press_options;
 pub mod question;
 pub mod replay;
 pub mod sample_space;

@@ -2,11 +2,13 @@
 //! through a sensor profile: what `tactex press` and the Python package's `Sensor.press`
 //! both run, so that the same request gives the same frame bytes through either.
 
+use crate::app::flag_range::FieldError;
 use anyhow::{Context, Result, bail};
 use glam::{DQuat, DVec2, DVec3};
 use image::RgbImage;
 use serde::Serialize;
 use std::path::PathBuf;
+use std::sync::Arc;
 use tactex_core::hardness::scale::{Hardness, HardnessReport};
 use tactex_core::hertz::Elastic;
 use tactex_core::press::protocol::PressProtocol;
@@ -173,7 +175,8 @@ pub struct PressRequest {
     pub cell_mm: Option<f64>,
     /// Relative pressure change at which the contact solve stops.
     pub tolerance: f64,
-    pub sensor: SensorProfile,
+    /// Shared: a caller pressing many times through one profile does not copy it.
+    pub sensor: Arc<SensorProfile>,
     /// Seed of the rendered frame's camera noise; the no-contact frame takes seed + 1.
     pub seed: u32,
 }
@@ -235,8 +238,47 @@ pub struct SolvedPress {
 }
 
 impl PressRequest {
+    /// Every number of the request within the range `tactex press` states for it, however
+    /// the request was built: a program's own `PressRequest` is held to what the CLI's
+    /// parsers and `PressOptions` hold theirs to.
+    pub fn check(&self) -> Result<(), FieldError> {
+        use crate::app::press_options::fields::*;
+        match &self.shape {
+            PressShape::Sphere { radius_mm } => {
+                RADIUS_MM.check(*radius_mm)?;
+            }
+            PressShape::Ellipsoid { size_mm } | PressShape::Box { size_mm } => {
+                for s in size_mm {
+                    SIZE_MM.check(*s)?;
+                }
+            }
+            PressShape::Mesh { scale, .. } | PressShape::Triangles { scale, .. } => {
+                MESH_SCALE.check(*scale)?;
+            }
+            PressShape::HeightMap(_) => {}
+        }
+        for v in self.pose.at_mm {
+            AT_MM.check(v)?;
+        }
+        YAW_DEG.check(self.pose.yaw_deg)?;
+        if let Hardness::ModulusMpa(e) = self.hardness {
+            MODULUS_MPA.check(e)?;
+        }
+        OBJECT_POISSON.check(self.object_poisson)?;
+        DEPTH_MM.check(self.depth_mm)?;
+        if let Some(cell) = self.cell_mm {
+            GRID_MM.check(cell)?;
+        }
+        TOLERANCE.check(self.tolerance)?;
+        let gel = &self.sensor.spec.gel;
+        GEL_THICKNESS_MM.check(gel.thickness_mm)?;
+        GEL_MODULUS_MPA.check(gel.modulus_mpa)?;
+        Ok(())
+    }
+
     /// Solves the contact and reports its figures.
     pub fn solve(&self) -> Result<SolvedPress> {
+        self.check()?;
         let surface = self.shape.surface(self.pose)?;
         let gel = self.sensor.spec.gel;
         let pad = Rect::centred(DVec2::from(self.sensor.spec.pad_size_mm()) / 2.0);
@@ -308,6 +350,17 @@ impl PressRequest {
     /// touch falls `phase_mm` (0 to 0.25) before a step. Returns the press and its frames,
     /// rendered on the CPU: the no-contact reference first, then the 8 recorded frames.
     pub fn press_sequence(&self, phase_mm: f64) -> Result<(PlannedPress, Vec<RgbImage>)> {
+        self.check()?;
+        if !(phase_mm.is_finite() && (0.0..0.25).contains(&phase_mm)) {
+            return Err(FieldError::new(
+                "phase_mm",
+                format!(
+                    "{} is outside [0, 0.25): first touch falls within one 0.25 mm step",
+                    crate::app::flag_range::show(phase_mm)
+                ),
+            )
+            .into());
+        }
         let surface = self.shape.surface(self.pose)?;
         let optics = SensorOptics::for_profile(&self.sensor);
         let setup = PressSetup {

@@ -243,7 +243,7 @@ fn bad_press_input_is_one_clear_line_and_a_failure() {
                 "--out",
                 out_dir,
             ],
-            "--marker-pitch-mm 0.000001: not over the markers' diameter",
+            "--marker-pitch-mm: 0.000001 mm is not over the markers' diameter",
         ),
         // A size the shape does not read would press another object than the one described.
         (
