@@ -2,14 +2,13 @@
 //! tactex library that the command line runs, so that a press, a generated sample or an
 //! answer is the same from Python as from the CLI, byte for byte.
 //!
-//! A press arrives as typed keywords checked by the library (`PressOptions::request`)
-//! against the same ranges as the CLI's flags, through a `Profile` loaded once; the
-//! other commands (ask, calibrate, compare, read) still arrive as the CLI's own flags,
-//! parsed by its parser. Long calls release the GIL and run on the Rust thread pool;
+//! Every call arrives as the library's own typed request, checked by the library against
+//! the ranges the CLI's flags state: a press as typed keywords (`PressOptions`) through a
+//! `Profile` loaded once, the longer calls (ask, calibrate, compare, read) as their request
+//! in JSON text (`AskRequest`, ...), whose errors name the field. Long calls release the GIL and run on the Rust thread pool;
 //! frames are handed to numpy without a copy.
 
 use anyhow::Context;
-use clap::Parser;
 use glam::DVec3;
 use numpy::ndarray::{Array2, Array3, Array4};
 use numpy::{IntoPyArray, PyArray4, PyReadonlyArray2};
@@ -21,9 +20,14 @@ use std::sync::{Arc, Mutex};
 use tactex::app::error_kind::ErrorKind;
 use tactex::app::flag_range::FieldError;
 use tactex::app::press_options::PressOptions;
+use tactex::app::request_json::from_json;
 use tactex::app::single_press::PressShape;
 use tactex::app::tactile_samples::{TactileSample, TactileSampleSource};
-use tactex::cli::{Cli, Command, error_line};
+use tactex::cli::error_line;
+use tactex::commands::ask::AskRequest;
+use tactex::commands::read::ReadRequest;
+use tactex::sim2real::calibrate::CalibrateRequest;
+use tactex::sim2real::compare::CompareRequest;
 use tactex_core::tactile::sensor_profile::SensorProfile;
 use tactex_sim::contact::ContactSolver;
 use tactex_sim::contact::HeightMap;
@@ -74,20 +78,6 @@ fn to_py(e: anyhow::Error) -> PyErr {
         ErrorKind::Missing => PyFileNotFoundError::new_err(line),
         ErrorKind::BadInput => PyValueError::new_err(line),
         ErrorKind::Failure => PyRuntimeError::new_err(line),
-    }
-}
-
-/// The CLI parses `argv` (without the program name); a parse error is one line, as
-/// `tactex` prints it.
-fn parse(argv: Vec<String>) -> PyResult<Command> {
-    let all = std::iter::once("tactex".to_string()).chain(argv);
-    match Cli::try_parse_from(all) {
-        Ok(cli) => Ok(cli.command),
-        Err(e) => Err(PyValueError::new_err(
-            tactex::cli::usage_error_line(&e)
-                .trim_start_matches("error: ")
-                .to_string(),
-        )),
     }
 }
 
@@ -185,7 +175,13 @@ impl Profile {
     #[new]
     #[pyo3(signature = (path=None))]
     fn new(path: Option<std::path::PathBuf>) -> PyResult<Self> {
-        let sensor = tactex::app::load_sensor(path.as_deref()).map_err(to_py)?;
+        // Named as `Sensor(profile)` names it.
+        let sensor = match path {
+            Some(p) => tactex::app::sensor::load_profile(&p)
+                .context("profile")
+                .map_err(to_py)?,
+            None => SensorProfile::gelsight_mini(),
+        };
         Ok(Self {
             sensor: Arc::new(sensor),
         })
@@ -465,56 +461,47 @@ fn stack(images: Vec<image::RgbImage>) -> Array4<u8> {
         .expect("every frame of a sample has the sensor's size")
 }
 
-/// The answer of `tactex ask` (flags in `argv`, the prompt last) as JSON text, as
-/// `ask --json` prints it.
+/// The answer to the question `request` holds (an `AskRequest` as JSON text: `tactex.ask`'s
+/// keywords), as JSON text, as `ask --json` prints it.
 #[pyfunction]
-fn ask(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
-    let Command::Ask(args) = parse(std::iter::once("ask".into()).chain(argv).collect())? else {
-        unreachable!("the argv starts with ask")
-    };
+fn ask(py: Python<'_>, request: &str) -> PyResult<String> {
+    let request: AskRequest = from_json(request).map_err(|e| to_py(e.into()))?;
     off_the_gil(py, || -> anyhow::Result<String> {
-        let answer = tactex::commands::ask::answer(&args)?;
+        let answer = tactex::commands::ask::answer(&request)?;
         serde_json::to_string_pretty(&answer).context("serialising the answer")
     })
 }
 
-/// `tactex calibrate` (flags in `argv`): fits and writes a sensor profile; returns what
-/// `calibrate --json` prints (JSON text).
+/// Fits and writes a sensor profile (`request`: a `CalibrateRequest` as JSON text,
+/// `tactex.calibrate`'s keywords); returns what `calibrate --json` prints (JSON text).
 #[pyfunction]
-fn calibrate(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
-    let Command::Calibrate(args) =
-        parse(std::iter::once("calibrate".into()).chain(argv).collect())?
-    else {
-        unreachable!("the argv starts with calibrate")
-    };
+fn calibrate(py: Python<'_>, request: &str) -> PyResult<String> {
+    let args: CalibrateRequest = from_json(request).map_err(|e| to_py(e.into()))?;
     off_the_gil(py, || -> anyhow::Result<String> {
         let fit = tactex::sim2real::calibrate::calibrate(&args)?;
         serde_json::to_string_pretty(&fit).context("serialising the calibration")
     })
 }
 
-/// `tactex compare` (flags in `argv`): ball presses or a recorded session rebuilt in the
-/// twin and scored; returns what `compare --json` prints (JSON text).
+/// Ball presses or a recorded session rebuilt in the twin and scored (`request`: a
+/// `CompareRequest` as JSON text, `tactex.compare`'s keywords); returns what `compare
+/// --json` prints (JSON text).
 #[pyfunction]
-fn compare(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
-    let Command::Compare(args) = parse(std::iter::once("compare".into()).chain(argv).collect())?
-    else {
-        unreachable!("the argv starts with compare")
-    };
+fn compare(py: Python<'_>, request: &str) -> PyResult<String> {
+    let args: CompareRequest = from_json(request).map_err(|e| to_py(e.into()))?;
     off_the_gil(py, || -> anyhow::Result<String> {
         let report = tactex::sim2real::compare::compare(&args)?;
         serde_json::to_string_pretty(&report).context("serialising the comparison")
     })
 }
 
-/// `tactex read` (flags in `argv`): one frame read through a sensor's optics. Returns the
-/// report (JSON text, what `read --json` prints) and the indentation map (mm into the gel,
-/// float32, H x W); `--out` writes the picture as the command does.
+/// One frame read through a sensor's optics (`request`: a `ReadRequest` as JSON text,
+/// `tactex.read`'s keywords). Returns the report (JSON text, what `read --json` prints) and
+/// the indentation map (mm into the gel, float32, H x W); `out` writes the picture as the
+/// command does.
 #[pyfunction]
-fn read(py: Python<'_>, argv: Vec<String>) -> PyResult<Bound<'_, PyDict>> {
-    let Command::Read(args) = parse(std::iter::once("read".into()).chain(argv).collect())? else {
-        unreachable!("the argv starts with read")
-    };
+fn read<'py>(py: Python<'py>, request: &str) -> PyResult<Bound<'py, PyDict>> {
+    let args: ReadRequest = from_json(request).map_err(|e| to_py(e.into()))?;
     let (report, map) = off_the_gil(py, || -> anyhow::Result<(String, Array2<f32>)> {
         let (report, reading, image) = tactex::commands::read::read(&args)?;
         if let Some(out) = &args.out {

@@ -18,6 +18,7 @@ with a one-line message that names the keyword (``depth_mm``).
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
@@ -67,24 +68,6 @@ FIDELITIES: Tuple[str, ...] = ("rigid", "hertz", "halfspace", "layer")
 SHAPE_FAMILIES: Tuple[str, ...] = ("sphere", "ellipsoid", "box", "fruit", "blob")
 
 PathLike = Union[str, "os.PathLike[str]"]
-
-
-def _flags(**values: Any) -> List[str]:
-    """Keyword arguments as CLI flags: ``depth_mm=1`` -> ``--depth-mm=1`` (joined, so that a
-    value such as ``-2,3`` is not read as a flag); None is left out, True is a bare flag, a
-    sequence is comma-joined."""
-    out: List[str] = []
-    for name, value in values.items():
-        if value is None or value is False:
-            continue
-        flag = "--" + name.replace("_", "-")
-        if value is True:
-            out.append(flag)
-        elif isinstance(value, (list, tuple)):
-            out.append(f"{flag}={','.join(str(v) for v in value)}")
-        else:
-            out.append(f"{flag}={os.fspath(value) if isinstance(value, os.PathLike) else value}")
-    return out
 
 
 def _number(name: str, value: Any) -> Optional[float]:
@@ -182,13 +165,36 @@ def _numbers(name: str, value: Any) -> Optional[List[float]]:
         raise InvalidArgument(f"{name}: give a sequence of numbers, got {value!r}") from None
 
 
+def _whole(name: str, value: Any, end: int) -> int:
+    """A keyword's whole number in [0, end)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InvalidArgument(f"{name}: give a whole number, got {value!r}")
+    if not 0 <= int(value) < end:
+        raise InvalidArgument(f"{name}: {value} is outside [0, {end - 1}]")
+    return int(value)
+
+
 def _seed(value: Any) -> int:
     """A camera-noise seed: a whole number in [0, 2**32)."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InvalidArgument(f"seed: give a whole number, got {value!r}")
-    if not 0 <= int(value) < 2**32:
-        raise InvalidArgument(f"seed: {value} is outside [0, 4294967295]")
-    return int(value)
+    return _whole("seed", value, 2**32)
+
+
+def _request(**values: Any) -> Dict[str, Any]:
+    """A library request's fields as JSON takes them: None left out (the library's default
+    applies), paths as text; any other value is checked by the caller or the library."""
+    out: Dict[str, Any] = {}
+    for name, value in values.items():
+        if value is None:
+            continue
+        if isinstance(value, os.PathLike):
+            value = os.fspath(value)
+        elif isinstance(value, bytes):
+            raise InvalidArgument(f"{name}: give text or a path, got bytes")
+        elif isinstance(value, float) and not math.isfinite(value):
+            # JSON has no NaN or infinity to carry it to the library's range check.
+            raise InvalidArgument(f"{name}: {value} is not a finite number")
+        out[name] = value
+    return out
 
 
 # Press keywords that are numbers; the others are text, paths or sequences.
@@ -650,10 +656,8 @@ def ask(
     arguments give the same result, equal to ``ask --json --reproducible``. ``parser="llm"``
     has the endpoint ``explainer="llm"`` uses read the question (``tactex ask --parser``).
     """
-    argv = _flags(
-        scene=scene,
-        seed=seed,
-        fidelity=fidelity,
+    twin = _request(
+        fidelity=_text("fidelity", fidelity),
         estimator=estimator,
         intervals=intervals,
         detector=detector,
@@ -662,11 +666,16 @@ def ask(
         explainer=explainer,
         parser=parser,
         llm_config=llm_config,
-        gel_modulus_mpa=gel_modulus_mpa,
-        reproducible=reproducible,
-        json=True,
     )
-    return json.loads(_tactex.ask(argv + ["--", prompt]))
+    request = _request(
+        prompt=_text("prompt", prompt),
+        scene=scene,
+        seed=_whole("seed", seed, 2**64),
+        reproducible=bool(reproducible),
+        gel_modulus_mpa=_number("gel_modulus_mpa", gel_modulus_mpa),
+        twin=twin,
+    )
+    return json.loads(_tactex.ask(json.dumps(request)))
 
 
 def calibrate(
@@ -701,29 +710,29 @@ def calibrate(
     and id, presses and pixels fitted, the table's rms residual per channel, the noise and
     the markers read. ``Sensor(out)`` then presses through it. Arguments left as None take
     the command's defaults (``tactex calibrate --help``)."""
-    argv = _flags(
+    request = _request(
         images=images,
         annotations=annotations,
         background=background,
-        ball_radius_mm=ball_radius_mm,
-        mm_per_px=mm_per_px,
+        ball_radius_mm=_number("ball_radius_mm", ball_radius_mm),
+        mm_per_px=_number("mm_per_px", mm_per_px),
         out=out,
         name=name,
         markers=markers,
-        gel_modulus_mpa=gel_modulus_mpa,
-        gel_thickness_mm=gel_thickness_mm,
-        gel_poisson=gel_poisson,
-        frame_rate_hz=frame_rate_hz,
+        gel_modulus_mpa=_number("gel_modulus_mpa", gel_modulus_mpa),
+        gel_thickness_mm=_number("gel_thickness_mm", gel_thickness_mm),
+        gel_poisson=_number("gel_poisson", gel_poisson),
+        frame_rate_hz=_number("frame_rate_hz", frame_rate_hz),
         split=split,
-        mag_bins=mag_bins,
-        dir_bins=dir_bins,
-        mag_max=mag_max,
-        smoothness=smoothness,
-        source=source or None,
-        no_glow=not glow,
+        mag_bins=None if mag_bins is None else _whole("mag_bins", mag_bins, 2**32),
+        dir_bins=None if dir_bins is None else _whole("dir_bins", dir_bins, 2**32),
+        mag_max=_number("mag_max", mag_max),
+        smoothness=_number("smoothness", smoothness),
+        source=source,
+        glow=bool(glow),
         fidelity=fidelity,
     )
-    return json.loads(_tactex.calibrate(argv))
+    return json.loads(_tactex.calibrate(json.dumps(request)))
 
 
 def compare(
@@ -755,23 +764,22 @@ def compare(
     each reads. ``out`` writes the side-by-side images and the JSON there. Arguments left
     as None take the command's defaults (``tactex compare --help``: split eval, fidelity
     layer, device auto)."""
-    argv = _flags(
+    request = _request(
         sensor=sensor,
         images=images,
         annotations=annotations,
         session=session,
         scene=scene,
-        seed=seed,
-        gel_modulus_mpa=gel_modulus_mpa,
+        seed=None if seed is None else _whole("seed", seed, 2**64),
+        gel_modulus_mpa=_number("gel_modulus_mpa", gel_modulus_mpa),
         estimator=estimator,
         split=split,
         fidelity=fidelity,
         device=device,
-        no_glow=not glow,
+        glow=bool(glow),
         out=out,
-        json=True,
     )
-    return json.loads(_tactex.compare(argv))
+    return json.loads(_tactex.compare(json.dumps(request)))
 
 
 def read(
@@ -790,8 +798,8 @@ def read(
     sensor's id) and ``indentation_mm``, the gel's
     indentation map (H x W float32, mm into the gel). ``out`` writes the frame beside the map
     as a PNG."""
-    argv = _flags(reference=reference, sensor=sensor, out=out) + ["--", os.fspath(image)]
-    native = _tactex.read(argv)
+    request = _request(image=image, reference=reference, sensor=sensor, out=out)
+    native = _tactex.read(json.dumps(request))
     report = json.loads(native["report"])
     report["indentation_mm"] = native["indentation_mm"]
     return report

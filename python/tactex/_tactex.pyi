@@ -53,19 +53,21 @@ def generate_samples(
 ) -> List[Tuple[str, np.ndarray]]:
     """Samples at ``indices``: (labels JSON text, frames (9, H, W, 3) uint8)."""
 
-def ask(argv: List[str]) -> str:
-    """``tactex ask --json`` from its flags (prompt last): the answer as JSON text."""
+def ask(request: str) -> str:
+    """The answer to an ``AskRequest`` (JSON text: prompt, scene, seed, reproducible, twin
+    {fidelity, estimator, ...}, ...), as ``tactex ask --json`` prints it (JSON text)."""
 
-def calibrate(argv: List[str]) -> str:
-    """``tactex calibrate --json`` from its flags: writes the profile, returns the fit (JSON
-    text)."""
+def calibrate(request: str) -> str:
+    """Fits and writes the profile a ``CalibrateRequest`` (JSON text) describes; returns the
+    fit (JSON text), as ``calibrate --json`` prints it."""
 
-def compare(argv: List[str]) -> str:
-    """``tactex compare --json`` from its flags: the comparison as JSON text."""
+def compare(request: str) -> str:
+    """The comparison a ``CompareRequest`` (JSON text) describes, as ``compare --json``
+    prints it (JSON text)."""
 
-def read(argv: List[str]) -> Dict[str, Any]:
-    """``tactex read`` from its flags: ``report`` (JSON text) and ``indentation_mm`` (H x W
-    float32)."""
+def read(request: str) -> Dict[str, Any]:
+    """One frame read as a ``ReadRequest`` (JSON text: image, reference, sensor, out) says:
+    ``report`` (JSON text) and ``indentation_mm`` (H x W float32)."""
 
 def threads() -> int:
     """Threads of the Rust pool that draws samples."""

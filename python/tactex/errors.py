@@ -28,7 +28,7 @@ class Failure(TactexError, RuntimeError):
 
 
 # Flags whose keyword is not the flag's own name.
-_KEYWORD = {"at_mm": "pose", "yaw_deg": "pose", "sensor": "profile"}
+_KEYWORD = {"at_mm": "pose", "yaw_deg": "pose"}
 
 
 def python_words(message: str) -> str:

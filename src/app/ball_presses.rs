@@ -5,7 +5,6 @@
 
 use crate::app::load_rgb;
 use anyhow::{Result, bail};
-use clap::ValueEnum;
 use glam::DVec2;
 use image::RgbImage;
 use std::path::{Path, PathBuf};
@@ -17,7 +16,7 @@ use tactex_sim::render::gel::{
     GelImageFields, SensorOptics, image_fields, pad_rect, pixel_centre_mm,
 };
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Split {
     /// The presses that are not held out (two of every three).
     Calib,
@@ -27,6 +26,12 @@ pub enum Split {
 }
 
 impl Split {
+    pub const NAMES: [&'static str; 3] = ["calib", "eval", "all"];
+
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
     fn keeps(self, index: usize) -> bool {
         let held_out = index % 3 == 2;
         match self {
@@ -34,6 +39,17 @@ impl Split {
             Split::Eval => held_out,
             Split::All => true,
         }
+    }
+}
+
+impl std::str::FromStr for Split {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let wanted = s.trim().to_ascii_lowercase();
+        [Split::Calib, Split::Eval, Split::All]
+            .into_iter()
+            .find(|k| k.name() == wanted)
+            .ok_or_else(|| format!("unknown split {s:?} (calib, eval or all)"))
     }
 }
 

@@ -7,7 +7,6 @@
 use crate::app::llm_chat::LlmChat;
 pub use crate::app::llm_chat::LlmConfig;
 use anyhow::{Result, bail};
-use clap::ValueEnum;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::explain::{
@@ -15,13 +14,29 @@ use tactex_core::explain::{
 };
 
 /// Which explainer writes the answer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ExplainerChoice {
     /// Deterministic text from the measurements; offline.
+    #[default]
     Template,
     /// A chat-completions endpoint (TACTEX_LLM_BASE_URL / --llm-config), checked for
     /// groundedness, with the template as fallback.
     Llm,
+}
+
+impl ExplainerChoice {
+    pub const NAMES: [&'static str; 2] = ["template", "llm"];
+}
+
+impl std::str::FromStr for ExplainerChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "template" => Ok(Self::Template),
+            "llm" => Ok(Self::Llm),
+            _ => Err(format!("unknown explainer {s:?} (template or llm)")),
+        }
+    }
 }
 
 pub struct LlmExplainer {

@@ -111,6 +111,16 @@ pub fn above(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
     Field::above("", lo, hi).parser()
 }
 
+/// Clap's parser for a choice among `names` (shown in `--help` and in the error), read by
+/// the choice's own `FromStr`: the one parse the library, Python and files use too.
+pub fn choice<T>(names: &'static [&'static str]) -> impl clap::builder::TypedValueParser<Value = T>
+where
+    T: std::str::FromStr<Err = String> + Clone + Send + Sync + 'static,
+{
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(names).try_map(|s| s.parse::<T>())
+}
+
 /// A whole number in [lo, hi]: a count, a repetition, a table's nodes.
 pub fn count<T: TryFrom<u64> + Clone + Send + Sync + 'static>(
     lo: u64,

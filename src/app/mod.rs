@@ -17,6 +17,7 @@ pub mod parser_choice;
 pub mod press_options;
 pub mod question;
 pub mod replay;
+pub mod request_json;
 pub mod sample_space;
 pub mod scene;
 pub mod sensor;

@@ -5,7 +5,6 @@
 
 use crate::app::llm_chat::{LlmChat, LlmConfig};
 use anyhow::Result;
-use clap::ValueEnum;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::printable::printable;
@@ -14,13 +13,29 @@ use tactex_core::query::reader::{PromptReader, ReadPrompt, RuleReader};
 use tactex_core::query::{self, Query, llm_prompt};
 
 /// Which parser reads the prompt.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ParserChoice {
     /// The rule parser; offline.
+    #[default]
     Rules,
     /// A chat-completions endpoint (TACTEX_LLM_BASE_URL / --llm-config), its reply checked
     /// against the query's schema and the catalog, with the rules as fallback.
     Llm,
+}
+
+impl ParserChoice {
+    pub const NAMES: [&'static str; 2] = ["rules", "llm"];
+}
+
+impl std::str::FromStr for ParserChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "rules" => Ok(Self::Rules),
+            "llm" => Ok(Self::Llm),
+            _ => Err(format!("unknown parser {s:?} (rules or llm)")),
+        }
+    }
 }
 
 /// The parser that reads prompts.

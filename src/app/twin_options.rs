@@ -6,10 +6,11 @@ use crate::app::detector_choice::DetectorChoice;
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::app::explainer_choice::{ExplainerChoice, explainer};
 use crate::app::parser_choice::{ParserChoice, PromptParser};
+use crate::app::request_json::parsed;
 use crate::app::scene::scene_renderer;
 use crate::app::sensor::load_sensor;
 use anyhow::{Result, bail};
-use clap::Args;
+use serde::Deserialize;
 use std::path::PathBuf;
 use std::sync::Arc;
 use tactex_core::explain::Explainer;
@@ -21,51 +22,55 @@ use tactex_sim::contact::Fidelity;
 use tactex_sim::render::device::DeviceChoice;
 use tactex_sim::render::scene::SceneRenderer;
 
-/// How the twin answers: the detector, the camera's render device and the explainer (shared
-/// by `ask` and `serve`).
-#[derive(Args)]
+/// How the twin answers: the detector, the camera's render device, who reads the question
+/// and writes the answer, the contact physics, the estimator and its intervals, the sensor
+/// (shared by `ask`, `serve` and the hardware path). The CLI's flags of the same names
+/// (`cli::TwinFlags`) and Python's keywords map onto it; `Default` is their defaults.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct TwinOptions {
     /// Object detector: classical, yolo:FILE.onnx (a YOLOv8-seg export), or a
     /// perception-error model on the twin's ground truth (error-gsam, error-yolo).
-    #[arg(long, default_value = "classical")]
     pub detector: String,
-    /// Device that renders the camera's frames: cpu, gpu (any Vulkan adapter, software
-    /// included) or auto (a hardware GPU if there is one). One clean render serves a
-    /// whole question, so the CPU default costs little (see `tactex bench scene`).
-    #[arg(long, default_value = "cpu")]
+    /// Device that renders the camera's frames: cpu, gpu or auto.
+    #[serde(deserialize_with = "parsed")]
     pub device: DeviceChoice,
-    /// Who writes the answer: template (deterministic, offline) or llm (an
-    /// OpenAI-compatible endpoint from TACTEX_LLM_BASE_URL / TACTEX_LLM_MODEL /
-    /// TACTEX_LLM_API_KEY or --llm-config; an ungrounded or failed reply falls back to the
-    /// template with a notice).
-    #[arg(long, value_enum, default_value = "template")]
+    /// Who writes the answer: template or llm.
+    #[serde(deserialize_with = "parsed")]
     pub explainer: ExplainerChoice,
-    /// Who reads the question: rules (offline) or llm (the endpoint --explainer llm uses;
-    /// its reading must check out against the catalog, else the rules read it, with a
-    /// notice).
-    #[arg(long, value_enum, default_value = "rules")]
+    /// Who reads the question: rules or llm.
+    #[serde(deserialize_with = "parsed")]
     pub parser: ParserChoice,
-    /// TOML with base_url, model, api_key_env and timeout_s for --explainer llm and
-    /// --parser llm.
-    #[arg(long)]
+    /// TOML with base_url, model, api_key_env and timeout_s for the llm explainer and parser.
     pub llm_config: Option<PathBuf>,
-    /// Contact physics of the sim GelSight: rigid, hertz, halfspace or layer (the bonded
-    /// 4 mm gel, the most faithful; see `tactex bench contact` for what each costs).
-    #[arg(long, default_value = "layer")]
+    /// Contact physics of the sim GelSight.
+    #[serde(deserialize_with = "parsed")]
     pub fidelity: Fidelity,
-    /// Hardness estimator that reads the presses: learned (the built-in model),
-    /// indentation, hertz or FILE.onnx (a model with its card FILE.json beside it).
-    #[arg(long, default_value = DEFAULT_ESTIMATOR)]
+    /// Hardness estimator that reads the presses (a name or a model file).
+    #[serde(deserialize_with = "parsed")]
     pub estimator: EstimatorChoice,
-    /// Interval calibration (JSON from `tactex eval fruits --calibrate`) the estimates' 68%
-    /// and 95% intervals come from; unset: the one shipped for the estimator at --fidelity.
-    #[arg(long)]
+    /// Interval calibration the estimates' intervals come from; None: the one shipped.
     pub intervals: Option<PathBuf>,
-    /// Sensor profile (TOML: `tactex calibrate` writes one, `tactex sensor show --toml`
-    /// prints the built-in one) the sim GelSight renders with; default the built-in GelSight
-    /// Mini.
-    #[arg(long)]
+    /// Sensor profile the sim GelSight renders with; None: the built-in GelSight Mini.
     pub sensor: Option<PathBuf>,
+}
+
+impl Default for TwinOptions {
+    fn default() -> Self {
+        Self {
+            detector: "classical".into(),
+            device: DeviceChoice::Cpu,
+            explainer: ExplainerChoice::Template,
+            parser: ParserChoice::Rules,
+            llm_config: None,
+            fidelity: Fidelity::Layer,
+            estimator: DEFAULT_ESTIMATOR
+                .parse()
+                .expect("the default estimator is registered"),
+            intervals: None,
+            sensor: None,
+        }
+    }
 }
 
 /// The estimator `ask`, `serve`, `compare --session` and `eval scenarios` use unless told:

@@ -82,7 +82,7 @@ pub struct AskBench {
     pub rows: Vec<AskBenchRow>,
 }
 
-pub fn run(args: &AskBenchArgs) -> Result<()> {
+pub(crate) fn run(args: &AskBenchArgs) -> Result<()> {
     if args.fidelity.is_empty() {
         bail!("--fidelity: name at least one of rigid, hertz, halfspace, layer");
     }

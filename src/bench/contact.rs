@@ -135,7 +135,7 @@ fn rms_um(
     1e3 * (sum / g.len() as f64).sqrt()
 }
 
-pub fn run(args: &ContactBenchArgs) -> Result<()> {
+pub(crate) fn run(args: &ContactBenchArgs) -> Result<()> {
     let spec = TactileSpec::gelsight_mini();
     let setup = Setup {
         surface: ObjectSurface::Sphere {

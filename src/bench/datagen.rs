@@ -80,7 +80,7 @@ fn dir_bytes(dir: &std::path::Path) -> u64 {
         .unwrap_or(0)
 }
 
-pub fn run(args: &DatagenBenchArgs) -> Result<()> {
+pub(crate) fn run(args: &DatagenBenchArgs) -> Result<()> {
     let bar = ProgressBar::new(args.fidelity.len() as u64).with_style(
         ProgressStyle::with_template("bench datagen [{bar:30}] {pos}/{len} levels {msg}")
             .expect("a valid template"),

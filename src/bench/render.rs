@@ -71,7 +71,7 @@ pub struct RenderBench {
 
 const DEPTHS_MM: [f64; 8] = [0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0];
 
-pub fn run(args: &RenderBenchArgs) -> Result<()> {
+pub(crate) fn run(args: &RenderBenchArgs) -> Result<()> {
     let reps = args.reps;
     let profile = crate::app::load_sensor(args.sensor.as_deref())?;
     let spec = profile.spec.clone();

@@ -60,7 +60,7 @@ pub struct SceneBench {
     pub rows: Vec<SceneBenchRow>,
 }
 
-pub fn run(args: &SceneBenchArgs) -> Result<()> {
+pub(crate) fn run(args: &SceneBenchArgs) -> Result<()> {
     let reps = args.reps;
     let path = args.scene.clone().unwrap_or_else(crate::app::default_scene);
     let scene = Scene::load(&path, &FruitCatalog::builtin())?;

@@ -1,7 +1,9 @@
-//! The command line: what `tactex` accepts (clap) and which library function each command
-//! runs. `main.rs` only parses, calls [`run`] and prints the error line.
+//! The command line: what `tactex` accepts (clap), which library function each command
+//! runs, and [`main`], the whole program. Clap stays here and in the commands' flag
+//! structs: the library's functions take typed requests (`AskRequest`, `PressOptions`, ...).
 
 pub mod process;
+pub mod twin_flags;
 
 #[cfg(feature = "plots")]
 use crate::{bench, eval};
@@ -11,6 +13,7 @@ use crate::{serve, xarm_twin};
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
+use std::process::ExitCode;
 
 #[derive(Parser)]
 #[command(
@@ -18,13 +21,13 @@ use std::path::PathBuf;
     version,
     about = "TactEx twin: ask a robot with an RGB-D camera and a GelSight Mini about fruit hardness"
 )]
-pub struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
-    pub command: Command,
+    pub(crate) command: Command,
 }
 
 #[derive(Subcommand)]
-pub enum Command {
+pub(crate) enum Command {
     /// Answer a question about the fruit on the table, e.g. "Which fruit is the softest?"
     Ask(commands::ask::AskArgs),
     /// The chat page: live camera view with detections, questions answered with progress,
@@ -90,7 +93,7 @@ pub enum Command {
 
 #[cfg(feature = "plots")]
 #[derive(Subcommand)]
-pub enum BenchCommand {
+pub(crate) enum BenchCommand {
     /// Speed and accuracy of each contact fidelity level and solver cell.
     Contact(bench::contact::ContactBenchArgs),
     /// Frames per second of full GelSight frames per fidelity level, CPU and GPU paths.
@@ -106,7 +109,7 @@ pub enum BenchCommand {
 
 #[cfg(feature = "plots")]
 #[derive(Subcommand)]
-pub enum EvalCommand {
+pub(crate) enum EvalCommand {
     /// The paper's grounding protocol: detectors' success, IoU and centroid error.
     Grounding(eval::grounding::GroundingEvalArgs),
     /// Hardness estimators on held-out synthetic presses of unseen shapes.
@@ -124,7 +127,7 @@ pub enum EvalCommand {
 }
 
 #[derive(Subcommand)]
-pub enum DatagenCommand {
+pub(crate) enum DatagenCommand {
     /// Press sequences (8 frames from first contact, 0.25 mm apart) of randomised objects
     /// and sensors, with hardness labels: pretraining data for tactile hardness models.
     Tactile(datagen::tactile::TactileDatagenArgs),
@@ -137,13 +140,53 @@ pub enum DatagenCommand {
 }
 
 #[derive(Subcommand)]
-pub enum SceneCommand {
+pub(crate) enum SceneCommand {
     /// Validate a scene file (and its meshes) and print a summary.
     Check { file: PathBuf },
 }
 
+/// The `tactex` program: parses the command line, runs the command, and prints any error
+/// as one line (the binary only sets the allocator and calls this).
+pub fn main() -> ExitCode {
+    process::ensure_runtime_dir();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // Help and the version are what was asked for.
+        Err(e)
+            if matches!(
+                e.kind(),
+                clap::error::ErrorKind::DisplayHelp
+                    | clap::error::ErrorKind::DisplayVersion
+                    | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) =>
+        {
+            e.exit()
+        }
+        // A bad value, a flag missing or in conflict: bad input like any other, one line
+        // (clap quotes values as given: escape codes and bidirectional overrides shown).
+        Err(e) => {
+            eprintln!("{}", usage_error_line(&e));
+            return ExitCode::FAILURE;
+        }
+    };
+    #[cfg(feature = "servers")]
+    let serves = matches!(cli.command, Command::Serve(_) | Command::Twin(_));
+    #[cfg(not(feature = "servers"))]
+    let serves = false;
+    if !serves {
+        process::quiet_on_closed_pipe();
+    }
+    match run(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", error_line(&e));
+            ExitCode::FAILURE
+        }
+    }
+}
+
 /// Runs one parsed command.
-pub fn run(command: Command) -> Result<()> {
+pub(crate) fn run(command: Command) -> Result<()> {
     match command {
         Command::Ask(args) => commands::ask::run(&args),
         #[cfg(feature = "servers")]
@@ -239,7 +282,7 @@ pub fn error_line(e: &anyhow::Error) -> String {
 
 /// A command-line parse error as one line: its first paragraph, whose lines (a list of the
 /// required flags not given) are joined, without the usage that follows; escapes shown.
-pub fn usage_error_line(e: &clap::Error) -> String {
+pub(crate) fn usage_error_line(e: &clap::Error) -> String {
     let text = e.render().to_string();
     let first: Vec<&str> = text
         .lines()

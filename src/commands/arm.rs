@@ -107,7 +107,7 @@ fn print_pose(p: &TcpPose, json: bool) -> Result<()> {
     Ok(())
 }
 
-pub fn run(args: &ArmArgs) -> Result<()> {
+pub(crate) fn run(args: &ArmArgs) -> Result<()> {
     let mut config = XArmConfig::new(&args.addr);
     config.reply_timeout = seconds("--timeout-s", args.timeout_s)?;
     config.move_timeout = seconds("--move-timeout-s", args.move_timeout_s)?;

@@ -1,14 +1,19 @@
 //! `tactex ask`: one question answered on the twin, the real devices or a recorded session.
 
+use crate::app::flag_range::choice;
 use crate::app::hardware::answer_on_hardware;
 use crate::app::parser_choice::ParserChoice;
+use crate::app::press_options::fields::GEL_MODULUS_MPA;
 use crate::app::replay::answer_on_replay;
+use crate::app::request_json::parsed;
 use crate::app::scene::{default_scene, load_scene};
 use crate::app::sensor::with_gel_modulus;
 use crate::app::twin::Twin;
 use crate::app::twin_options::TwinOptions;
+use crate::cli::twin_flags::TwinFlags;
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use serde::Deserialize;
 use std::path::PathBuf;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::pipeline::{Answer, PipelineConfig};
@@ -28,10 +33,10 @@ pub struct AskArgs {
     #[arg(long)]
     pub reproducible: bool,
     #[command(flatten)]
-    pub twin: TwinOptions,
+    pub twin: TwinFlags,
     /// Devices: sim (the twin of --scene), hw (the real devices --devices names) or
     /// replay (a recorded --session).
-    #[arg(long, value_enum, default_value = "sim")]
+    #[arg(long, default_value = "sim", value_parser = choice::<Backend>(&Backend::NAMES))]
     pub backend: Backend,
     /// devices.toml for --backend hw: the xArm's address and base, the RealSense's V4L2
     /// nodes, intrinsics and pose, the GelSight Mini's node.
@@ -46,22 +51,93 @@ pub struct AskArgs {
     pub record: Option<PathBuf>,
     /// The sim GelSight's gel modulus (MPa) instead of the stock 0.3: what a softer or
     /// harder gel would see (--backend sim); 0.01 to 50 MPa.
-    #[arg(long, value_parser = crate::app::flag_range::within(0.01, 50.0))]
+    #[arg(long, value_parser = GEL_MODULUS_MPA.parser())]
     pub gel_modulus_mpa: Option<f64>,
     /// The question.
     pub prompt: String,
 }
 
+impl AskArgs {
+    /// The question as the library takes it.
+    pub(crate) fn request(&self) -> AskRequest {
+        AskRequest {
+            prompt: self.prompt.clone(),
+            scene: self.scene.clone(),
+            seed: self.seed,
+            reproducible: self.reproducible,
+            twin: self.twin.options(),
+            backend: self.backend,
+            devices: self.devices.clone(),
+            session: self.session.clone(),
+            record: self.record.clone(),
+            gel_modulus_mpa: self.gel_modulus_mpa,
+        }
+    }
+}
+
+/// One question and how to answer it: `tactex ask`'s flags and Python's `tactex.ask`
+/// keywords map onto it (field for flag, `--gel-modulus-mpa` is `gel_modulus_mpa`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AskRequest {
+    pub prompt: String,
+    /// Scene file (TOML) for the sim backend; None: scenes/demo.toml.
+    #[serde(default)]
+    pub scene: Option<PathBuf>,
+    /// Seed of every random draw (sensor noise).
+    #[serde(default)]
+    pub seed: u64,
+    /// Leave out wall-clock times so that the answer is byte-reproducible.
+    #[serde(default)]
+    pub reproducible: bool,
+    #[serde(default)]
+    pub twin: TwinOptions,
+    #[serde(default, deserialize_with = "parsed")]
+    pub backend: Backend,
+    /// devices.toml for the hw backend.
+    #[serde(default)]
+    pub devices: Option<PathBuf>,
+    /// The recorded session the replay backend runs from.
+    #[serde(default)]
+    pub session: Option<PathBuf>,
+    /// Record every frame and move into a new session directory.
+    #[serde(default)]
+    pub record: Option<PathBuf>,
+    /// The sim GelSight's gel modulus (MPa) instead of the profile's.
+    #[serde(default)]
+    pub gel_modulus_mpa: Option<f64>,
+}
+
 /// Where the devices' data comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Backend {
+    #[default]
     Sim,
     Hw,
     Replay,
 }
 
+impl Backend {
+    pub const NAMES: [&'static str; 3] = ["sim", "hw", "replay"];
+}
+
+impl std::str::FromStr for Backend {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "sim" => Ok(Self::Sim),
+            "hw" => Ok(Self::Hw),
+            "replay" => Ok(Self::Replay),
+            _ => Err(format!("unknown backend {s:?} (sim, hw or replay)")),
+        }
+    }
+}
+
 /// The answer `tactex ask` prints, as a value (the Python package's `ask` returns it).
-pub fn answer(args: &AskArgs) -> Result<Answer> {
+pub fn answer(args: &AskRequest) -> Result<Answer> {
+    if let Some(e) = args.gel_modulus_mpa {
+        GEL_MODULUS_MPA.check(e)?;
+    }
     let catalog = FruitCatalog::builtin();
     // The prompt is checked before any device is opened so that a bad question fails fast
     // (a model may read what the rules refuse: with --parser llm it is read in the pipeline).
@@ -128,8 +204,8 @@ pub fn answer(args: &AskArgs) -> Result<Answer> {
     Ok(answer)
 }
 
-pub fn run(args: &AskArgs) -> Result<()> {
-    let answer = answer(args)?;
+pub(crate) fn run(args: &AskArgs) -> Result<()> {
+    let answer = answer(&args.request())?;
     if args.json {
         println!(
             "{}",

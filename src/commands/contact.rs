@@ -41,7 +41,7 @@ struct ContactReport {
     contact_area_mm2: Option<f64>,
 }
 
-pub fn run(args: &ContactArgs) -> Result<()> {
+pub(crate) fn run(args: &ContactArgs) -> Result<()> {
     let mm_per_px = args.mm_per_px;
     let image = load_tactile_frame(&args.image)?;
     let reference = load_tactile_frame(&args.reference).context("--reference")?;

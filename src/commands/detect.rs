@@ -50,7 +50,7 @@ struct DetectReport {
     detections: Vec<Found>,
 }
 
-pub fn run(args: &DetectArgs) -> Result<()> {
+pub(crate) fn run(args: &DetectArgs) -> Result<()> {
     anyhow::ensure!(
         (0.0..1.0).contains(&args.confidence),
         "--confidence: {} is not in [0, 1)",

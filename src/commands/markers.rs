@@ -208,7 +208,7 @@ struct MarkersReport {
     annotated: Option<AnnotationScore>,
 }
 
-pub fn run(args: &MarkersArgs) -> Result<()> {
+pub(crate) fn run(args: &MarkersArgs) -> Result<()> {
     let image = load_rgb(&args.image)?;
     let found = detect_markers(&image);
     let mut report = MarkersReport {

@@ -18,14 +18,14 @@ pub struct ParseArgs {
     /// Who reads the question: rules (offline) or llm (an OpenAI-compatible endpoint from
     /// TACTEX_LLM_* or --llm-config; a reading that does not check out falls back to the
     /// rules with a notice).
-    #[arg(long, value_enum, default_value = "rules")]
+    #[arg(long, default_value = "rules", value_parser = crate::app::flag_range::choice::<ParserChoice>(&ParserChoice::NAMES))]
     pub parser: ParserChoice,
     /// TOML with base_url, model, api_key_env and timeout_s for --parser llm.
     #[arg(long)]
     pub llm_config: Option<PathBuf>,
 }
 
-pub fn run(args: &ParseArgs) -> Result<()> {
+pub(crate) fn run(args: &ParseArgs) -> Result<()> {
     let catalog = FruitCatalog::builtin();
     if let (Some(path), ParserChoice::Rules) = (&args.llm_config, args.parser) {
         bail!("--llm-config {}: read only by --parser llm", path.display());

@@ -98,12 +98,12 @@ pub struct PressArgs {
 
 impl PressArgs {
     /// The device that renders the frames.
-    pub fn device(&self) -> DeviceChoice {
+    pub(crate) fn device(&self) -> DeviceChoice {
         self.device.unwrap_or(DeviceChoice::Auto)
     }
 
     /// The press as the library takes it: the flags, field for field.
-    pub fn options(&self) -> PressOptions {
+    pub(crate) fn options(&self) -> PressOptions {
         PressOptions {
             shape: self.shape.parse().unwrap_or_default(),
             radius_mm: self.radius_mm,

@@ -7,7 +7,7 @@ use crate::report::indentation_view::indentation_view;
 use crate::report::output::write_png_atomic;
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use tactex_core::tactile::frame_reading::{FrameReading, read_frame};
 use tactex_core::tactile::sensor_profile::ProfileId;
@@ -29,6 +29,35 @@ pub struct ReadArgs {
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+impl ReadArgs {
+    pub(crate) fn request(&self) -> ReadRequest {
+        ReadRequest {
+            image: self.image.clone(),
+            reference: self.reference.clone(),
+            sensor: self.sensor.clone(),
+            out: self.out.clone(),
+        }
+    }
+}
+
+/// One frame to read: `tactex read`'s arguments and Python's `tactex.read` keywords.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReadRequest {
+    /// The tactile frame (PNG of the sensor's size).
+    pub image: PathBuf,
+    /// A no-contact frame of the same sensor; None: the profile's background.
+    #[serde(default)]
+    pub reference: Option<PathBuf>,
+    /// Sensor profile whose optics the frame is read through; None: the built-in Mini.
+    #[serde(default)]
+    pub sensor: Option<PathBuf>,
+    /// Where the frame beside its indentation map will be written (checked here; the
+    /// caller writes it with `write_picture`).
+    #[serde(default)]
+    pub out: Option<PathBuf>,
 }
 
 /// Shallower than this no imprint is reported: the reading of a frame against itself, or of
@@ -61,7 +90,7 @@ pub struct ReadReport {
 }
 
 /// Reads the frame as the estimators do.
-pub fn read(args: &ReadArgs) -> Result<(ReadReport, FrameReading, image::RgbImage)> {
+pub fn read(args: &ReadRequest) -> Result<(ReadReport, FrameReading, image::RgbImage)> {
     if let Some(out) = &args.out {
         crate::report::output::check_png_path(out).context("--out")?;
     }
@@ -153,8 +182,8 @@ pub fn write_picture(
     write_png_atomic(out, &indentation_view(image, reading)).context("--out")
 }
 
-pub fn run(args: &ReadArgs) -> Result<()> {
-    let (report, reading, image) = read(args)?;
+pub(crate) fn run(args: &ReadArgs) -> Result<()> {
+    let (report, reading, image) = read(&args.request())?;
     if let Some(out) = &args.out {
         write_picture(out, &image, &reading)?;
     }

@@ -43,7 +43,7 @@ pub struct CheckArgs {
     pub json: bool,
 }
 
-pub fn run(command: &SensorCommand) -> Result<()> {
+pub(crate) fn run(command: &SensorCommand) -> Result<()> {
     match command {
         SensorCommand::Show(args) => show(args),
         SensorCommand::Check(args) => check(args),

@@ -117,7 +117,7 @@ fn draw_press(args: &BallPressDatagenArgs, index: usize, optics: &SensorOptics) 
     }
 }
 
-pub fn run(args: &BallPressDatagenArgs) -> Result<()> {
+pub(crate) fn run(args: &BallPressDatagenArgs) -> Result<()> {
     let profile = crate::app::load_sensor(args.sensor.as_deref())?;
     let with_markers = SensorOptics::for_profile(&profile);
     let optics = SensorOptics {

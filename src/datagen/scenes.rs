@@ -358,7 +358,7 @@ pub struct SceneDatagenSummary {
     pub labels: usize,
 }
 
-pub fn run(args: &SceneDatagenArgs) -> Result<()> {
+pub(crate) fn run(args: &SceneDatagenArgs) -> Result<()> {
     let summary = generate(args, true)?;
     eprintln!(
         "{}: {} scenes ({} new, {} already there), {} labelled fruits in the new ones; \
@@ -372,7 +372,10 @@ pub fn run(args: &SceneDatagenArgs) -> Result<()> {
     Ok(())
 }
 
-pub fn generate(args: &SceneDatagenArgs, show_progress: bool) -> Result<SceneDatagenSummary> {
+pub(crate) fn generate(
+    args: &SceneDatagenArgs,
+    show_progress: bool,
+) -> Result<SceneDatagenSummary> {
     if args.count == 0 {
         bail!("--count: must be at least 1");
     }

@@ -251,11 +251,11 @@ pub struct DatagenSummary {
     pub mean_search_steps: f64,
 }
 
-pub fn run(args: &TactileDatagenArgs) -> Result<()> {
+pub(crate) fn run(args: &TactileDatagenArgs) -> Result<()> {
     generate(args, true).map(|_| ())
 }
 
-pub fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<DatagenSummary> {
+pub(crate) fn generate(args: &TactileDatagenArgs, show_progress: bool) -> Result<DatagenSummary> {
     let shard = parse_shard(&args.shard)?;
     if args.count == 0 {
         bail!("--count: must be at least 1");

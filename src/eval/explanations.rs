@@ -50,7 +50,7 @@ pub struct ExplanationEvalArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Who writes the answers: template or llm (see `tactex ask --help`).
-    #[arg(long, value_enum, default_value = "template")]
+    #[arg(long, default_value = "template", value_parser = crate::app::flag_range::choice::<ExplainerChoice>(&ExplainerChoice::NAMES))]
     pub explainer: ExplainerChoice,
     #[arg(long)]
     pub llm_config: Option<PathBuf>,
@@ -600,7 +600,7 @@ fn share(scores: &[&CaseScore], f: impl Fn(&CaseScore) -> bool) -> f64 {
     scores.iter().filter(|s| f(s)).count() as f64 / scores.len() as f64
 }
 
-pub fn run(args: &ExplanationEvalArgs) -> Result<()> {
+pub(crate) fn run(args: &ExplanationEvalArgs) -> Result<()> {
     let catalog = FruitCatalog::builtin();
     let explainer: Box<dyn Explainer> = explainer(args.explainer, args.llm_config.as_ref())?;
     let cases = (0..args.prompts)

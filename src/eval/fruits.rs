@@ -537,7 +537,7 @@ fn plots(dir: &std::path::Path, report: &FruitReport, rows: &[FruitRow]) -> Resu
     )
 }
 
-pub fn run(args: &FruitEvalArgs) -> Result<()> {
+pub(crate) fn run(args: &FruitEvalArgs) -> Result<()> {
     ensure!(
         args.placements + args.crowded >= 1,
         "--placements, --crowded: ask for at least one table"

@@ -374,7 +374,7 @@ fn table(report: &Report) -> String {
 const MAX_PER_KIND: usize = 100;
 const MAX_DEPTH_FRAMES: usize = 100;
 
-pub fn run(args: &GroundingEvalArgs) -> Result<()> {
+pub(crate) fn run(args: &GroundingEvalArgs) -> Result<()> {
     anyhow::ensure!(
         (1..=MAX_PER_KIND).contains(&args.per_kind),
         "--per-kind: {}, expected 1..={MAX_PER_KIND}",

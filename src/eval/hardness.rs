@@ -100,7 +100,7 @@ struct PressRecord {
     predictions: Vec<Prediction>,
 }
 
-pub fn run(args: &HardnessEvalArgs) -> Result<()> {
+pub(crate) fn run(args: &HardnessEvalArgs) -> Result<()> {
     let mut space = crate::app::sample_space::sample_space(&args.fidelity, &args.shapes)?;
     if args.sensor.is_some() {
         space = space.around(crate::app::load_sensor(args.sensor.as_deref())?);

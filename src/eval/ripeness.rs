@@ -124,7 +124,7 @@ struct Job {
     press: u32,
 }
 
-pub fn run(args: &RipenessEvalArgs) -> Result<()> {
+pub(crate) fn run(args: &RipenessEvalArgs) -> Result<()> {
     let fidelity: Fidelity = args
         .fidelity
         .parse()

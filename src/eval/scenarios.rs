@@ -520,7 +520,7 @@ fn plots(dir: &std::path::Path, report: &ScenarioReport) -> Result<()> {
     Ok(())
 }
 
-pub fn run(args: &ScenarioEvalArgs) -> Result<()> {
+pub(crate) fn run(args: &ScenarioEvalArgs) -> Result<()> {
     anyhow::ensure!(!args.detector.is_empty(), "--detector: name at least one");
     let tiers: Vec<u8> = if args.tiers.is_empty() {
         vec![1, 2, 3, 4]

@@ -7,7 +7,8 @@ mod queries;
 
 use crate::app::detector_choice::DetectorChoice;
 use crate::app::parser_choice::ParserChoice;
-use crate::app::{OpenedTwin, Twin, TwinOptions};
+use crate::app::{OpenedTwin, Twin};
+use crate::cli::twin_flags::TwinFlags;
 use anyhow::{Context, Result};
 use axum::Router;
 use axum::body::Bytes;
@@ -55,7 +56,7 @@ pub struct ServeArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     #[command(flatten)]
-    pub twin: TwinOptions,
+    pub twin: TwinFlags,
     /// Questions answered at once (1-64); more are refused with HTTP 429 until one finishes.
     #[arg(long, default_value_t = 2)]
     pub max_queries: usize,
@@ -88,7 +89,7 @@ struct Served {
 
 type Shared = Arc<Served>;
 
-pub fn run(args: &ServeArgs) -> Result<()> {
+pub(crate) fn run(args: &ServeArgs) -> Result<()> {
     if !(1..=64).contains(&args.max_queries) {
         anyhow::bail!("--max-queries: {}, expected 1..=64", args.max_queries);
     }
@@ -109,7 +110,7 @@ pub fn run(args: &ServeArgs) -> Result<()> {
         estimator,
         fidelity,
         sensor,
-    } = args.twin.open()?;
+    } = args.twin.options().open()?;
     let mut live = SimDevices::from_scene(&scene, args.seed.wrapping_add(1))?.camera;
     live.set_renderer(renderer.clone());
     let served = Arc::new(Served {

@@ -3,12 +3,13 @@
 //! noise, and writes a sensor profile (TOML + its background PNG beside it).
 
 use crate::app::ball_presses::{self, Split, contact_box, rebuild};
-use crate::app::flag_range::{above, within};
+use crate::app::flag_range::{FieldError, choice, count};
+use crate::app::request_json::parsed;
 use crate::report::output::write_profile_atomic;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbImage;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use tactex_core::stats::median;
 use tactex_core::tactile::ball_calibration::{
@@ -34,10 +35,10 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub background: PathBuf,
     /// The ball's radius (mm, above 0 up to 100).
-    #[arg(long, value_parser = above(0.0, 100.0))]
+    #[arg(long, value_parser = BALL_RADIUS_MM.parser())]
     pub ball_radius_mm: f64,
     /// The frames' scale (mm per pixel, 0.001 to 1).
-    #[arg(long, value_parser = within(tactex_core::tactile::sensor_profile::MIN_MM_PER_PX, 1.0))]
+    #[arg(long, value_parser = MM_PER_PX.parser())]
     pub mm_per_px: f64,
     /// The sensor profile to write (TOML; its background goes beside it as
     /// NAME.background.png).
@@ -48,31 +49,31 @@ pub struct CalibrateArgs {
     #[arg(long, value_parser = profile_name)]
     pub name: Option<String>,
     /// The gel's Young's modulus (MPa, above 0 up to 1000); default the GelSight Mini's.
-    #[arg(long, value_parser = above(0.0, 1000.0))]
+    #[arg(long, value_parser = GEL_MODULUS_MPA.parser())]
     pub gel_modulus_mpa: Option<f64>,
     /// The gel's thickness (mm, 0.5 to 50); default the GelSight Mini's.
-    #[arg(long, value_parser = crate::app::flag_range::within(tactex_core::tactile::sensor_profile::MIN_GEL_THICKNESS_MM, 50.0))]
+    #[arg(long, value_parser = GEL_THICKNESS_MM.parser())]
     pub gel_thickness_mm: Option<f64>,
     /// The gel's Poisson ratio (0 to 0.5); default the GelSight Mini's.
-    #[arg(long, value_parser = within(0.0, 0.5))]
+    #[arg(long, value_parser = GEL_POISSON.parser())]
     pub gel_poisson: Option<f64>,
     /// The camera's frame rate (Hz, above 0 up to 1000); default the GelSight Mini's.
-    #[arg(long, value_parser = above(0.0, 1000.0))]
+    #[arg(long, value_parser = FRAME_RATE_HZ.parser())]
     pub frame_rate_hz: Option<f64>,
     /// Which presses to fit: calib (all but every third), eval, or all.
-    #[arg(long, value_enum, default_value_t = Split::Calib)]
+    #[arg(long, default_value = "calib", value_parser = choice::<Split>(&Split::NAMES))]
     pub split: Split,
     /// Table nodes over slope magnitude; 2 to 100, and at most 768 nodes with --dir-bins.
-    #[arg(long, value_parser = crate::app::flag_range::count::<u32>(2, 100), default_value_t = 12)]
+    #[arg(long, value_parser = count::<u32>(MAG_BINS.0, MAG_BINS.1), default_value_t = DEFAULT_MAG_BINS)]
     pub mag_bins: u32,
     /// Table nodes over slope direction; 4 to 256, and at most 768 nodes with --mag-bins.
-    #[arg(long, value_parser = crate::app::flag_range::count::<u32>(4, 256), default_value_t = 24)]
+    #[arg(long, value_parser = count::<u32>(DIR_BINS.0, DIR_BINS.1), default_value_t = DEFAULT_DIR_BINS)]
     pub dir_bins: u32,
     /// Largest slope (dw/dr) the table covers (above 0 up to 100).
-    #[arg(long, default_value_t = 2.5, value_parser = above(0.0, 100.0))]
+    #[arg(long, default_value_t = DEFAULT_MAG_MAX, value_parser = MAG_MAX.parser())]
     pub mag_max: f64,
     /// Weight tying neighbouring table nodes together (0 to 1e6).
-    #[arg(long, default_value_t = 20.0, value_parser = within(0.0, 1e6))]
+    #[arg(long, default_value_t = DEFAULT_SMOOTHNESS, value_parser = SMOOTHNESS.parser())]
     pub smoothness: f64,
     /// Attribution of the images, stored in the file.
     #[arg(long, default_value = "")]
@@ -221,12 +222,171 @@ fn profile_name(s: &str) -> Result<String, String> {
     Ok(s.to_string())
 }
 
+impl CalibrateArgs {
+    pub(crate) fn request(&self) -> CalibrateRequest {
+        CalibrateRequest {
+            images: self.images.clone(),
+            annotations: self.annotations.clone(),
+            background: self.background.clone(),
+            ball_radius_mm: self.ball_radius_mm,
+            mm_per_px: self.mm_per_px,
+            out: self.out.clone(),
+            name: self.name.clone(),
+            gel_modulus_mpa: self.gel_modulus_mpa,
+            gel_thickness_mm: self.gel_thickness_mm,
+            gel_poisson: self.gel_poisson,
+            frame_rate_hz: self.frame_rate_hz,
+            split: self.split,
+            mag_bins: self.mag_bins,
+            dir_bins: self.dir_bins,
+            mag_max: self.mag_max,
+            smoothness: self.smoothness,
+            source: self.source.clone(),
+            markers: self.markers.clone(),
+            glow: !self.no_glow,
+            fidelity: self.fidelity,
+        }
+    }
+}
+
+/// The numbers a calibration takes and their ranges (`tactex calibrate --help` states them).
+pub mod fields {
+    use crate::app::flag_range::Field;
+    use tactex_core::tactile::sensor_profile::{MIN_GEL_THICKNESS_MM, MIN_MM_PER_PX};
+    pub const BALL_RADIUS_MM: Field = Field::above("ball_radius_mm", 0.0, 100.0);
+    pub const MM_PER_PX: Field = Field::within("mm_per_px", MIN_MM_PER_PX, 1.0);
+    pub const GEL_MODULUS_MPA: Field = Field::above("gel_modulus_mpa", 0.0, 1000.0);
+    pub const GEL_THICKNESS_MM: Field =
+        Field::within("gel_thickness_mm", MIN_GEL_THICKNESS_MM, 50.0);
+    pub const GEL_POISSON: Field = Field::within("gel_poisson", 0.0, 0.5);
+    pub const FRAME_RATE_HZ: Field = Field::above("frame_rate_hz", 0.0, 1000.0);
+    pub const MAG_MAX: Field = Field::above("mag_max", 0.0, 100.0);
+    pub const SMOOTHNESS: Field = Field::within("smoothness", 0.0, 1e6);
+    /// Table nodes over slope magnitude and direction: whole numbers in these ranges.
+    pub const MAG_BINS: (u64, u64) = (2, 100);
+    pub const DIR_BINS: (u64, u64) = (4, 256);
+    pub const DEFAULT_MAG_BINS: u32 = 12;
+    pub const DEFAULT_DIR_BINS: u32 = 24;
+    pub const DEFAULT_MAG_MAX: f64 = 2.5;
+    pub const DEFAULT_SMOOTHNESS: f64 = 20.0;
+}
+use fields::*;
+
+/// A calibration from annotated ball presses: `tactex calibrate`'s flags and Python's
+/// `tactex.calibrate` keywords map onto it (`--no-glow` is `glow: false`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrateRequest {
+    /// Directory of the ball-press images.
+    pub images: PathBuf,
+    /// CSV: image,center_x_px,center_y_px,contact_radius_px.
+    pub annotations: PathBuf,
+    /// The sensor's no-contact frame.
+    pub background: PathBuf,
+    pub ball_radius_mm: f64,
+    pub mm_per_px: f64,
+    /// The sensor profile to write (TOML; its background beside it).
+    pub out: PathBuf,
+    /// The profile's name; None: the output file's stem.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// The gel's modulus, thickness, Poisson ratio and the camera's frame rate; None: the
+    /// GelSight Mini's.
+    #[serde(default)]
+    pub gel_modulus_mpa: Option<f64>,
+    #[serde(default)]
+    pub gel_thickness_mm: Option<f64>,
+    #[serde(default)]
+    pub gel_poisson: Option<f64>,
+    #[serde(default)]
+    pub frame_rate_hz: Option<f64>,
+    #[serde(default = "calib", deserialize_with = "parsed")]
+    pub split: Split,
+    #[serde(default = "mag_bins")]
+    pub mag_bins: u32,
+    #[serde(default = "dir_bins")]
+    pub dir_bins: u32,
+    #[serde(default = "mag_max")]
+    pub mag_max: f64,
+    #[serde(default = "smoothness")]
+    pub smoothness: f64,
+    /// Attribution of the images, stored in the file.
+    #[serde(default)]
+    pub source: String,
+    /// A real frame of the sensor's marker grid.
+    #[serde(default)]
+    pub markers: Option<PathBuf>,
+    /// Fit the glow round a contact (else the table alone).
+    #[serde(default = "yes")]
+    pub glow: bool,
+    /// Contact model that rebuilds the presses the glow is fitted to.
+    #[serde(default, deserialize_with = "parsed")]
+    pub fidelity: Fidelity,
+}
+
+fn calib() -> Split {
+    Split::Calib
+}
+fn mag_bins() -> u32 {
+    DEFAULT_MAG_BINS
+}
+fn dir_bins() -> u32 {
+    DEFAULT_DIR_BINS
+}
+fn mag_max() -> f64 {
+    DEFAULT_MAG_MAX
+}
+fn smoothness() -> f64 {
+    DEFAULT_SMOOTHNESS
+}
+fn yes() -> bool {
+    true
+}
+
+impl CalibrateRequest {
+    /// Every number within the range `calibrate --help` states, however the request was
+    /// built.
+    pub fn check(&self) -> Result<(), FieldError> {
+        BALL_RADIUS_MM.check(self.ball_radius_mm)?;
+        MM_PER_PX.check(self.mm_per_px)?;
+        let optional = [
+            (GEL_MODULUS_MPA, self.gel_modulus_mpa),
+            (GEL_THICKNESS_MM, self.gel_thickness_mm),
+            (GEL_POISSON, self.gel_poisson),
+            (FRAME_RATE_HZ, self.frame_rate_hz),
+        ];
+        for (field, v) in optional {
+            if let Some(v) = v {
+                field.check(v)?;
+            }
+        }
+        MAG_MAX.check(self.mag_max)?;
+        SMOOTHNESS.check(self.smoothness)?;
+        for (name, (lo, hi), v) in [
+            ("mag_bins", MAG_BINS, self.mag_bins),
+            ("dir_bins", DIR_BINS, self.dir_bins),
+        ] {
+            if !(lo..=hi).contains(&u64::from(v)) {
+                return Err(FieldError::new(
+                    name,
+                    format!("{v} is outside [{lo}, {hi}]"),
+                ));
+            }
+        }
+        if let Some(name) = &self.name {
+            profile_name(name).map_err(|e| FieldError::new("name", e))?;
+        }
+        Ok(())
+    }
+}
+
 /// Fits the profile the flags describe and writes it to `--out`.
 /// The most table nodes (--mag-bins x --dir-bins) a fit may have: its normal equations are
 /// dense, so its time grows with the cube of the nodes (12 x 48 took 10 s, 12 x 64 23 s).
 pub const MAX_TABLE_NODES: u32 = 768;
 
-pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
+pub fn calibrate(args: &CalibrateRequest) -> Result<Calibration> {
+    args.check()?;
     let (radius, scale) = (args.ball_radius_mm, args.mm_per_px);
     let nodes = args.mag_bins * args.dir_bins;
     if nodes > MAX_TABLE_NODES {
@@ -388,7 +548,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
             ball_radius_mm: radius,
         }),
     };
-    if !args.no_glow {
+    if args.glow {
         profile.spec.glow = Some(fit_glow(&profile, &presses, radius, args.fidelity)?);
     }
     profile
@@ -409,8 +569,8 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<Calibration> {
     })
 }
 
-pub fn run(args: &CalibrateArgs) -> Result<()> {
-    let fit = calibrate(args)?;
+pub(crate) fn run(args: &CalibrateArgs) -> Result<()> {
+    let fit = calibrate(&args.request())?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&fit)?);
         return Ok(());

@@ -9,6 +9,10 @@
 //! the marked circle.
 
 use crate::app::ball_presses::{self, Split, contact_box, rebuild};
+use crate::app::estimator_choice::EstimatorChoice;
+use crate::app::flag_range::{FieldError, choice, flag};
+use crate::app::press_options::fields::GEL_MODULUS_MPA;
+use crate::app::request_json::parsed;
 use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic};
 use crate::report::side_by_side::side_by_side;
 use crate::sim2real::compare_session::{SessionCompare, SessionComparison, compare_session};
@@ -17,7 +21,7 @@ use crate::sim2real::reading_score::{self, ReadingScore, ReadingSummary, score_r
 use anyhow::{Result, bail};
 use clap::Args;
 use image::RgbImage;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use tactex_core::tactile::ball_calibration::BallPress;
 use tactex_core::tactile::sensor_profile::SensorProfile;
@@ -51,15 +55,15 @@ pub struct CompareArgs {
     /// With --session: the twin's seed (default: the session's).
     #[arg(long, conflicts_with_all = ["images", "annotations"])]
     pub seed: Option<u64>,
-    /// With --session: the twin's gel modulus (MPa) instead of the stock 0.3.
-    #[arg(long, conflicts_with_all = ["images", "annotations"])]
+    /// With --session: the twin's gel modulus (MPa, 0.01 to 50) instead of the stock 0.3.
+    #[arg(long, conflicts_with_all = ["images", "annotations"], value_parser = GEL_MODULUS_MPA.parser())]
     pub gel_modulus_mpa: Option<f64>,
     /// With --session: the hardness estimator that reads both presses (learned,
     /// indentation, hertz or FILE.onnx).
     #[arg(long, conflicts_with_all = ["images", "annotations"], default_value = crate::app::DEFAULT_ESTIMATOR)]
     pub estimator: crate::app::estimator_choice::EstimatorChoice,
     /// Which presses to score: eval (every third, held out of calibration), calib, or all.
-    #[arg(long, value_enum, default_value_t = Split::Eval)]
+    #[arg(long, default_value = "eval", value_parser = choice::<Split>(&Split::NAMES))]
     pub split: Split,
     /// Contact model that rebuilds each press.
     #[arg(long, default_value = "layer")]
@@ -183,6 +187,135 @@ pub enum Comparison {
 }
 
 impl CompareArgs {
+    pub(crate) fn request(&self) -> CompareRequest {
+        CompareRequest {
+            sensor: self.sensor.clone(),
+            images: self.images.clone(),
+            annotations: self.annotations.clone(),
+            session: self.session.clone(),
+            scene: self.scene.clone(),
+            seed: self.seed,
+            gel_modulus_mpa: self.gel_modulus_mpa,
+            estimator: self.estimator.clone(),
+            split: self.split,
+            fidelity: self.fidelity,
+            device: self.device,
+            glow: !self.no_glow,
+            out: self.out.clone(),
+        }
+    }
+}
+
+/// What `compare` scores: annotated real ball presses rebuilt through a calibrated profile,
+/// or a recorded session rebuilt in the twin. `tactex compare`'s flags and Python's
+/// `tactex.compare` keywords map onto it (`--no-glow` is `glow: false`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompareRequest {
+    /// For ball presses, the calibrated profile; with `session`, the twin's sensor.
+    #[serde(default)]
+    pub sensor: Option<PathBuf>,
+    /// Folder of the real ball-press frames.
+    #[serde(default)]
+    pub images: Option<PathBuf>,
+    /// CSV of the annotated contact circles.
+    #[serde(default)]
+    pub annotations: Option<PathBuf>,
+    /// A recorded session (`ask --record`) instead of ball presses.
+    #[serde(default)]
+    pub session: Option<PathBuf>,
+    /// With `session`: the objects as they stood, for a session that carries no scene.
+    #[serde(default)]
+    pub scene: Option<PathBuf>,
+    /// With `session`: the twin's seed (default: the session's).
+    #[serde(default)]
+    pub seed: Option<u64>,
+    /// With `session`: the twin's gel modulus (MPa).
+    #[serde(default)]
+    pub gel_modulus_mpa: Option<f64>,
+    /// With `session`: the estimator that reads both presses.
+    #[serde(default = "default_estimator", deserialize_with = "parsed")]
+    pub estimator: EstimatorChoice,
+    /// Which presses to score.
+    #[serde(default = "held_out", deserialize_with = "parsed")]
+    pub split: Split,
+    #[serde(default, deserialize_with = "parsed")]
+    pub fidelity: Fidelity,
+    #[serde(default, deserialize_with = "parsed")]
+    pub device: DeviceChoice,
+    /// Render with the profile's glow (ball presses).
+    #[serde(default = "yes")]
+    pub glow: bool,
+    /// Write real | rendered | difference images per press here.
+    #[serde(default)]
+    pub out: Option<PathBuf>,
+}
+
+fn default_estimator() -> EstimatorChoice {
+    crate::app::DEFAULT_ESTIMATOR
+        .parse()
+        .expect("the default estimator is registered")
+}
+
+fn held_out() -> Split {
+    Split::Eval
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl CompareRequest {
+    /// The rules the CLI's parser keeps between the flags, for a request built in code.
+    pub fn check(&self) -> Result<(), FieldError> {
+        if let Some(e) = self.gel_modulus_mpa {
+            GEL_MODULUS_MPA.check(e)?;
+        }
+        if self.session.is_some() {
+            let ball_only = [
+                ("images", self.images.is_some()),
+                ("annotations", self.annotations.is_some()),
+                ("glow", !self.glow),
+            ];
+            if let Some((field, _)) = ball_only.iter().find(|(_, given)| *given) {
+                return Err(FieldError::new(
+                    field,
+                    format!("for ball presses; not with {}", flag("session")),
+                ));
+            }
+        } else {
+            let session_only = [
+                ("scene", self.scene.is_some()),
+                ("seed", self.seed.is_some()),
+                ("gel_modulus_mpa", self.gel_modulus_mpa.is_some()),
+            ];
+            if let Some((field, _)) = session_only.iter().find(|(_, given)| *given) {
+                return Err(FieldError::new(
+                    field,
+                    format!("read only with {}", flag("session")),
+                ));
+            }
+            let needed = [
+                ("sensor", self.sensor.is_none()),
+                ("images", self.images.is_none()),
+                ("annotations", self.annotations.is_none()),
+            ];
+            if let Some((field, _)) = needed.iter().find(|(_, missing)| *missing) {
+                return Err(FieldError::new(
+                    field,
+                    format!(
+                        "needed: ball presses take {}, {} and {}, or give {} DIR",
+                        flag("sensor"),
+                        flag("images"),
+                        flag("annotations"),
+                        flag("session")
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     fn session_compare(&self) -> Option<SessionCompare<'_>> {
         let session = self.session.as_deref()?;
         Some(SessionCompare {
@@ -194,24 +327,31 @@ impl CompareArgs {
             fidelity: self.fidelity,
             estimator: &self.estimator,
             out: self.out.as_deref(),
-            json: self.json,
+            json: false,
         })
     }
 }
 
 /// Runs the comparison the flags name, writing `--out` when given.
-pub fn compare(args: &CompareArgs) -> Result<Comparison> {
+pub fn compare(args: &CompareRequest) -> Result<Comparison> {
+    args.check()?;
     match args.session_compare() {
         Some(session) => Ok(Comparison::Session(compare_session(&session)?)),
         None => Ok(Comparison::BallPresses(compare_ball_presses(args)?)),
     }
 }
 
-pub fn run(args: &CompareArgs) -> Result<()> {
-    if let Some(session) = args.session_compare() {
+pub(crate) fn run(args: &CompareArgs) -> Result<()> {
+    let request = args.request();
+    request.check()?;
+    if let Some(session) = request.session_compare() {
+        let session = SessionCompare {
+            json: args.json,
+            ..session
+        };
         return crate::sim2real::compare_session::run(&session);
     }
-    let report = compare_ball_presses(args)?;
+    let report = compare_ball_presses(&request)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
@@ -220,7 +360,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     Ok(())
 }
 
-fn compare_ball_presses(args: &CompareArgs) -> Result<CompareReport> {
+fn compare_ball_presses(args: &CompareRequest) -> Result<CompareReport> {
     let (Some(profile_path), Some(images), Some(annotations)) =
         (&args.sensor, &args.images, &args.annotations)
     else {
@@ -241,7 +381,7 @@ fn compare_ball_presses(args: &CompareArgs) -> Result<CompareReport> {
         markers: Vec::new(),
         ..SensorOptics::for_profile(&profile)
     };
-    if args.no_glow {
+    if !args.glow {
         optics.glow = None;
     }
     let spec = &profile.spec;
@@ -318,7 +458,7 @@ fn compare_ball_presses(args: &CompareArgs) -> Result<CompareReport> {
     }
     let report = CompareReport {
         sensor: profile.id(),
-        split: format!("{:?}", args.split).to_lowercase(),
+        split: args.split.name().into(),
         fidelity: args.fidelity.name().into(),
         glow: optics.glow.is_some(),
         device: renderer.name(),

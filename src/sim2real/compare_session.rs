@@ -516,7 +516,7 @@ pub fn compare_session(args: &SessionCompare) -> Result<SessionComparison> {
     Ok(report)
 }
 
-pub fn run(args: &SessionCompare) -> Result<()> {
+pub(crate) fn run(args: &SessionCompare) -> Result<()> {
     let report = compare_session(args)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

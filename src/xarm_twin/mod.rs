@@ -109,7 +109,7 @@ fn bind(host: IpAddr, port: u16, flag: &str) -> Result<TcpListener> {
     })
 }
 
-pub fn run(args: &TwinArgs) -> Result<()> {
+pub(crate) fn run(args: &TwinArgs) -> Result<()> {
     if !(args.time_scale.is_finite() && (0.01..=1000.0).contains(&args.time_scale)) {
         anyhow::bail!("--time-scale: {}, expected 0.01..=1000", args.time_scale);
     }

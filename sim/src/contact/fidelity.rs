@@ -4,11 +4,13 @@ use std::fmt;
 use std::str::FromStr;
 
 /// How much physics a contact solve models.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// `Default` is the layer model, the one every command takes unless told.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Fidelity {
     Rigid,
     Hertz,
     Halfspace,
+    #[default]
     Layer,
 }
 

@@ -1,0 +1,73 @@
+//! The flags that say how the twin answers (`ask`, `serve`), read into the library's
+//! `TwinOptions`.
+
+use crate::app::estimator_choice::EstimatorChoice;
+use crate::app::explainer_choice::ExplainerChoice;
+use crate::app::flag_range::choice;
+use crate::app::parser_choice::ParserChoice;
+use crate::app::twin_options::{DEFAULT_ESTIMATOR, TwinOptions};
+use clap::Args;
+use std::path::PathBuf;
+use tactex_sim::contact::Fidelity;
+use tactex_sim::render::device::DeviceChoice;
+
+#[derive(Args, Clone, Debug)]
+pub struct TwinFlags {
+    /// Object detector: classical, yolo:FILE.onnx (a YOLOv8-seg export), or a
+    /// perception-error model on the twin's ground truth (error-gsam, error-yolo).
+    #[arg(long, default_value = "classical")]
+    pub detector: String,
+    /// Device that renders the camera's frames: cpu, gpu (any Vulkan adapter, software
+    /// included) or auto (a hardware GPU if there is one). One clean render serves a
+    /// whole question, so the CPU default costs little (see `tactex bench scene`).
+    #[arg(long, default_value = "cpu")]
+    pub device: DeviceChoice,
+    /// Who writes the answer: template (deterministic, offline) or llm (an
+    /// OpenAI-compatible endpoint from TACTEX_LLM_BASE_URL / TACTEX_LLM_MODEL /
+    /// TACTEX_LLM_API_KEY or --llm-config; an ungrounded or failed reply falls back to the
+    /// template with a notice).
+    #[arg(long, default_value = "template", value_parser = choice::<ExplainerChoice>(&ExplainerChoice::NAMES))]
+    pub explainer: ExplainerChoice,
+    /// Who reads the question: rules (offline) or llm (the endpoint --explainer llm uses;
+    /// its reading must check out against the catalog, else the rules read it, with a
+    /// notice).
+    #[arg(long, default_value = "rules", value_parser = choice::<ParserChoice>(&ParserChoice::NAMES))]
+    pub parser: ParserChoice,
+    /// TOML with base_url, model, api_key_env and timeout_s for --explainer llm and
+    /// --parser llm.
+    #[arg(long)]
+    pub llm_config: Option<PathBuf>,
+    /// Contact physics of the sim GelSight: rigid, hertz, halfspace or layer (the bonded
+    /// 4 mm gel, the most faithful; see `tactex bench contact` for what each costs).
+    #[arg(long, default_value = "layer")]
+    pub fidelity: Fidelity,
+    /// Hardness estimator that reads the presses: learned (the built-in model),
+    /// indentation, hertz or FILE.onnx (a model with its card FILE.json beside it).
+    #[arg(long, default_value = DEFAULT_ESTIMATOR)]
+    pub estimator: EstimatorChoice,
+    /// Interval calibration (JSON from `tactex eval fruits --calibrate`) the estimates' 68%
+    /// and 95% intervals come from; unset: the one shipped for the estimator at --fidelity.
+    #[arg(long)]
+    pub intervals: Option<PathBuf>,
+    /// Sensor profile (TOML: `tactex calibrate` writes one, `tactex sensor show --toml`
+    /// prints the built-in one) the sim GelSight renders with; default the built-in GelSight
+    /// Mini.
+    #[arg(long)]
+    pub sensor: Option<PathBuf>,
+}
+
+impl TwinFlags {
+    pub(crate) fn options(&self) -> TwinOptions {
+        TwinOptions {
+            detector: self.detector.clone(),
+            device: self.device,
+            explainer: self.explainer,
+            parser: self.parser,
+            llm_config: self.llm_config.clone(),
+            fidelity: self.fidelity,
+            estimator: self.estimator.clone(),
+            intervals: self.intervals.clone(),
+            sensor: self.sensor.clone(),
+        }
+    }
+}
