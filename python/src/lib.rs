@@ -20,8 +20,9 @@ use std::sync::{Arc, Mutex};
 use tactex::app::error_kind::ErrorKind;
 use tactex::app::flag_range::FieldError;
 use tactex::app::press_options::PressOptions;
+use tactex::app::press_steps::PressSteps;
 use tactex::app::request_json::from_json;
-use tactex::app::single_press::PressShape;
+use tactex::app::single_press::{PressPose, PressReport, PressShape};
 use tactex::app::tactile_samples::{TactileSample, TactileSampleSource};
 use tactex::cli::error_line;
 use tactex::commands::ask::AskRequest;
@@ -29,8 +30,8 @@ use tactex::commands::read::ReadRequest;
 use tactex::sim2real::calibrate::CalibrateRequest;
 use tactex::sim2real::compare::CompareRequest;
 use tactex_core::tactile::sensor_profile::SensorProfile;
-use tactex_sim::contact::ContactSolver;
 use tactex_sim::contact::HeightMap;
+use tactex_sim::contact::{ContactSolution, ContactSolver, GelFields};
 use tactex_sim::mesh::TriMesh;
 use tactex_sim::render::gel::{DeviceChoice, open_renderer};
 
@@ -302,6 +303,81 @@ fn press_options(options: PressKeywords, geometry: Option<Geometry<'_>>) -> PyRe
     options.options(object)
 }
 
+/// A press's results, ready for numpy: the report (JSON text), the frame (and the
+/// no-contact frame where the call draws one), the gel's fields over the pad and the
+/// pressure over the solver grid (float32, rows x columns) with their grids, and the
+/// library's own time for it.
+struct PressArrays {
+    report: String,
+    frame: Array3<u8>,
+    reference: Option<Array3<u8>>,
+    fields: [(&'static str, Array2<f32>); 3],
+    pressure: Array2<f32>,
+    grids: [(f64, [f64; 2]); 2],
+    library_s: f64,
+}
+
+impl PressArrays {
+    fn new(
+        report: &PressReport,
+        fields: &GelFields,
+        solution: &ContactSolution,
+        frame: image::RgbImage,
+        reference: Option<image::RgbImage>,
+        library_s: f64,
+    ) -> anyhow::Result<Self> {
+        let g = &fields.grid;
+        let s = &solution.grid;
+        Ok(Self {
+            report: serde_json::to_string(report).context("serialising the report")?,
+            frame: frame_array(frame),
+            reference: reference.map(frame_array),
+            fields: [
+                ("gel_normal_mm", field_array(&fields.normal_mm, g.nx, g.ny)),
+                (
+                    "gel_lateral_x_mm",
+                    field_array(&fields.lateral_x_mm, g.nx, g.ny),
+                ),
+                (
+                    "gel_lateral_y_mm",
+                    field_array(&fields.lateral_y_mm, g.nx, g.ny),
+                ),
+            ],
+            pressure: field_array(&solution.pressure_mpa, s.nx, s.ny),
+            grids: [
+                (g.cell_mm, [g.origin_mm.x, g.origin_mm.y]),
+                (s.cell_mm, [s.origin_mm.x, s.origin_mm.y]),
+            ],
+            library_s,
+        })
+    }
+
+    fn into_dict(self, py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+        let out = PyDict::new(py);
+        out.set_item("report", self.report)?;
+        out.set_item("library_s", self.library_s)?;
+        out.set_item("frame", self.frame.into_pyarray(py))?;
+        if let Some(reference) = self.reference {
+            out.set_item("reference", reference.into_pyarray(py))?;
+        }
+        let fields = PyDict::new(py);
+        for (name, array) in self.fields {
+            fields.set_item(name, array.into_pyarray(py))?;
+        }
+        fields.set_item("pressure_mpa", self.pressure.into_pyarray(py))?;
+        out.set_item("fields", fields)?;
+        out.set_item("field_grid", self.grids[0])?;
+        out.set_item("pressure_grid", self.grids[1])?;
+        Ok(out)
+    }
+}
+
+fn device_choice(device: &str) -> PyResult<DeviceChoice> {
+    device
+        .parse()
+        .map_err(|e: String| PyValueError::new_err(format!("device: {e}")))
+}
+
 /// One press through `profile`: `options` are `Sensor.press`'s keywords, `geometry` the
 /// caller's own object if any, `device` the renderer (auto, gpu, cpu). Returns the report
 /// (JSON text), the pressed frame and the no-contact frame (H x W x 3 uint8), and the gel's
@@ -316,12 +392,10 @@ fn press<'py>(
     device: &str,
     geometry: Option<Geometry<'py>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let device: DeviceChoice = device
-        .parse()
-        .map_err(|e: String| PyValueError::new_err(format!("device: {e}")))?;
+    let device = device_choice(device)?;
     let options = press_options(options, geometry)?;
     let sensor = profile.sensor.clone();
-    let solved = off_the_gil(py, || -> anyhow::Result<_> {
+    let solved = off_the_gil(py, || -> anyhow::Result<PressArrays> {
         // The library's own time for the press (the request checked, solved and rendered),
         // against which the binding's cost is measured (python/bench/press_overhead.py).
         let started = std::time::Instant::now();
@@ -331,50 +405,90 @@ fn press<'py>(
         let fields = press.pad_fields();
         let (frame, reference) = press.render(&request, renderer.as_mut())?;
         let library_s = started.elapsed().as_secs_f64();
-        let report = serde_json::to_string(&press.report).context("serialising the report")?;
-        let g = &fields.grid;
-        let arrays = [
-            ("gel_normal_mm", field_array(&fields.normal_mm, g.nx, g.ny)),
-            (
-                "gel_lateral_x_mm",
-                field_array(&fields.lateral_x_mm, g.nx, g.ny),
-            ),
-            (
-                "gel_lateral_y_mm",
-                field_array(&fields.lateral_y_mm, g.nx, g.ny),
-            ),
-        ];
-        let s = &press.solution;
-        let pressure = field_array(&s.pressure_mpa, s.grid.nx, s.grid.ny);
-        let grids = [
-            (g.cell_mm, [g.origin_mm.x, g.origin_mm.y]),
-            (s.grid.cell_mm, [s.grid.origin_mm.x, s.grid.origin_mm.y]),
-        ];
-        Ok((
-            report,
-            frame_array(frame),
-            frame_array(reference),
-            arrays,
-            pressure,
-            grids,
+        PressArrays::new(
+            &press.report,
+            &fields,
+            &press.solution,
+            frame,
+            Some(reference),
             library_s,
-        ))
+        )
     });
-    let (report, frame, reference, arrays, pressure, grids, library_s) = solved?;
-    let out = PyDict::new(py);
-    out.set_item("report", report)?;
-    out.set_item("library_s", library_s)?;
-    out.set_item("frame", frame.into_pyarray(py))?;
-    out.set_item("reference", reference.into_pyarray(py))?;
-    let fields = PyDict::new(py);
-    for (name, array) in arrays {
-        fields.set_item(name, array.into_pyarray(py))?;
+    solved?.into_dict(py)
+}
+
+/// One object pressed step by step along a path the caller drives (`Sensor.contact`): the
+/// object read once, the solver's kernels and the optics kept between steps.
+#[pyclass(frozen, module = "tactex._tactex")]
+struct Steps {
+    steps: Mutex<PressSteps>,
+    reference: Array3<u8>,
+}
+
+#[pymethods]
+impl Steps {
+    /// The no-contact frame (H x W x 3 uint8) the steps are read against.
+    #[getter]
+    fn reference<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray3<u8>> {
+        numpy::PyArray3::from_array(py, &self.reference)
     }
-    fields.set_item("pressure_mpa", pressure.into_pyarray(py))?;
-    out.set_item("fields", fields)?;
-    out.set_item("field_grid", (grids[0].0, grids[0].1))?;
-    out.set_item("pressure_grid", (grids[1].0, grids[1].1))?;
-    Ok(out)
+
+    /// The object at (x_mm, y_mm, yaw_deg) on the pad, the sensor `depth_mm` past first
+    /// touch: a press's arrays and report, as `press` returns them, without the reference.
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        x_mm: f64,
+        y_mm: f64,
+        yaw_deg: f64,
+        depth_mm: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let done = off_the_gil(py, || -> anyhow::Result<PressArrays> {
+            let started = std::time::Instant::now();
+            let mut steps = self.steps.lock().unwrap_or_else(|p| p.into_inner());
+            let pose = PressPose {
+                at_mm: [x_mm, y_mm],
+                yaw_deg,
+            };
+            let step = steps.step(pose, depth_mm)?;
+            let library_s = started.elapsed().as_secs_f64();
+            PressArrays::new(
+                &step.report,
+                &step.fields,
+                &step.solution,
+                step.frame,
+                None,
+                library_s,
+            )
+        });
+        done?.into_dict(py)
+    }
+}
+
+/// The object `options` and `geometry` describe through `profile`, ready to be pressed step
+/// by step (`options`' pose and depth are the first step's default; each step gives its own).
+#[pyfunction]
+#[pyo3(signature = (profile, options, device, geometry=None))]
+fn contact<'py>(
+    py: Python<'py>,
+    profile: PyRef<'py, Profile>,
+    options: PressKeywords,
+    device: &str,
+    geometry: Option<Geometry<'py>>,
+) -> PyResult<Steps> {
+    let device = device_choice(device)?;
+    let options = press_options(options, geometry)?;
+    let sensor = profile.sensor.clone();
+    off_the_gil(py, || -> anyhow::Result<Steps> {
+        let request = options.request(sensor)?;
+        let renderer = open_renderer(device)?.renderer;
+        let steps = PressSteps::new(request, renderer)?;
+        let reference = frame_array(steps.reference().clone());
+        Ok(Steps {
+            steps: Mutex::new(steps),
+            reference,
+        })
+    })
 }
 
 /// The paper's press protocol on one object through `profile` (`options`: `Sensor.press`'s
@@ -535,6 +649,8 @@ fn _tactex(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_class::<Profile>()?;
+    m.add_class::<Steps>()?;
+    m.add_function(wrap_pyfunction!(contact, m)?)?;
     m.add_function(wrap_pyfunction!(threads, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -45,6 +45,7 @@ __all__ = [
     "MissingFile",
     "Failure",
     "Sensor",
+    "Contact",
     "Press",
     "PressSequence",
     "Sample",
@@ -496,6 +497,71 @@ class Sensor:
             device=device,
         )
 
+    def contact(
+        self,
+        shape: str = "sphere",
+        *,
+        radius_mm: Optional[float] = None,
+        size_mm: Optional[Sequence[float]] = None,
+        mesh: Any = None,
+        mesh_scale: Optional[float] = None,
+        height_map_mm: Any = None,
+        mm_per_px: Optional[float] = None,
+        hardness: Optional[str] = None,
+        modulus_mpa: Optional[float] = None,
+        object_poisson: Optional[float] = None,
+        fidelity: str = "layer",
+        grid_mm: Optional[float] = None,
+        tolerance: Optional[float] = None,
+        gel_modulus_mpa: Optional[float] = None,
+        gel_thickness_mm: Optional[float] = None,
+        marker_grid: Optional[str] = None,
+        marker_pitch_mm: Optional[float] = None,
+        seed: int = 0,
+        device: str = "cpu",
+    ) -> "Contact":
+        """One object under the pad, to be pressed step by step along a path you drive (your
+        simulator's steps, a policy's actions): ``Contact.step(depth_mm, pose)`` returns each
+        step's :class:`Press`. The object is given as for :meth:`press` (a named shape, a
+        mesh file, ``(vertices, faces)``, a trimesh) or as a height map as for
+        :meth:`render`; it is read once, and the contact solver's kernels and the sensor's
+        optics are kept between steps. Each step is the press of its pose and depth, drawn
+        with its own camera noise (``seed`` + 2 + the step's number; the no-contact
+        ``Contact.reference`` has ``seed`` + 1)."""
+        if height_map_mm is not None:
+            if mesh is not None:
+                raise InvalidArgument("height_map_mm: give a mesh or a height map, not both")
+            geometry = _geometry(
+                height_map_mm=height_map_mm,
+                mm_per_px=self.mm_per_px if mm_per_px is None else mm_per_px,
+            )
+        else:
+            if mesh is not None and shape == "sphere":
+                shape = "mesh"
+            geometry = _geometry(mesh, mesh_scale)
+        keywords = _press_keywords(
+            "sphere" if geometry is not None else shape,
+            0.0,
+            None,
+            radius_mm=radius_mm,
+            size_mm=size_mm,
+            mesh=None if geometry is not None else mesh,
+            mesh_scale=mesh_scale,
+            hardness=hardness,
+            modulus_mpa=modulus_mpa,
+            object_poisson=object_poisson,
+            fidelity=fidelity,
+            grid_mm=grid_mm,
+            tolerance=tolerance,
+            gel_modulus_mpa=gel_modulus_mpa,
+            gel_thickness_mm=gel_thickness_mm,
+            marker_grid=marker_grid,
+            marker_pitch_mm=marker_pitch_mm,
+            seed=seed,
+        )
+        native = _tactex.contact(self._native, keywords, _text("device", device), geometry)
+        return Contact(native)
+
     def _press(
         self,
         shape: str,
@@ -513,6 +579,39 @@ class Sensor:
         return Press(
             frame=out["frame"],
             reference=out["reference"],
+            fields=dict(out["fields"]),
+            field_grid=_grid(out["field_grid"]),
+            pressure_grid=_grid(out["pressure_grid"]),
+            report=json.loads(out["report"]),
+            library_s=float(out["library_s"]),
+        )
+
+
+class Contact:
+    """One object under the pad, pressed step by step (:meth:`Sensor.contact`)."""
+
+    def __init__(self, native: Any) -> None:
+        self._native = native
+        #: The no-contact frame (H, W, 3) uint8 every step is read against.
+        self.reference: np.ndarray = native.reference
+
+    def step(self, depth_mm: float, pose: Optional[Tuple[float, float, float]] = None) -> Press:
+        """The object at ``pose`` ``(x_mm, y_mm, yaw_deg)`` on the pad (default the centre,
+        unturned), the sensor ``depth_mm`` past first touch: the same :class:`Press` as
+        :meth:`Sensor.press` of that pose and depth gives, with this step's noise."""
+        depth = _number("depth_mm", depth_mm)
+        if depth is None:
+            raise InvalidArgument("depth_mm: give the sensor's travel past first touch in mm")
+        x = y = yaw = 0.0
+        if pose is not None:
+            try:
+                x, y, yaw = (float(v) for v in pose)
+            except (TypeError, ValueError):
+                raise InvalidArgument(f"pose: give (x_mm, y_mm, yaw_deg), got {pose!r}") from None
+        out = translated(self._native.step)(x, y, yaw, depth)
+        return Press(
+            frame=out["frame"],
+            reference=self.reference,
             fields=dict(out["fields"]),
             field_grid=_grid(out["field_grid"]),
             pressure_grid=_grid(out["pressure_grid"]),

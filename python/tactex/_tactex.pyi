@@ -39,6 +39,22 @@ def press(
     mesh_scale, height_map_mm, mm_per_px) the caller's own object. Returns report (JSON
     text), library_s, frame, reference, fields, field_grid, pressure_grid."""
 
+class Steps:
+    """One object pressed step by step (``contact``)."""
+
+    @property
+    def reference(self) -> np.ndarray: ...
+    def step(self, x_mm: float, y_mm: float, yaw_deg: float, depth_mm: float) -> Dict[str, Any]:
+        """One step's press, as ``press`` returns it without the reference."""
+
+def contact(
+    profile: Profile,
+    options: Dict[str, Any],
+    device: str,
+    geometry: Optional[Dict[str, Any]] = None,
+) -> Steps:
+    """The object ``options`` and ``geometry`` describe, ready to be pressed step by step."""
+
 def press_sequence(
     profile: Profile,
     options: Dict[str, Any],

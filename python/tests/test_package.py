@@ -105,6 +105,36 @@ def test_a_mesh_given_as_arrays_presses_as_the_same_mesh_from_its_file():
     assert sequence.frames.shape == (8, 240, 320, 3)
 
 
+def test_a_contact_stepped_along_a_path_gives_each_steps_press():
+    """The object a simulator moves under the pad, pressed step by step: each step is the
+    press of its pose and depth (same figures, same frame bytes given the step's seed), a
+    mesh as a height map alike, and a pose off the pad is refused naming pose."""
+    sensor = tactex.Sensor()
+    path = [(0.4, None), (0.8, (2.0, -1.0, 30.0)), (0.4, None)]
+    contact = sensor.contact(radius_mm=6, hardness="40A", fidelity="halfspace", seed=3)
+    frames = []
+    for k, (depth, pose) in enumerate(path):
+        step = contact.step(depth, pose)
+        alone = sensor.press(radius_mm=6, hardness="40A", fidelity="halfspace", depth_mm=depth,
+                             pose=pose, seed=3 + 2 + k)
+        assert step.force_n == alone.force_n
+        assert np.array_equal(step.frame, alone.frame), k
+        assert np.array_equal(step.fields["pressure_mpa"], alone.fields["pressure_mpa"])
+        assert step.reference is contact.reference
+        frames.append(step.frame)
+    assert not np.array_equal(frames[0], frames[2]), "each step draws its own noise"
+    w, h = sensor.size
+    ys, xs = np.mgrid[0:h, 0:w]
+    r2 = ((xs + 0.5 - w / 2) ** 2 + (ys + 0.5 - h / 2) ** 2) * sensor.mm_per_px**2
+    cap = np.where(r2 <= 36.0, np.sqrt(np.maximum(36.0 - r2, 0.0)), np.nan)
+    mapped = sensor.contact(height_map_mm=cap, hardness="40A", fidelity="rigid").step(0.5)
+    assert mapped.report["shape"] == "height map" and mapped.force_n > 0
+    with pytest.raises(tactex.InvalidArgument, match="pose"):
+        contact.step(0.5, (40.0, 0.0, 0.0))
+    with pytest.raises(tactex.InvalidArgument, match="depth_mm"):
+        contact.step(float("nan"))
+
+
 def test_a_press_imprint_stands_where_the_pose_puts_the_object():
     for x, y in [(0.0, 0.0), (3.0, -2.0), (-6.5, 4.0)]:
         press = tactex.Sensor().press("sphere", radius_mm=4, modulus_mpa=1.0, depth_mm=0.4, pose=(x, y, 0))

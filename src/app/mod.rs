@@ -15,6 +15,7 @@ pub mod image_input;
 pub mod llm_chat;
 pub mod parser_choice;
 pub mod press_options;
+pub mod press_steps;
 pub mod question;
 pub mod replay;
 pub mod request_json;

@@ -196,7 +196,7 @@ impl PressOptions {
             Arc::make_mut(&mut sensor).spec.gel.modulus_mpa = e;
         }
         let pose = PressPose {
-            at_mm: self.at_on_pad(sensor.spec.pad_size_mm())?,
+            at_mm: self.at_mm()?,
             yaw_deg: self.yaw_deg,
         };
         let request = PressRequest {
@@ -315,8 +315,8 @@ impl PressOptions {
         }
     }
 
-    /// `at_mm`, checked to lie on the pad (a contact may still be cut by its edge).
-    fn at_on_pad(&self, pad_mm: [f64; 2]) -> Result<[f64; 2], FieldError> {
+    /// `at_mm` as X, Y.
+    fn at_mm(&self) -> Result<[f64; 2], FieldError> {
         let Some(at) = &self.at_mm else {
             return Ok([0.0, 0.0]);
         };
@@ -324,13 +324,7 @@ impl PressOptions {
         let [x, y] = at[..] else {
             return bad(format!("give X,Y in mm, got {} values", at.len()));
         };
-        let (x, y) = (fields::AT_MM.check(x)?, fields::AT_MM.check(y)?);
-        let [hw, hh] = pad_mm.map(|s| s / 2.0);
-        if x.abs() > hw || y.abs() > hh {
-            return bad(format!(
-                "({x}, {y}) mm is off the pad, which spans X -{hw:.2}..{hw:.2} and Y -{hh:.2}..{hh:.2} mm"
-            ));
-        }
+        // Its range and whether it lies on the pad: `PressRequest::check`.
         Ok([x, y])
     }
 }

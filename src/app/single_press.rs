@@ -13,6 +13,7 @@ use tactex_core::hardness::scale::{Hardness, HardnessReport};
 use tactex_core::hertz::Elastic;
 use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::sensor_profile::{ProfileId, SensorProfile};
+use tactex_core::tactile::spec::GelSpec;
 use tactex_sim::contact::{
     ContactError, ContactProblem, ContactSolution, ContactSolver, Fidelity, GelFields, Grid,
     HeightMap, ObjectSurface, Rect, field_pooling, mesh_top,
@@ -260,6 +261,17 @@ impl PressRequest {
         for v in self.pose.at_mm {
             AT_MM.check(v)?;
         }
+        // On the pad (a contact may still be cut by its edge).
+        let [x, y] = self.pose.at_mm;
+        let [hw, hh] = self.sensor.spec.pad_size_mm().map(|s| s / 2.0);
+        if x.abs() > hw || y.abs() > hh {
+            return Err(FieldError::new(
+                "at_mm",
+                format!(
+                    "({x}, {y}) mm is off the pad, which spans X -{hw:.2}..{hw:.2} and Y -{hh:.2}..{hh:.2} mm"
+                ),
+            ));
+        }
         YAW_DEG.check(self.pose.yaw_deg)?;
         if let Hardness::ModulusMpa(e) = self.hardness {
             MODULUS_MPA.check(e)?;
@@ -278,6 +290,12 @@ impl PressRequest {
 
     /// Solves the contact and reports its figures.
     pub fn solve(&self) -> Result<SolvedPress> {
+        self.solve_with(ContactSolver::new())
+    }
+
+    /// As `solve`, with `solver`, whose kernels (one set per grid) carry over from the
+    /// presses it solved before: a caller pressing step after step hands it back each time.
+    pub fn solve_with(&self, mut solver: ContactSolver) -> Result<SolvedPress> {
         self.check()?;
         let surface = self.shape.surface(self.pose)?;
         let gel = self.sensor.spec.gel;
@@ -293,7 +311,6 @@ impl PressRequest {
             approach_mm: self.depth_mm,
             cell_mm: self.cell_mm,
         };
-        let mut solver = ContactSolver::new();
         solver.settings.tolerance = self.tolerance;
         let solution = solver.solve(&problem, self.fidelity)?;
         // The gel's fields are drawn over the pad at the solver's cell; a contact far smaller
@@ -393,12 +410,7 @@ impl SolvedPress {
         renderer: &mut dyn GelRenderer,
     ) -> Result<(RgbImage, RgbImage)> {
         let optics = SensorOptics::for_profile(&request.sensor);
-        let fields = image_fields(
-            &mut self.solver,
-            &self.solution,
-            &request.sensor.spec.gel,
-            &optics,
-        );
+        let fields = self.image_fields(&request.sensor.spec.gel, &optics);
         let flat = GelImageFields::flat(optics.width, optics.height);
         let mut frames = renderer.render_batch(
             &optics,
@@ -416,6 +428,11 @@ impl SolvedPress {
         let reference = frames.pop().context("the renderer returned no frames")?;
         let frame = frames.pop().context("the renderer returned one frame")?;
         Ok((frame, reference))
+    }
+
+    /// What the frame is drawn from: the gel's fields at the frame's pixels.
+    pub fn image_fields(&mut self, gel: &GelSpec, optics: &SensorOptics) -> GelImageFields {
+        image_fields(&mut self.solver, &self.solution, gel, optics)
     }
 
     /// The gel's displacement over the whole pad, at the solver's cell unless that would

@@ -21,7 +21,7 @@ use crate::report::npz::{NpyArray, npz_bytes};
 use crate::report::output::write_bytes_atomic;
 use crate::report::output::write_json_atomic;
 use anyhow::{Context, Result, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -36,11 +36,26 @@ use tactex_sim::render::gel::{DeviceChoice, GelRenderer, open_renderer};
 const FORMAT: &str = "tactex-tactile-dataset/1";
 /// Redraws of a sample whose press found no contact before the run gives up on it.
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SampleFormat {
     Png,
     Npz,
+}
+
+impl SampleFormat {
+    pub const NAMES: [&'static str; 2] = ["png", "npz"];
+}
+
+impl std::str::FromStr for SampleFormat {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "png" => Ok(Self::Png),
+            "npz" => Ok(Self::Npz),
+            _ => Err(format!("unknown format {s:?} (png or npz)")),
+        }
+    }
 }
 
 #[derive(Args, Debug)]
@@ -56,7 +71,7 @@ pub struct TactileDatagenArgs {
     /// This job's part of the data set, I/N with I in 0..N: samples i with i mod N = I.
     #[arg(long, default_value = "0/1")]
     pub(crate) shard: String,
-    #[arg(long, value_enum, default_value = "png")]
+    #[arg(long, default_value = "png", value_parser = crate::app::flag_range::choice::<SampleFormat>(&SampleFormat::NAMES))]
     pub(crate) format: SampleFormat,
     /// Contact model: rigid, hertz, halfspace or layer.
     #[arg(long, default_value = "layer")]
