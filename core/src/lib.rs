@@ -16,6 +16,7 @@
 pub mod catalog;
 pub mod devices;
 pub mod dir_claim;
+pub mod dummy;
 pub mod explain;
 pub mod file_failure;
 pub mod frames;

@@ -10,3 +10,7 @@ pub mod grounding;
 pub mod height_split;
 pub mod mask;
 pub mod neck_split;
+
+// The stage's face: its trait and what it hands on.
+pub use detect::{ClassicalDetector, DetectError, Detection, Detector, RgbdView};
+pub use grounding::{Located, locate};

@@ -11,3 +11,11 @@ pub mod indentation_estimator;
 pub mod interval_calibration;
 pub mod layer_compliance;
 pub mod scale;
+
+// The stage's face: its trait, what it reads and hands on, and the estimators core holds.
+pub use estimate::{
+    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, HertzSlopeEstimator,
+    ModulusInterval, PressSequence,
+};
+pub use indentation_estimator::IndentationEstimator;
+pub use scale::Hardness;

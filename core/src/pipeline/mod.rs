@@ -2,13 +2,11 @@
 //! hardness -> explain. Every stage reports its wall time and the robot's (simulated) time.
 //! `targets` is the ground stage on the camera, `arm_press` the press stage on the arm and
 //! the sensor; `answer` and `config` are what goes out and in. The unit tests run it on
-//! `fake_devices`.
+//! the public dummy devices (`crate::dummy`).
 
 mod answer;
 mod arm_press;
 mod config;
-#[cfg(test)]
-mod fake_devices;
 mod targets;
 #[cfg(test)]
 mod tests;

@@ -1,10 +1,8 @@
-//! The pipeline on the fake devices (fake_devices.rs).
+//! The pipeline on the dummy devices (crate::dummy).
 
-use super::fake_devices::*;
 use super::*;
+use crate::dummy::{DummyWorld, FixedEstimator, TOP_M};
 use crate::tactile::spec::TactileSpec;
-use std::cell::Cell;
-use std::rc::Rc;
 
 fn ask(centre: (f64, f64), shows: bool, refuse_below_m: f64) -> Answer {
     ask_on(centre, None, shows, refuse_below_m)
@@ -16,7 +14,14 @@ fn ask_on(
     shows: bool,
     refuse_below_m: f64,
 ) -> Answer {
-    ask_with(centre, object_m, shows, refuse_below_m, &TwoMpa).expect("the question is answered")
+    ask_with(
+        centre,
+        object_m,
+        shows,
+        refuse_below_m,
+        &FixedEstimator::new(2.0),
+    )
+    .expect("the question is answered")
 }
 
 fn ask_with(
@@ -26,31 +31,20 @@ fn ask_with(
     refuse_below_m: f64,
     estimator: &dyn HardnessEstimator,
 ) -> Result<Answer, PipelineError> {
-    let z = Rc::new(Cell::new(0.3));
-    let xy = Rc::new(Cell::new((0.0, 0.0)));
-    let mut gel = Gel {
-        z: z.clone(),
-        xy: xy.clone(),
-        first_xy: Cell::new(None),
-        centre,
-        object_m,
-        shows,
-        spec: TactileSpec::gelsight_mini(),
-    };
-    let mut arm = FakeArm {
-        z,
-        xy,
-        refuse_below_m,
-    };
+    let mut world = DummyWorld::apple();
+    world.tactile.centre = centre;
+    world.tactile.object_m = object_m;
+    world.tactile.shows = shows;
+    world.arm.refuse_below_m = refuse_below_m;
     answer(
         "How hard is the apple?",
         &FruitCatalog::builtin(),
         Devices {
-            camera: &mut Camera,
-            tactile: &mut gel,
-            arm: &mut arm,
+            camera: &mut world.camera,
+            tactile: &mut world.tactile,
+            arm: &mut world.arm,
         },
-        &OneApple,
+        &world.detector,
         estimator,
         Language::OFFLINE,
         &PipelineConfig::default(),

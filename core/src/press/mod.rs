@@ -4,3 +4,7 @@
 
 pub mod protocol;
 pub mod site;
+
+// The stage's face: the probe a backend implements, the protocol, and where to press.
+pub use protocol::{PressError, PressOutcome, PressProbe, PressProtocol, Pressed, run_press};
+pub use site::{PressSite, press_site};

@@ -8,6 +8,9 @@ pub mod reader;
 pub mod spelling;
 pub mod threshold;
 
+// The stage's face beside `Query` and `parse`: the reader trait a model may stand behind.
+pub use reader::{PromptReader, ReadPrompt, RuleReader};
+
 use crate::catalog::FruitCatalog;
 use lexicon::Degree;
 use serde::{Deserialize, Serialize};

@@ -23,3 +23,8 @@ pub mod shading_table;
 pub mod slopes;
 pub mod spec;
 pub mod ssim;
+
+// The stage's face: what a sensor is and what a frame reads as.
+pub use frame_reading::{FrameReading, read_frame};
+pub use sensor_profile::{ProfileError, ProfileId, SensorProfile, Shading};
+pub use spec::{GelSpec, MarkerGrid, TactileSpec};

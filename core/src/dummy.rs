@@ -1,17 +1,24 @@
-//! Fake devices for the pipeline's unit tests: one apple under a downward camera, a gel
-//! that shows a disc once the pad is below the apple's top, an arm that may refuse to go
-//! low, and an estimator that always reads 2 MPa.
+//! Dummy devices to test code against without hardware or the twin, as openrr's `arci`
+//! ships them: one apple under a downward RGB-D camera, a detector that finds it, a gel that
+//! shows a disc once the pad is below the apple's top, an arm that moves where it is told
+//! (refusing below a limit), and an estimator that reads a fixed modulus. They are the least
+//! a backend must do (the `devices` traits), and the pipeline's own tests run on them:
+//!
+//! ```text
+//! let mut world = DummyWorld::apple();
+//! let devices = Devices { camera: &mut world.camera, tactile: &mut world.tactile, arm: &mut world.arm };
+//! pipeline::answer(prompt, &catalog, devices, &world.detector, &FixedEstimator::new(2.0), ...)
+//! ```
 
-use super::*;
-use crate::devices::DeviceError;
+use crate::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
 use crate::frames::TactileFrame;
 use crate::frames::{DepthImage, RgbdFrame};
 use crate::geometry::CameraIntrinsics;
 use crate::geometry::Pose;
-use crate::ground::detect::Detection;
-use crate::ground::detect::{DetectError, RgbdView};
+use crate::ground::detect::{DetectError, Detection, Detector, RgbdView};
 use crate::hardness::estimate::{
-    EstimateError, Evidence, HardnessEstimate, ModulusInterval, PhysicsEvidence,
+    EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval, PhysicsEvidence,
+    PressSequence,
 };
 use crate::hardness::scale::Hardness;
 use crate::tactile::spec::TactileSpec;
@@ -20,8 +27,45 @@ use image::{GrayImage, Luma, Rgb, RgbImage};
 use std::cell::Cell;
 use std::rc::Rc;
 
-pub(super) const TOP_M: f64 = 0.03;
-pub(super) const K: CameraIntrinsics = CameraIntrinsics {
+/// The dummy devices of one apple on a table, the gel and the arm sharing where the pad is.
+pub struct DummyWorld {
+    pub camera: DummyCamera,
+    pub detector: DummyDetector,
+    pub tactile: DummyGel,
+    pub arm: DummyArm,
+}
+
+impl DummyWorld {
+    /// The apple at the camera's centre, its contact shown at the gel frame's centre, the pad
+    /// 0.3 m up, the arm free to go down to the table.
+    pub fn apple() -> Self {
+        let z = Rc::new(Cell::new(0.3));
+        let xy = Rc::new(Cell::new((0.0, 0.0)));
+        Self {
+            camera: DummyCamera,
+            detector: DummyDetector,
+            tactile: DummyGel {
+                z: z.clone(),
+                xy: xy.clone(),
+                first_xy: Cell::new(None),
+                centre: (48.0, 40.0),
+                object_m: None,
+                shows: true,
+                spec: TactileSpec::gelsight_mini(),
+            },
+            arm: DummyArm {
+                z,
+                xy,
+                refuse_below_m: 0.0,
+            },
+        }
+    }
+}
+
+/// The apple's top above the table (m).
+pub const TOP_M: f64 = 0.03;
+/// The camera's intrinsics: a 64 x 48 frame.
+pub const K: CameraIntrinsics = CameraIntrinsics {
     width: 64,
     height: 48,
     fx: 60.0,
@@ -30,14 +74,16 @@ pub(super) const K: CameraIntrinsics = CameraIntrinsics {
     cy: 24.0,
 };
 
-pub(super) fn on_apple(x: u32, y: u32) -> bool {
+/// Whether pixel (x, y) of the camera's frame shows the apple.
+pub fn on_apple(x: u32, y: u32) -> bool {
     (x as f64 - 32.0).hypot(y as f64 - 24.0) < 14.0
 }
 
-pub(super) struct Camera;
-impl RgbdCamera for Camera {
+/// A camera 0.7 m above the table, looking down at the apple.
+pub struct DummyCamera;
+impl RgbdCamera for DummyCamera {
     fn name(&self) -> &str {
-        "fake-camera"
+        "dummy-camera"
     }
     fn intrinsics(&self) -> CameraIntrinsics {
         K
@@ -66,8 +112,9 @@ impl RgbdCamera for Camera {
     }
 }
 
-pub(super) struct OneApple;
-impl Detector for OneApple {
+/// Finds the apple, with its mask.
+pub struct DummyDetector;
+impl Detector for DummyDetector {
     fn name(&self) -> &str {
         "one-apple"
     }
@@ -86,18 +133,21 @@ impl Detector for OneApple {
 /// top (never, when `shows` is false). With `object_m` the disc is instead where a point
 /// that far (world x, y) from the pad's first place lies under the pad, wherever the arm
 /// has put the pad since.
-pub(super) struct Gel {
-    pub(super) z: Rc<Cell<f64>>,
-    pub(super) xy: Rc<Cell<(f64, f64)>>,
-    pub(super) first_xy: Cell<Option<(f64, f64)>>,
-    pub(super) centre: (f64, f64),
-    pub(super) object_m: Option<(f64, f64)>,
-    pub(super) shows: bool,
-    pub(super) spec: TactileSpec,
+pub struct DummyGel {
+    z: Rc<Cell<f64>>,
+    xy: Rc<Cell<(f64, f64)>>,
+    first_xy: Cell<Option<(f64, f64)>>,
+    /// Where the disc stands in the 96 x 80 frame (px).
+    pub centre: (f64, f64),
+    /// Instead of `centre`: the object's offset (m, world x, y) from the pad's first place.
+    pub object_m: Option<(f64, f64)>,
+    /// Whether the gel ever shows a contact.
+    pub shows: bool,
+    pub spec: TactileSpec,
 }
-impl TactileSensor for Gel {
+impl TactileSensor for DummyGel {
     fn name(&self) -> &str {
-        "fake-gel"
+        "dummy-gel"
     }
     fn spec(&self) -> &TactileSpec {
         &self.spec
@@ -136,14 +186,16 @@ impl TactileSensor for Gel {
     }
 }
 
-pub(super) struct FakeArm {
-    pub(super) z: Rc<Cell<f64>>,
-    pub(super) xy: Rc<Cell<(f64, f64)>>,
-    pub(super) refuse_below_m: f64,
+/// Moves the pad where it is told, refusing a move below `refuse_below_m` (a crush limit).
+pub struct DummyArm {
+    z: Rc<Cell<f64>>,
+    xy: Rc<Cell<(f64, f64)>>,
+    /// The lowest the pad may go (m above the table).
+    pub refuse_below_m: f64,
 }
-impl Arm for FakeArm {
+impl Arm for DummyArm {
     fn name(&self) -> &str {
-        "fake-arm"
+        "dummy-arm"
     }
     fn pose(&self) -> Result<Pose, DeviceError> {
         let (x, y) = self.xy.get();
@@ -152,7 +204,7 @@ impl Arm for FakeArm {
     fn move_linear(&mut self, target: &Pose, _: f64) -> Result<(), DeviceError> {
         if target.position.z < self.refuse_below_m {
             return Err(DeviceError::UnsafeMove {
-                device: "fake-arm".into(),
+                device: "dummy-arm".into(),
                 reason: "crush limit".into(),
             });
         }
@@ -165,21 +217,36 @@ impl Arm for FakeArm {
     }
 }
 
-/// Reads every press as 2 MPa: the pipeline is under test, not estimation.
-pub(super) struct TwoMpa;
-impl HardnessEstimator for TwoMpa {
+/// Reads every press of 8 frames as one modulus: for testing what is around estimation.
+pub struct FixedEstimator {
+    pub modulus_mpa: f64,
+}
+
+impl FixedEstimator {
+    pub fn new(modulus_mpa: f64) -> Self {
+        Self { modulus_mpa }
+    }
+}
+
+impl HardnessEstimator for FixedEstimator {
     fn name(&self) -> &str {
-        "two-mpa"
+        "fixed"
     }
     fn estimate(
         &self,
         press: &PressSequence,
         _: &TactileSpec,
     ) -> Result<HardnessEstimate, EstimateError> {
-        assert_eq!(press.frames.len(), 8);
+        if press.frames.len() != 8 {
+            return Err(EstimateError::BadSequence(format!(
+                "{} frames, the protocol records 8",
+                press.frames.len()
+            )));
+        }
+        let e = self.modulus_mpa;
         Ok(HardnessEstimate {
-            hardness: Hardness::ModulusMpa(2.0),
-            interval: ModulusInterval::log_normal(2f64.ln(), 0.1, "test"),
+            hardness: Hardness::ModulusMpa(e),
+            interval: ModulusInterval::log_normal(e.ln(), 0.1, "fixed"),
             evidence: Evidence::Physics(PhysicsEvidence {
                 gel_share: 0.1,
                 gel_share_se: 0.0,
