@@ -9,6 +9,7 @@ use crate::app::{Twin, load_sensor};
 use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::provenance::write_markdown_report;
 use crate::report::summary::median;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -179,11 +180,10 @@ pub(crate) fn run(args: &AskBenchArgs) -> Result<()> {
         write_json_atomic(&dir.join("ask_bench.json"), &report)?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         print!("{}", markdown(&report));
-    }
+        Ok(())
+    })?;
     Ok(())
 }
 

@@ -8,6 +8,7 @@ use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::report::plot;
 use crate::report::provenance::write_markdown_report;
 use crate::report::summary::median;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::DVec2;
@@ -367,11 +368,10 @@ pub(crate) fn run(args: &ContactBenchArgs) -> Result<()> {
         )?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
-    } else {
+    print_json_or_text(&rows, args.json, || {
         print!("{}", markdown(&rows));
-    }
+        Ok(())
+    })?;
     Ok(())
 }
 

@@ -4,6 +4,7 @@
 
 use crate::datagen::tactile::{SampleFormat, TactileDatagenArgs, generate};
 use crate::report::output::{OutputDir, write_json_atomic};
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -129,32 +130,30 @@ pub(crate) fn run(args: &DatagenBenchArgs) -> Result<()> {
         write_json_atomic(&dir.join("datagen_bench.json"), &bench)?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&bench)?);
-        return Ok(());
-    }
-    println!(
-        "datagen tactile, {} sequences per level, {} threads, {:?}, shapes {}",
-        args.count,
-        bench.threads,
-        args.format,
-        args.shapes.join(",")
-    );
-    println!(
-        "{:<10} {:>9} {:>8} {:>10} {:>8} {:>12} {:>8}",
-        "fidelity", "seq/s", "seconds", "5000 (min)", "redraws", "search steps", "MB/seq"
-    );
-    for r in &bench.rows {
+    print_json_or_text(&bench, args.json, || {
         println!(
-            "{:<10} {:>9.2} {:>8.1} {:>10.1} {:>8} {:>12.2} {:>8.2}",
-            r.fidelity,
-            r.sequences_per_s,
-            r.seconds,
-            r.minutes_for_5000,
-            r.redraws,
-            r.mean_search_steps,
-            r.megabytes_per_sequence
+            "datagen tactile, {} sequences per level, {} threads, {:?}, shapes {}",
+            args.count,
+            bench.threads,
+            args.format,
+            args.shapes.join(",")
         );
-    }
-    Ok(())
+        println!(
+            "{:<10} {:>9} {:>8} {:>10} {:>8} {:>12} {:>8}",
+            "fidelity", "seq/s", "seconds", "5000 (min)", "redraws", "search steps", "MB/seq"
+        );
+        for r in &bench.rows {
+            println!(
+                "{:<10} {:>9.2} {:>8.1} {:>10.1} {:>8} {:>12.2} {:>8.2}",
+                r.fidelity,
+                r.sequences_per_s,
+                r.seconds,
+                r.minutes_for_5000,
+                r.redraws,
+                r.mean_search_steps,
+                r.megabytes_per_sequence
+            );
+        }
+        Ok(())
+    })
 }

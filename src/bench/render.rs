@@ -7,6 +7,7 @@
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::report::provenance::write_markdown_report;
 use crate::report::summary::median;
+use crate::report::tail::print_json_or_text;
 use anyhow::Result;
 use clap::Args;
 use glam::DVec2;
@@ -210,11 +211,10 @@ pub(crate) fn run(args: &RenderBenchArgs) -> Result<()> {
         write_json_atomic(&dir.join("render_bench.json"), &report)?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         print!("{}", markdown(&report));
-    }
+        Ok(())
+    })?;
     Ok(())
 }
 

@@ -6,6 +6,7 @@
 use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::provenance::write_markdown_report;
 use crate::report::summary::median;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -135,11 +136,10 @@ pub(crate) fn run(args: &SceneBenchArgs) -> Result<()> {
         write_json_atomic(&dir.join("scene_bench.json"), &report)?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         print!("{}", markdown(&report));
-    }
+        Ok(())
+    })?;
     Ok(())
 }
 

@@ -11,7 +11,8 @@ use crate::app::sensor::with_gel_modulus;
 use crate::app::twin::Twin;
 use crate::app::twin_options::TwinOptions;
 use crate::cli::twin_flags::TwinFlags;
-use anyhow::{Context, Result, bail};
+use crate::report::tail::print_json_or_text;
+use anyhow::{Result, bail};
 use clap::Args;
 use serde::Deserialize;
 use std::path::PathBuf;
@@ -206,15 +207,10 @@ pub fn answer(args: &AskRequest) -> Result<Answer> {
 
 pub(crate) fn run(args: &AskArgs) -> Result<()> {
     let answer = answer(&args.request())?;
-    if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&answer).context("serialising the answer")?
-        );
-    } else {
+    print_json_or_text(&answer, args.json, || {
         print_answer(&answer);
-    }
-    Ok(())
+        Ok(())
+    })
 }
 
 fn print_answer(a: &Answer) {

@@ -3,6 +3,7 @@
 
 use crate::app::flag_range::above;
 use crate::app::load_tactile_frame;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde::Serialize;
@@ -86,41 +87,39 @@ pub(crate) fn run(args: &ContactArgs) -> Result<()> {
         contact_area_mm2: mm.map(|m| m.1),
         circle,
     };
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-        return Ok(());
-    }
-    let e = &report.evidence;
-    println!(
-        "{}: {} (worst 32 px tile SSIM {:.4}, contact at <= {:.4}; frame SSIM {:.3}{})",
-        report.image,
-        if e.contact { "contact" } else { "no contact" },
-        e.min_tile_ssim,
-        e.tile_threshold,
-        e.ssim,
-        e.marker_px.map_or(String::new(), |m| format!(
-            "; markers moved {m:.2} px on average"
-        ))
-    );
-    match &report.circle {
-        Some(c) => {
-            let mm = report.contact_radius_mm.map_or(String::new(), |r| {
-                format!(
-                    " = {r:.3} mm, region {:.3} mm^2",
-                    report.contact_area_mm2.unwrap_or(0.0)
-                )
-            });
-            println!(
-                "  contact circle: centre ({:.1}, {:.1}) px, radius {:.1} px{mm}; outline of {} edge points, {:.2} px from round (rms)",
-                c.centre_px[0],
-                c.centre_px[1],
-                c.radius_px,
-                c.edge_px.len(),
-                c.rms_residual_px
-            );
+    print_json_or_text(&report, args.json, || {
+        let e = &report.evidence;
+        println!(
+            "{}: {} (worst 32 px tile SSIM {:.4}, contact at <= {:.4}; frame SSIM {:.3}{})",
+            report.image,
+            if e.contact { "contact" } else { "no contact" },
+            e.min_tile_ssim,
+            e.tile_threshold,
+            e.ssim,
+            e.marker_px.map_or(String::new(), |m| format!(
+                "; markers moved {m:.2} px on average"
+            ))
+        );
+        match &report.circle {
+            Some(c) => {
+                let mm = report.contact_radius_mm.map_or(String::new(), |r| {
+                    format!(
+                        " = {r:.3} mm, region {:.3} mm^2",
+                        report.contact_area_mm2.unwrap_or(0.0)
+                    )
+                });
+                println!(
+                    "  contact circle: centre ({:.1}, {:.1}) px, radius {:.1} px{mm}; outline of {} edge points, {:.2} px from round (rms)",
+                    c.centre_px[0],
+                    c.centre_px[1],
+                    c.radius_px,
+                    c.edge_px.len(),
+                    c.rms_residual_px
+                );
+            }
+            None if e.contact => println!("  no contact circle found"),
+            None => {}
         }
-        None if e.contact => println!("  no contact circle found"),
-        None => {}
-    }
-    Ok(())
+        Ok(())
+    })
 }

@@ -4,6 +4,7 @@
 
 use crate::app::load_rgb;
 use crate::report::output::write_png_atomic;
+use crate::report::tail::print_json_or_text;
 use anyhow::Result;
 use clap::Args;
 use image::Rgb;
@@ -95,9 +96,7 @@ pub(crate) fn run(args: &DetectArgs) -> Result<()> {
             })
             .collect(),
     };
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         println!(
             "{}: {} detections ({}, {})",
             report.image,
@@ -111,6 +110,7 @@ pub(crate) fn run(args: &DetectArgs) -> Result<()> {
                 d.label, d.score, d.bbox[0], d.bbox[1], d.bbox[2], d.bbox[3], d.mask_px
             );
         }
-    }
+        Ok(())
+    })?;
     Ok(())
 }

@@ -4,6 +4,7 @@
 
 use crate::app::load_rgb;
 use crate::report::output::write_png_atomic;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Result, bail};
 use clap::Args;
 use serde::Serialize;
@@ -264,51 +265,49 @@ pub(crate) fn run(args: &MarkersArgs) -> Result<()> {
         report.pitch_px = Some(pitch);
         report.reference = Some(path.display().to_string());
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-        return Ok(());
-    }
-    if let Some(a) = &report.annotated {
-        println!(
-            "{}: {} of {} annotated markers found within {FOUND_WITHIN_PX} px",
-            a.annotations, a.found, a.count
-        );
-        for m in &a.misses {
+    print_json_or_text(&report, args.json, || {
+        if let Some(a) = &report.annotated {
             println!(
-                "  missed ({:.1}, {:.1}): nearest detection {:.2} px away",
-                m.x_px, m.y_px, m.nearest_px
+                "{}: {} of {} annotated markers found within {FOUND_WITHIN_PX} px",
+                a.annotations, a.found, a.count
             );
-        }
-    }
-    match &report.displacements {
-        None => {
-            println!("{}: {} markers (x, y px)", report.image, report.count);
-            for m in &report.markers {
-                println!("  {:8.2} {:8.2}", m[0], m[1]);
-            }
-        }
-        Some(d) => {
-            let lost = d.iter().filter(|d| d.dx_px.is_none()).count();
-            println!(
-                "{}: {} markers; {} in the reference (pitch {:.1} px), {lost} lost; mean displacement of those that moved {:.2} px",
-                report.image,
-                report.count,
-                d.len(),
-                report.pitch_px.unwrap_or(0.0),
-                report.mean_moved_px.unwrap_or(0.0)
-            );
-            println!("  {:>8} {:>8} {:>7} {:>7}", "x", "y", "dx", "dy");
-            for m in d {
-                let f = |v: Option<f64>| v.map_or("lost".into(), |v| format!("{v:+.2}"));
+            for m in &a.misses {
                 println!(
-                    "  {:8.2} {:8.2} {:>7} {:>7}",
-                    m.x_px,
-                    m.y_px,
-                    f(m.dx_px),
-                    f(m.dy_px)
+                    "  missed ({:.1}, {:.1}): nearest detection {:.2} px away",
+                    m.x_px, m.y_px, m.nearest_px
                 );
             }
         }
-    }
-    Ok(())
+        match &report.displacements {
+            None => {
+                println!("{}: {} markers (x, y px)", report.image, report.count);
+                for m in &report.markers {
+                    println!("  {:8.2} {:8.2}", m[0], m[1]);
+                }
+            }
+            Some(d) => {
+                let lost = d.iter().filter(|d| d.dx_px.is_none()).count();
+                println!(
+                    "{}: {} markers; {} in the reference (pitch {:.1} px), {lost} lost; mean displacement of those that moved {:.2} px",
+                    report.image,
+                    report.count,
+                    d.len(),
+                    report.pitch_px.unwrap_or(0.0),
+                    report.mean_moved_px.unwrap_or(0.0)
+                );
+                println!("  {:>8} {:>8} {:>7} {:>7}", "x", "y", "dx", "dy");
+                for m in d {
+                    let f = |v: Option<f64>| v.map_or("lost".into(), |v| format!("{v:+.2}"));
+                    println!(
+                        "  {:8.2} {:8.2} {:>7} {:>7}",
+                        m.x_px,
+                        m.y_px,
+                        f(m.dx_px),
+                        f(m.dy_px)
+                    );
+                }
+            }
+        }
+        Ok(())
+    })
 }

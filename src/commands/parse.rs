@@ -1,6 +1,7 @@
 //! `tactex parse`: what the prompt parser reads from a question, as text or JSON.
 
 use crate::app::parser_choice::{ParserChoice, PromptParser};
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -36,17 +37,15 @@ pub(crate) fn run(args: &ParseArgs) -> Result<()> {
         eprintln!("note: {notice}");
     }
     let query = read.query?;
-    if args.json {
-        // The query's fields, and who read it ("rules" or "llm:<model>").
-        let mut json = serde_json::to_value(&query).context("serialising the query")?;
-        json["parser"] = read.parser.clone().into();
-        json["parse_notice"] = read.notice.clone().into();
-        println!("{}", serde_json::to_string_pretty(&json)?);
-    } else {
+    // The query's fields, and who read it ("rules" or "llm:<model>").
+    let mut json = serde_json::to_value(&query).context("serialising the query")?;
+    json["parser"] = read.parser.clone().into();
+    json["parse_notice"] = read.notice.clone().into();
+    print_json_or_text(&json, args.json, || {
         print!("{}", describe(&query));
         println!("parser:   {}", read.parser);
-    }
-    Ok(())
+        Ok(())
+    })
 }
 
 /// The snake_case name serde gives an enum value.

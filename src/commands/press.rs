@@ -5,6 +5,7 @@ use crate::app::press_options::fields::*;
 use crate::app::press_options::{PressOptions, ShapeKind};
 use crate::app::single_press::{GridReport, PressReport, PressRequest, SolvedPress};
 use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic, write_png16_atomic};
+use crate::report::tail::print_json_or_text;
 use anyhow::{Result, bail};
 use clap::Args;
 use serde::Serialize;
@@ -168,11 +169,10 @@ pub(crate) fn run(args: &PressArgs) -> Result<()> {
         write_png_atomic(&dir.join("reference.png"), &reference)?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&press.report)?);
-    } else {
+    print_json_or_text(&press.report, args.json, || {
         print_report(&press.report);
-    }
+        Ok(())
+    })?;
     Ok(())
 }
 

@@ -5,6 +5,7 @@
 use crate::app::{load_sensor, load_tactile_frame};
 use crate::report::indentation_view::indentation_view;
 use crate::report::output::write_png_atomic;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde::{Deserialize, Serialize};
@@ -187,40 +188,38 @@ pub(crate) fn run(args: &ReadArgs) -> Result<()> {
     if let Some(out) = &args.out {
         write_picture(out, &image, &reading)?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-        return Ok(());
-    }
-    let (Some(axes), Some(radius), Some(within)) = (
-        report.contact_axes_mm,
-        report.contact_radius_mm,
-        report.within_frame,
-    ) else {
+    print_json_or_text(&report, args.json, || {
+        let (Some(axes), Some(radius), Some(within)) = (
+            report.contact_axes_mm,
+            report.contact_radius_mm,
+            report.within_frame,
+        ) else {
+            println!(
+                "{}: no imprint read (none {MIN_IMPRINT_MM} mm deep or more; {:.0}% of the pixels readable); read through {}",
+                report.image,
+                100.0 * report.readable_share,
+                report.sensor
+            );
+            return Ok(());
+        };
+        let edge = match report.contact_edge {
+            Some("outline") => "the outline where the slope peaks",
+            _ => "the half-depth region",
+        };
         println!(
-            "{}: no imprint read (none {MIN_IMPRINT_MM} mm deep or more; {:.0}% of the pixels readable); read through {}",
+            "{}: peak depth {:.3} mm, contact radius {:.3} mm (semi-axes {:.3} x {:.3} mm, from {edge}){}; read through {}",
             report.image,
-            100.0 * report.readable_share,
+            report.peak_depth_mm,
+            radius,
+            axes[0],
+            axes[1],
+            if within {
+                ""
+            } else {
+                ", the imprint reaches the frame's edge (its depth reads short)"
+            },
             report.sensor
         );
-        return Ok(());
-    };
-    let edge = match report.contact_edge {
-        Some("outline") => "the outline where the slope peaks",
-        _ => "the half-depth region",
-    };
-    println!(
-        "{}: peak depth {:.3} mm, contact radius {:.3} mm (semi-axes {:.3} x {:.3} mm, from {edge}){}; read through {}",
-        report.image,
-        report.peak_depth_mm,
-        radius,
-        axes[0],
-        axes[1],
-        if within {
-            ""
-        } else {
-            ", the imprint reaches the frame's edge (its depth reads short)"
-        },
-        report.sensor
-    );
-    Ok(())
+        Ok(())
+    })
 }

@@ -1,6 +1,7 @@
 //! `tactex sensor show|check`: what a sensor profile says, and whether the twin can render
 //! with it (its no-contact frame against its background, at its camera noise).
 
+use crate::report::tail::print_json_or_text;
 use anyhow::Result;
 use clap::{Args, Subcommand};
 use serde::Serialize;
@@ -154,41 +155,39 @@ fn show(args: &ShowArgs) -> Result<()> {
         return Ok(());
     }
     let s = summary(&profile);
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&s)?);
-        return Ok(());
-    }
-    println!("{}", s.sensor);
-    println!("  sha256      {}", s.sensor.sha256);
-    if !s.source.is_empty() {
-        println!("  source      {}", s.source);
-    }
-    println!(
-        "  camera      {} x {} px at {} mm/px ({:.1} x {:.1} mm), {} Hz, noise {:.2} grey levels, vignette {}, exposure {}",
-        s.width_px,
-        s.height_px,
-        s.mm_per_px,
-        s.pad_mm[0],
-        s.pad_mm[1],
-        s.frame_rate_hz,
-        s.noise_sigma_grey,
-        s.vignette,
-        s.exposure
-    );
-    println!(
-        "  gel         E {} MPa, nu {}, {} mm thick",
-        s.gel_modulus_mpa, s.gel_poisson, s.gel_thickness_mm
-    );
-    println!("  background  {}", s.background);
-    println!("  shading     {}", s.shading);
-    if let Some(glow) = &s.glow {
-        println!("  glow        {glow}");
-    }
-    println!("  markers     {}", s.markers);
-    if let Some(fit) = &s.fit {
-        println!("  fit         {fit}");
-    }
-    Ok(())
+    print_json_or_text(&s, args.json, || {
+        println!("{}", s.sensor);
+        println!("  sha256      {}", s.sensor.sha256);
+        if !s.source.is_empty() {
+            println!("  source      {}", s.source);
+        }
+        println!(
+            "  camera      {} x {} px at {} mm/px ({:.1} x {:.1} mm), {} Hz, noise {:.2} grey levels, vignette {}, exposure {}",
+            s.width_px,
+            s.height_px,
+            s.mm_per_px,
+            s.pad_mm[0],
+            s.pad_mm[1],
+            s.frame_rate_hz,
+            s.noise_sigma_grey,
+            s.vignette,
+            s.exposure
+        );
+        println!(
+            "  gel         E {} MPa, nu {}, {} mm thick",
+            s.gel_modulus_mpa, s.gel_poisson, s.gel_thickness_mm
+        );
+        println!("  background  {}", s.background);
+        println!("  shading     {}", s.shading);
+        if let Some(glow) = &s.glow {
+            println!("  glow        {glow}");
+        }
+        println!("  markers     {}", s.markers);
+        if let Some(fit) = &s.fit {
+            println!("  fit         {fit}");
+        }
+        Ok(())
+    })
 }
 
 #[derive(Serialize)]
@@ -236,13 +235,12 @@ fn check(args: &CheckArgs) -> Result<()> {
         noise_sigma_grey: profile.noise_sigma_grey,
         no_contact_ssim: score,
     };
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         println!(
             "{}: valid; its no-contact frame against its background: SSIM {:.4} (its markers and {:.2} grey levels of noise)",
             report.sensor, report.no_contact_ssim, report.noise_sigma_grey
         );
-    }
+        Ok(())
+    })?;
     Ok(())
 }

@@ -21,6 +21,7 @@ use crate::eval::other_paper_kinds;
 use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::plot::{self, BarSeries};
 use crate::report::provenance::write_markdown_report;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -688,9 +689,7 @@ pub(crate) fn run(args: &ExplanationEvalArgs) -> Result<()> {
         )?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         print!("{table}");
         for s in scores.iter().filter(|s| !s.problems.is_empty()).take(10) {
             println!(
@@ -701,7 +700,8 @@ pub(crate) fn run(args: &ExplanationEvalArgs) -> Result<()> {
                 s.problems.join("; ")
             );
         }
-    }
+        Ok(())
+    })?;
     Ok(())
 }
 

@@ -19,6 +19,7 @@ use crate::eval::report_matching::match_reports;
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::report::plot::{self, BarSeries, ScatterSeries};
 use crate::report::provenance::write_markdown_report;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail, ensure};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -696,11 +697,10 @@ pub(crate) fn run(args: &FruitEvalArgs) -> Result<()> {
         plots(dir, &report, &rows)?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         print!("{}", markdown(&report));
-    }
+        Ok(())
+    })?;
     Ok(())
 }
 

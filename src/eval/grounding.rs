@@ -11,6 +11,7 @@ use crate::eval::PAPER_FRUIT_KINDS;
 use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::plot::{self, StageGroup};
 use crate::report::provenance::write_markdown_report;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result};
 use clap::Args;
 use glam::DVec3;
@@ -478,18 +479,14 @@ pub(crate) fn run(args: &GroundingEvalArgs) -> Result<()> {
         )?;
         out.finish()?;
     }
-    if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::json!({
-                "protocol": report.protocol,
-                "seed": report.seed,
-                "detectors": report.detectors,
-                "tests": report.tests,
-            }))?
-        );
-    } else {
+    let summary = serde_json::json!({
+        "protocol": report.protocol,
+        "seed": report.seed,
+        "detectors": report.detectors,
+        "tests": report.tests,
+    });
+    print_json_or_text(&summary, args.json, || {
         println!("{}\n\n{md}", report.protocol);
-    }
-    Ok(())
+        Ok(())
+    })
 }

@@ -6,6 +6,7 @@
 use crate::app::estimator_choice::{ESTIMATORS, check_reads, unreadable};
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
 use crate::report::plot::{self, ScatterSeries};
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -267,9 +268,7 @@ pub(crate) fn run(args: &HardnessEvalArgs) -> Result<()> {
         )?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         println!(
             "{} held-out presses ({}; {}), Shore A {}-{}",
             args.count,
@@ -296,6 +295,7 @@ pub(crate) fn run(args: &HardnessEvalArgs) -> Result<()> {
         if let Some(dir) = &args.out {
             println!("wrote {}", dir.join("hardness.png").display());
         }
-    }
+        Ok(())
+    })?;
     Ok(())
 }

@@ -11,6 +11,7 @@
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::report::output::OutputDir;
 use crate::report::plot::{self, StageGroup};
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -308,9 +309,7 @@ pub(crate) fn run(args: &RipenessEvalArgs) -> Result<()> {
         )?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         println!(
             "{} estimator, {} presses per stage on {}, Shore A: median [q25, q75]",
             report.estimator, args.presses, report.sensor
@@ -332,6 +331,7 @@ pub(crate) fn run(args: &RipenessEvalArgs) -> Result<()> {
         if let Some(dir) = &args.out {
             println!("wrote {}", dir.join("ripeness.png").display());
         }
-    }
+        Ok(())
+    })?;
     Ok(())
 }

@@ -23,6 +23,7 @@ use crate::eval::{PAPER_FRUIT_KINDS, other_paper_kinds};
 use crate::report::output::{OutputDir, write_json_atomic};
 use crate::report::plot::{self, BarSeries};
 use crate::report::provenance::write_markdown_report;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -613,11 +614,10 @@ pub(crate) fn run(args: &ScenarioEvalArgs) -> Result<()> {
         plots(dir, &report)?;
         out.finish()?;
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         print!("{}", markdown(&report));
-    }
+        Ok(())
+    })?;
     Ok(())
 }
 

@@ -11,3 +11,4 @@ pub mod plot;
 pub mod provenance;
 pub mod side_by_side;
 pub mod summary;
+pub mod tail;

@@ -6,6 +6,7 @@ use crate::app::ball_presses::{self, Split, contact_box, rebuild};
 use crate::app::flag_range::{FieldError, choice, count};
 use crate::app::request_json::parsed;
 use crate::report::output::write_profile_atomic;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbImage;
@@ -571,35 +572,33 @@ pub fn calibrate(args: &CalibrateRequest) -> Result<Calibration> {
 
 pub(crate) fn run(args: &CalibrateArgs) -> Result<()> {
     let fit = calibrate(&args.request())?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&fit)?);
-        return Ok(());
-    }
-    if let Some(m) = &fit.markers {
+    print_json_or_text(&fit, args.json, || {
+        if let Some(m) = &fit.markers {
+            println!(
+                "{}: markers {} x {}, pitch {:.3} mm, dot radius {:.3} mm, darkness {:.2}",
+                m.frame.display(),
+                m.cols,
+                m.rows,
+                m.pitch_mm,
+                m.radius_mm,
+                m.darkness
+            );
+        }
         println!(
-            "{}: markers {} x {}, pitch {:.3} mm, dot radius {:.3} mm, darkness {:.2}",
-            m.frame.display(),
-            m.cols,
-            m.rows,
-            m.pitch_mm,
-            m.radius_mm,
-            m.darkness
+            "{}: fitted {} x {} bins to {} pixels of {} presses; rms residual R {:.2} G {:.2} B {:.2} grey levels",
+            fit.profile.display(),
+            fit.mag_bins,
+            fit.dir_bins,
+            fit.samples,
+            fit.presses,
+            fit.rms_grey[0],
+            fit.rms_grey[1],
+            fit.rms_grey[2]
         );
-    }
-    println!(
-        "{}: fitted {} x {} bins to {} pixels of {} presses; rms residual R {:.2} G {:.2} B {:.2} grey levels",
-        fit.profile.display(),
-        fit.mag_bins,
-        fit.dir_bins,
-        fit.samples,
-        fit.presses,
-        fit.rms_grey[0],
-        fit.rms_grey[1],
-        fit.rms_grey[2]
-    );
-    println!(
-        "camera noise {:.2} grey levels (1 sigma); profile {}",
-        fit.noise_sigma_grey, fit.sensor
-    );
-    Ok(())
+        println!(
+            "camera noise {:.2} grey levels (1 sigma); profile {}",
+            fit.noise_sigma_grey, fit.sensor
+        );
+        Ok(())
+    })
 }

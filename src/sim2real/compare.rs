@@ -15,6 +15,7 @@ use crate::app::press_options::fields::GEL_MODULUS_MPA;
 use crate::app::request_json::parsed;
 use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic};
 use crate::report::side_by_side::side_by_side;
+use crate::report::tail::print_json_or_text;
 use crate::sim2real::compare_session::{SessionCompare, SessionComparison, compare_session};
 use crate::sim2real::contact_circle_score::{CircleScore, CircleSummary, score_circle, summarise};
 use crate::sim2real::reading_score::{self, ReadingScore, ReadingSummary, score_reading};
@@ -352,12 +353,10 @@ pub(crate) fn run(args: &CompareArgs) -> Result<()> {
         return crate::sim2real::compare_session::run(&session);
     }
     let report = compare_ball_presses(&request)?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-        return Ok(());
-    }
-    print_report(&report);
-    Ok(())
+    print_json_or_text(&report, args.json, || {
+        print_report(&report);
+        Ok(())
+    })
 }
 
 fn compare_ball_presses(args: &CompareRequest) -> Result<CompareReport> {

@@ -13,6 +13,7 @@ use crate::report::output::{OutputDir, write_json_atomic, write_png_atomic};
 #[cfg(feature = "plots")]
 use crate::report::plot::{self, BarSeries};
 use crate::report::side_by_side::side_by_side;
+use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
 use image::RgbImage;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -518,11 +519,10 @@ pub fn compare_session(args: &SessionCompare) -> Result<SessionComparison> {
 
 pub(crate) fn run(args: &SessionCompare) -> Result<()> {
     let report = compare_session(args)?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    print_json_or_text(&report, args.json, || {
         print_report(&report);
-    }
+        Ok(())
+    })?;
     Ok(())
 }
 
