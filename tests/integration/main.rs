@@ -9,7 +9,6 @@ mod datagen;
 mod datagen_scenes;
 mod detect;
 mod eval;
-mod golden_images;
 mod hw_backend;
 mod input_bounds;
 mod numeric_flags;

@@ -6,6 +6,7 @@ mod contact_extremes;
 mod contact_mechanics;
 mod fruit_footprint;
 mod gel_render;
+mod golden_images;
 mod hardness_estimators;
 mod scene_render;
 mod touching_fruit;

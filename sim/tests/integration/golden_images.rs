@@ -1,13 +1,15 @@
 //! Golden images: one press rendered at every fidelity level through the built-in GelSight
 //! Mini and through a profile calibrated from real presses (tests/fixtures/fots/profile,
-//! made by the `calibrate` command in tests/golden/README.md), compared with the committed
-//! frames in tests/golden/. The CPU path must give them byte for byte; the GPU path (CI's
-//! lavapipe) within the tolerance its agreement with the CPU path is held to elsewhere.
+//! made by the `calibrate` command in sim/tests/golden/README.md), compared with the
+//! committed frames in sim/tests/golden/, beside the renderer they pin. The CPU path must
+//! give them byte for byte; the GPU path (CI's lavapipe) within the tolerance its agreement
+//! with the CPU path is held to elsewhere.
 //!
 //! A frame that differs is written beside the run's target directory as `NAME.actual.png`
 //! with `NAME.diff.png` (the absolute difference, 8x), and the failure names both. When a
-//! change is meant to alter the frames, `TACTEX_BLESS_GOLDEN=1 cargo test --test
-//! golden_images` writes them anew; the commit then says why they changed.
+//! change is meant to alter the frames, `TACTEX_BLESS_GOLDEN=1 cargo test -p tactex-sim
+//! --test integration golden_images::` writes them anew; the commit then says why they
+//! changed.
 
 use glam::DVec2;
 use image::RgbImage;
@@ -22,13 +24,18 @@ use tactex_sim::render::gel::{
 
 const SEED: u32 = 7;
 
+/// tactex-sim's own directory (the goldens) and the repository's (the fixture profile).
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
+fn repository() -> PathBuf {
+    root().join("..")
+}
+
 /// The sensors the goldens cover: the built-in Mini and a calibrated profile.
 fn profiles() -> Vec<(&'static str, SensorProfile)> {
-    let fots = root().join("tests/fixtures/fots/profile/fots-9.toml");
+    let fots = repository().join("tests/fixtures/fots/profile/fots-9.toml");
     vec![
         ("mini", SensorProfile::gelsight_mini()),
         (
