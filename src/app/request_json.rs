@@ -29,7 +29,23 @@ pub fn from_json<T: DeserializeOwned>(text: &str) -> Result<T, FieldError> {
             Some(at) => message[..at].to_string(),
             None => message,
         };
-        FieldError::new(if field == "?" { "request" } else { &field }, message)
+        // A missing or unknown key is about that key, whatever the path says.
+        let named = |what: &str| {
+            let rest = message.strip_prefix(what)?.strip_prefix(" `")?;
+            Some(rest[..rest.find('`')?].to_string())
+        };
+        if let Some(key) = named("missing field") {
+            return FieldError::new(&key, "needed, and not given");
+        }
+        if let Some(key) = named("unknown field") {
+            return FieldError::new(&key, "not a field of this request");
+        }
+        let field = if field.is_empty() || field == "?" || field == "." {
+            "request"
+        } else {
+            &field
+        };
+        FieldError::new(field, message)
     })
 }
 
@@ -56,5 +72,13 @@ mod tests {
         assert!(!e.problem.contains("line"), "{e}");
         let e = from_json::<Request>(r#"{"fidelity": "layer", "depth_mm": "x"}"#).unwrap_err();
         assert_eq!(e.field, "depth_mm");
+        let e = from_json::<Request>(r#"{"fidelity": "layer"}"#).unwrap_err();
+        assert_eq!(
+            (e.field.as_str(), e.problem.as_str()),
+            ("depth_mm", "needed, and not given")
+        );
+        let e =
+            from_json::<Request>(r#"{"fidelity": "layer", "depth_mm": 1, "x": 2}"#).unwrap_err();
+        assert_eq!(e.field, "x");
     }
 }

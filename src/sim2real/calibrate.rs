@@ -602,3 +602,37 @@ pub(crate) fn run(args: &CalibrateArgs) -> Result<()> {
         Ok(())
     })
 }
+
+#[cfg(test)]
+mod request_tests {
+    use super::*;
+    use crate::app::request_json::from_json;
+
+    #[test]
+    fn a_calibration_from_code_is_held_to_the_ranges_the_flags_state() {
+        let base =
+            r#""images": "i", "annotations": "a.csv", "background": "b.png", "out": "o.toml""#;
+        let parse = |extra: &str| {
+            from_json::<CalibrateRequest>(&format!(
+                "{{{base}, \"ball_radius_mm\": 2, \"mm_per_px\": 0.05{extra}}}"
+            ))
+            .unwrap()
+        };
+        let request = parse("");
+        assert!(request.check().is_ok());
+        assert_eq!((request.mag_bins, request.dir_bins), (12, 24));
+        assert!(request.glow && request.split == Split::Calib);
+        for (extra, field) in [
+            (r#", "mag_bins": 1"#, "mag_bins"),
+            (r#", "dir_bins": 1000"#, "dir_bins"),
+            (r#", "gel_poisson": 0.7"#, "gel_poisson"),
+            (r#", "smoothness": -1"#, "smoothness"),
+            (r#", "name": "a\nb""#, "name"),
+        ] {
+            assert_eq!(parse(extra).check().unwrap_err().field, field, "{extra}");
+        }
+        let e =
+            from_json::<CalibrateRequest>(&format!("{{{base}, \"mm_per_px\": 0.05}}")).unwrap_err();
+        assert_eq!(e.field, "ball_radius_mm", "{e}");
+    }
+}

@@ -567,3 +567,37 @@ fn print_report(report: &CompareReport) {
         );
     }
 }
+
+#[cfg(test)]
+mod request_tests {
+    use super::*;
+    use crate::app::request_json::from_json;
+
+    #[test]
+    fn a_request_from_code_keeps_the_rules_the_flags_keep_between_them() {
+        let ball = r#"{"sensor": "p.toml", "images": "i", "annotations": "a.csv"}"#;
+        let request: CompareRequest = from_json(ball).unwrap();
+        assert!(request.check().is_ok());
+        assert_eq!((request.split, request.glow), (Split::Eval, true));
+        let field = |json: &str| {
+            let request: CompareRequest = from_json(json).unwrap();
+            request.check().unwrap_err().field
+        };
+        assert_eq!(
+            field(r#"{"images": "i", "annotations": "a.csv"}"#),
+            "sensor"
+        );
+        assert_eq!(field(r#"{"session": "s", "images": "i"}"#), "images");
+        assert_eq!(field(r#"{"session": "s", "glow": false}"#), "glow");
+        assert_eq!(
+            field(r#"{"sensor": "p", "images": "i", "annotations": "a", "seed": 3}"#),
+            "seed"
+        );
+        assert_eq!(
+            field(r#"{"session": "s", "gel_modulus_mpa": 1e9}"#),
+            "gel_modulus_mpa"
+        );
+        let e = from_json::<CompareRequest>(r#"{"session": "s", "split": "dev"}"#).unwrap_err();
+        assert_eq!(e.field, "split");
+    }
+}
