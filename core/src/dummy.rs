@@ -5,10 +5,19 @@
 //! a backend must do (the `devices` traits), and the pipeline's own tests run on them:
 //!
 //! ```text
+//! use tactex_core::catalog::FruitCatalog;
+//! use tactex_core::dummy::{DummyWorld, FixedEstimator};
+//! use tactex_core::pipeline::{Devices, Language, PipelineConfig, answer};
+//!
 //! let mut world = DummyWorld::apple();
 //! let devices = Devices { camera: &mut world.camera, tactile: &mut world.tactile, arm: &mut world.arm };
-//! pipeline::answer(prompt, &catalog, devices, &world.detector, &FixedEstimator::new(2.0), ...)
+//! let a = answer("How hard is the apple?", &FruitCatalog::builtin(), devices, &world.detector,
+//!                &FixedEstimator::new(2.0), Language::OFFLINE, &PipelineConfig::default())?;
 //! ```
+//!
+//! To test your own device, put it in place of its dummy: your estimator or detector as is;
+//! your arm holding `world.tactile.pad_place()` and setting it after each move (the dummy
+//! arm tells the gel where the pad is; yours must too, for the gel to show the apple).
 
 use crate::devices::{Arm, DeviceError, RgbdCamera, TactileSensor};
 use crate::frames::TactileFrame;
@@ -145,6 +154,32 @@ pub struct DummyGel {
     pub shows: bool,
     pub spec: TactileSpec,
 }
+/// Where the pad is, shared by the gel and whichever arm moves the pad.
+#[derive(Clone)]
+pub struct PadPlace {
+    z: Rc<Cell<f64>>,
+    xy: Rc<Cell<(f64, f64)>>,
+}
+
+impl PadPlace {
+    /// The pad's centre now (world metres): what an arm other than `DummyArm` calls after
+    /// each move, so that the gel shows the apple under it.
+    pub fn set(&self, position: DVec3) {
+        self.z.set(position.z);
+        self.xy.set((position.x, position.y));
+    }
+}
+
+impl DummyGel {
+    /// The pad's place this gel reads: hand it to your own arm.
+    pub fn pad_place(&self) -> PadPlace {
+        PadPlace {
+            z: self.z.clone(),
+            xy: self.xy.clone(),
+        }
+    }
+}
+
 impl TactileSensor for DummyGel {
     fn name(&self) -> &str {
         "dummy-gel"
@@ -262,5 +297,61 @@ impl HardnessEstimator for FixedEstimator {
                 first_contact_aspect: None,
             }),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::catalog::FruitCatalog;
+    use crate::pipeline::{Devices, Language, PipelineConfig, answer};
+
+    /// A user's own arm: moves where told and says where the pad went.
+    struct MyArm {
+        at: Pose,
+        pad: PadPlace,
+    }
+    impl Arm for MyArm {
+        fn name(&self) -> &str {
+            "my-arm"
+        }
+        fn pose(&self) -> Result<Pose, DeviceError> {
+            Ok(self.at)
+        }
+        fn move_linear(&mut self, target: &Pose, _: f64) -> Result<(), DeviceError> {
+            self.at = *target;
+            self.pad.set(target.position);
+            Ok(())
+        }
+        fn stop(&mut self) -> Result<(), DeviceError> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_users_own_arm_in_the_dummy_world_presses_the_apple() {
+        let mut world = DummyWorld::apple();
+        let mut arm = MyArm {
+            at: Pose::tool_down(DVec3::new(0.0, 0.0, 0.3)),
+            pad: world.tactile.pad_place(),
+        };
+        let devices = Devices {
+            camera: &mut world.camera,
+            tactile: &mut world.tactile,
+            arm: &mut arm,
+        };
+        let a = answer(
+            "How hard is the apple?",
+            &FruitCatalog::builtin(),
+            devices,
+            &world.detector,
+            &FixedEstimator::new(2.0),
+            Language::OFFLINE,
+            &PipelineConfig::default(),
+        )
+        .unwrap();
+        let apple = &a.objects[0];
+        assert!(apple.not_measured.is_none(), "{:?}", apple.not_measured);
+        assert_eq!(apple.hardness.as_ref().unwrap().modulus_mpa, Some(2.0));
     }
 }

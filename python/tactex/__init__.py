@@ -25,7 +25,27 @@ from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import _tactex as _raw
+
+def _runtime_dir() -> None:
+    """Software Vulkan (lavapipe) prints an error on every start without a runtime
+    directory: give it a private one when the environment has none, as the CLI does
+    (src/cli/process.rs)."""
+    current = os.environ.get("XDG_RUNTIME_DIR")
+    if current and os.path.isdir(current):
+        return
+    import tempfile
+
+    path = os.path.join(tempfile.gettempdir(), f"tactex-xdg-runtime-{os.getuid()}")
+    try:
+        os.makedirs(path, mode=0o700, exist_ok=True)
+        os.environ["XDG_RUNTIME_DIR"] = path
+    except OSError:
+        pass
+
+
+_runtime_dir()
+
+from . import _tactex as _raw  # noqa: E402
 from .errors import Failure, InvalidArgument, MissingFile, TactexError, translated
 
 
