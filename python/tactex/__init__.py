@@ -91,14 +91,55 @@ SHAPE_FAMILIES: Tuple[str, ...] = ("sphere", "ellipsoid", "box", "fruit", "blob"
 PathLike = Union[str, "os.PathLike[str]"]
 
 
+def _shown(value: Any) -> str:
+    """A value as an error shows it: short, on one line."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _number(name: str, value: Any) -> Optional[float]:
-    """A keyword's number, or None; anything else is an InvalidArgument naming it."""
+    """A keyword's number (an int, a float or a numpy number; not a bool or text), or None;
+    anything else is an InvalidArgument naming it."""
     if value is None:
         return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+        raise InvalidArgument(f"{name}: give a number, got {_shown(value)}")
     try:
         return float(value)
-    except (TypeError, ValueError):
-        raise InvalidArgument(f"{name}: give a number, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidArgument(f"{name}: {_shown(value)} is not a number this can take") from None
+
+
+def _flag(name: str, value: Any) -> bool:
+    """A keyword's True or False (not text, which would read as True)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise InvalidArgument(f"{name}: give True or False, got {_shown(value)}")
+    return bool(value)
+
+
+def _mesh_shape(shape: Any, mesh: Any) -> Any:
+    """The shape to press: "mesh" when a mesh is given (the default "sphere" gives way to
+    it); another named shape beside a mesh would be dropped, so it is refused."""
+    if mesh is None:
+        return shape
+    if shape not in ("sphere", "mesh"):
+        raise InvalidArgument(f"shape: {_shown(shape)} given with a mesh; give one object")
+    return "mesh"
+
+
+def _pose(pose: Any) -> Optional[Tuple[float, float, float]]:
+    """``pose=(x_mm, y_mm, yaw_deg)``: three numbers, or None."""
+    if pose is None:
+        return None
+    if isinstance(pose, (str, bytes, dict)) or not hasattr(pose, "__len__") or len(pose) != 3:
+        raise InvalidArgument(f"pose: give (x_mm, y_mm, yaw_deg), got {_shown(pose)}")
+    try:
+        x, y, yaw = (_number("pose", v) for v in pose)
+    except InvalidArgument:
+        raise InvalidArgument(f"pose: give (x_mm, y_mm, yaw_deg), got {_shown(pose)}") from None
+    if x is None or y is None or yaw is None:
+        raise InvalidArgument(f"pose: give (x_mm, y_mm, yaw_deg), got {_shown(pose)}")
+    return (x, y, yaw)
 
 
 def _array(name: str, value: Any, dtype: Any) -> np.ndarray:
@@ -178,20 +219,20 @@ def _numbers(name: str, value: Any) -> Optional[List[float]]:
     """A keyword's sequence of numbers, or None."""
     if value is None:
         return None
-    if isinstance(value, (str, bytes)):
-        raise InvalidArgument(f"{name}: give a sequence of numbers, got {value!r}")
+    if isinstance(value, (str, bytes, dict, set)) or not hasattr(value, "__iter__"):
+        raise InvalidArgument(f"{name}: give a sequence of numbers, got {_shown(value)}")
     try:
-        return [float(v) for v in value]
-    except (TypeError, ValueError):
-        raise InvalidArgument(f"{name}: give a sequence of numbers, got {value!r}") from None
+        return [float(v) for v in (_number(name, v) for v in value)]  # type: ignore[arg-type]
+    except (InvalidArgument, TypeError):
+        raise InvalidArgument(f"{name}: give a sequence of numbers, got {_shown(value)}") from None
 
 
 def _whole(name: str, value: Any, end: int) -> int:
     """A keyword's whole number in [0, end)."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InvalidArgument(f"{name}: give a whole number, got {value!r}")
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise InvalidArgument(f"{name}: give a whole number, got {_shown(value)}")
     if not 0 <= int(value) < end:
-        raise InvalidArgument(f"{name}: {value} is outside [0, {end - 1}]")
+        raise InvalidArgument(f"{name}: {_shown(value)} is outside [0, {end - 1}]")
     return int(value)
 
 
@@ -244,11 +285,9 @@ def _press_keywords(
         raise InvalidArgument("depth_mm: give the press's depth past first touch in mm")
     at_mm: Optional[List[float]] = None
     yaw: Optional[float] = None
-    if pose is not None:
-        try:
-            x, y, yaw = (float(v) for v in pose)
-        except (TypeError, ValueError):
-            raise InvalidArgument(f"pose: give (x_mm, y_mm, yaw_deg), got {pose!r}") from None
+    placed = _pose(pose)
+    if placed is not None:
+        x, y, yaw = placed
         at_mm = [x, y]
     mesh = kw.get("mesh")
     if mesh is not None and not isinstance(mesh, (str, os.PathLike)):
@@ -328,7 +367,11 @@ class Sensor:
     """
 
     def __init__(self, profile: Optional[PathLike] = None) -> None:
+        if profile is not None and not isinstance(profile, (str, os.PathLike)):
+            raise InvalidArgument(f"profile: give a profile file's path, got {_shown(profile)}")
         self.profile: Optional[str] = None if profile is None else os.fspath(profile)
+        if isinstance(self.profile, bytes):
+            raise InvalidArgument("profile: give the path as text, not bytes")
         # Loaded once: every press through this sensor reuses it.
         self._native = _tactex.Profile(self.profile)
         #: The profile's name and content hash, as every output names it.
@@ -373,8 +416,7 @@ class Sensor:
         (local SSIM against the no-contact frame, or marker motion), then 8 frames from
         the first contact frame, 0.25 mm apart. First touch falls ``phase_mm`` (0 to 0.25)
         before a step. Rendered on the CPU; ``seed`` seeds every frame's camera noise."""
-        if mesh is not None and shape == "sphere":
-            shape = "mesh"
+        shape = _mesh_shape(shape, mesh)
         geometry = _geometry(mesh, mesh_scale)
         keywords = _press_keywords(
             "sphere" if geometry is not None else shape,
@@ -396,6 +438,8 @@ class Sensor:
             seed=seed,
         )
         phase = _number("phase_mm", phase_mm)
+        if phase is None:
+            raise InvalidArgument("phase_mm: give a number in [0, 0.25)")
         frames, facts = _tactex.press_sequence(self._native, keywords, phase, geometry)
         return PressSequence(reference=frames[0], frames=frames[1:], labels=json.loads(facts))
 
@@ -437,8 +481,7 @@ class Sensor:
         the unit; given a mesh, ``shape`` may be left out. A mesh from arrays presses exactly
         as the same mesh from a file.
         """
-        if mesh is not None and shape == "sphere":
-            shape = "mesh"
+        shape = _mesh_shape(shape, mesh)
         geometry = _geometry(mesh, mesh_scale)
         return self._press(
             "sphere" if geometry is not None else shape,
@@ -551,13 +594,16 @@ class Sensor:
         if height_map_mm is not None:
             if mesh is not None:
                 raise InvalidArgument("height_map_mm: give a mesh or a height map, not both")
+            if mesh_scale is not None:
+                raise InvalidArgument("mesh_scale: not read with height_map_mm (mm_per_px sets its scale)")
             geometry = _geometry(
                 height_map_mm=height_map_mm,
                 mm_per_px=self.mm_per_px if mm_per_px is None else mm_per_px,
             )
         else:
-            if mesh is not None and shape == "sphere":
-                shape = "mesh"
+            if mm_per_px is not None:
+                raise InvalidArgument("mm_per_px: read only with height_map_mm")
+            shape = _mesh_shape(shape, mesh)
             geometry = _geometry(mesh, mesh_scale)
         keywords = _press_keywords(
             "sphere" if geometry is not None else shape,
@@ -622,12 +668,7 @@ class Contact:
         depth = _number("depth_mm", depth_mm)
         if depth is None:
             raise InvalidArgument("depth_mm: give the sensor's travel past first touch in mm")
-        x = y = yaw = 0.0
-        if pose is not None:
-            try:
-                x, y, yaw = (float(v) for v in pose)
-            except (TypeError, ValueError):
-                raise InvalidArgument(f"pose: give (x_mm, y_mm, yaw_deg), got {pose!r}") from None
+        x, y, yaw = _pose(pose) or (0.0, 0.0, 0.0)
         out = translated(self._native.step)(x, y, yaw, depth)
         return Press(
             frame=out["frame"],
@@ -702,9 +743,13 @@ class Sample:
 def shard_indices(count: int, shard: Tuple[int, int] = (0, 1), start: int = 0) -> range:
     """The sample indices of ``shard`` (i, n) of a data set of ``count``: i, i + n, ...,
     from ``start`` on, as ``datagen tactile --shard i/n`` takes them."""
+    if isinstance(shard, (str, bytes)) or not hasattr(shard, "__len__") or len(shard) != 2:
+        raise InvalidArgument(f"shard: {_shown(shard)} is not (i, n) with 0 <= i < n")
     i, n = shard
-    if not (isinstance(n, int) and isinstance(i, int) and n >= 1 and 0 <= i < n):
-        raise InvalidArgument(f"shard: {shard!r} is not (i, n) with 0 <= i < n")
+    whole = (int, np.integer)
+    if not (isinstance(n, whole) and isinstance(i, whole) and n >= 1 and 0 <= i < n):
+        raise InvalidArgument(f"shard: {_shown(shard)} is not (i, n) with 0 <= i < n")
+    i, n = int(i), int(n)
     if count < 0 or start < 0:
         raise InvalidArgument(f"count and start must be at least 0, got {count} and {start}")
     first = start + (i - start) % n
@@ -737,7 +782,15 @@ def generate(
     memory: same seed and index, same frames and labels. Samples are drawn ``batch`` at a
     time (default 4 per Rust thread) in parallel, without the GIL.
     """
-    shape_list = list(SHAPE_FAMILIES if shapes is None else shapes)
+    count = _whole("count", count, 2**63)
+    seed = _whole("seed", seed, 2**64)
+    start = _whole("start", start, 2**63)
+    if batch is not None:
+        batch = _whole("batch", batch, 2**31)
+    if isinstance(shapes, (str, bytes)):
+        raise InvalidArgument(f"shapes: give a list of shape families, got {_shown(shapes)}")
+    shape_list = [_text("shapes", s) for s in (SHAPE_FAMILIES if shapes is None else shapes)]
+    fidelity = _text("fidelity", fidelity)
     profile = None if sensor is None else os.fspath(sensor)
     # A range, not a list: a data set of 10**9 samples is drawn without an index of them all.
     indices = shard_indices(count, shard, start)
@@ -790,7 +843,7 @@ def ask(
         prompt=_text("prompt", prompt),
         scene=scene,
         seed=_whole("seed", seed, 2**64),
-        reproducible=bool(reproducible),
+        reproducible=_flag("reproducible", reproducible),
         gel_modulus_mpa=_number("gel_modulus_mpa", gel_modulus_mpa),
         twin=twin,
     )
@@ -848,7 +901,7 @@ def calibrate(
         mag_max=_number("mag_max", mag_max),
         smoothness=_number("smoothness", smoothness),
         source=source,
-        glow=bool(glow),
+        glow=_flag("glow", glow),
         fidelity=fidelity,
     )
     return json.loads(_tactex.calibrate(json.dumps(request)))
@@ -895,7 +948,7 @@ def compare(
         split=split,
         fidelity=fidelity,
         device=device,
-        glow=bool(glow),
+        glow=_flag("glow", glow),
         out=out,
     )
     return json.loads(_tactex.compare(json.dumps(request)))

@@ -60,6 +60,7 @@ fn is_missing(cause: &(dyn std::error::Error + 'static)) -> bool {
 fn is_bad_input(cause: &(dyn std::error::Error + 'static)) -> bool {
     cause.is::<QueryError>()
         || cause.is::<FieldError>()
+        || cause.is::<crate::app::image_input::ImageInputError>()
         || cause.is::<SceneError>()
         || cause.is::<ProfileError>()
         || cause.is::<CatalogError>()

@@ -44,6 +44,8 @@ impl PressSteps {
                 name: path.display().to_string(),
             };
         }
+        // The object checked now (a mesh with NaN vertices, a flat one), not at every step.
+        request.shape.surface(request.pose)?;
         let optics = SensorOptics::for_profile(&request.sensor);
         let flat = GelImageFields::flat(optics.width, optics.height);
         let reference = render_one(

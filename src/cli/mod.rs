@@ -149,6 +149,7 @@ pub(crate) enum SceneCommand {
 /// as one line (the binary only sets the allocator and calls this).
 pub fn main() -> ExitCode {
     process::ensure_runtime_dir();
+    process::one_line_on_stdout_failure();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         // Help and the version are what was asked for.

@@ -32,3 +32,23 @@ pub fn quiet_on_closed_pipe() {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
+
+/// A stdout that cannot be written (a full disk, `> /dev/full`) ends the program with one
+/// error line and a failure exit, as any output that cannot be written does, rather than
+/// with println!'s panic and backtrace.
+pub fn one_line_on_stdout_failure() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if let Some(why) = message.strip_prefix("failed printing to stdout: ") {
+            eprintln!("error: stdout: cannot write the output: {why}");
+            std::process::exit(1);
+        }
+        default(info);
+    }));
+}

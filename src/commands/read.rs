@@ -111,15 +111,18 @@ pub fn read(args: &ReadRequest) -> Result<(ReadReport, FrameReading, image::RgbI
     let spec = &profile.spec;
     let size = (spec.width_px, spec.height_px);
     if image.dimensions() != size {
-        bail!(
-            "{}: {} x {} px, the sensor {} has {} x {}",
-            args.image.display(),
-            image.width(),
-            image.height(),
-            profile.id(),
-            size.0,
-            size.1
-        );
+        return Err(crate::app::image_input::ImageInputError::new(
+            &args.image,
+            format!(
+                "{} x {} px, the sensor {} has {} x {}",
+                image.width(),
+                image.height(),
+                profile.id(),
+                size.0,
+                size.1
+            ),
+        )
+        .into());
     }
     if reference.dimensions() != size {
         bail!(

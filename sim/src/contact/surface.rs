@@ -101,7 +101,10 @@ impl HeightMap {
         if !(self.mm_per_px.is_finite() && self.mm_per_px > 0.0) {
             return Err(invalid(
                 "mm_per_px",
-                format!("must be a positive finite number, got {}", self.mm_per_px),
+                format!(
+                    "must be a positive finite number, got {}",
+                    tactex_core::printable::short_number(self.mm_per_px)
+                ),
             ));
         }
         if let Some(k) = self.heights_mm.iter().position(|h| h.is_infinite()) {
@@ -134,8 +137,9 @@ impl HeightMap {
             return Err(invalid(
                 "mm_per_px",
                 format!(
-                    "{} mm a point makes the map {span_mm:.0} mm across, wider than an object on a table ({most_mm:.0} mm)",
-                    self.mm_per_px
+                    "{} mm a point makes the map {} mm across, wider than an object on a table ({most_mm:.0} mm)",
+                    tactex_core::printable::short_number(self.mm_per_px),
+                    tactex_core::printable::short_number(span_mm.round())
                 ),
             ));
         }
