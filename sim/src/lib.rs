@@ -11,6 +11,7 @@
 //! render device choice), `datagen/` (randomised presses and scenes, and the press protocol
 //! on the solver alone). `world` and `mesh` are the table and its bodies.
 
+pub mod arm;
 pub mod contact;
 pub mod datagen;
 pub mod devices;

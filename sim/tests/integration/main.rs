@@ -1,6 +1,7 @@
 //! tactex-sim's integration tests, one module per area, in one test binary.
 //! `cargo test -p tactex-sim --test integration gel_render::` runs one module.
 
+mod arm_kinematics;
 mod common;
 mod contact_extremes;
 mod contact_mechanics;
