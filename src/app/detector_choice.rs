@@ -2,7 +2,7 @@
 //! YOLOv8-seg ONNX export), or the perception-error models `error-gsam` and `error-yolo`
 //! (the twin's ground truth perturbed with the paper's measured detector statistics).
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::ground::detect::{ClassicalDetector, Detector};
 use tactex_learned::yolo_seg::YoloSegDetector;
@@ -31,9 +31,10 @@ impl DetectorChoice {
             if file.trim().is_empty() {
                 bail!("--detector: 'yolo:' names no model; give yolo:FILE.onnx");
             }
-            return Ok(Self::Yolo(Box::new(YoloSegDetector::load(
-                std::path::Path::new(file),
-            )?)));
+            let path = std::path::Path::new(file);
+            // A model that is not there is missing, not a model that cannot be read.
+            crate::app::file_input::present(path, "no such model file").context("--detector")?;
+            return Ok(Self::Yolo(Box::new(YoloSegDetector::load(path)?)));
         }
         if spec == "classical" {
             return Ok(Self::Classical);

@@ -160,6 +160,9 @@ impl EstimatorChoice {
         let estimator: BoxedEstimator = match self {
             Self::Named(e) => (e.open)()?,
             Self::Model(path) => {
+                // A model that is not there is missing, not a model that cannot be read.
+                crate::app::file_input::present(path, "no such model file")
+                    .with_context(|| flag.to_string())?;
                 if !path.is_file() {
                     bail!("{flag} {}: no such model file", path.display());
                 }
