@@ -63,6 +63,7 @@ fn control_client(mut stream: TcpStream, twin: &Twin) -> Result<(), String> {
                 .map_err(|_| "the controller's lock is poisoned".to_string())?;
             let (bits, params) = match c.handle(register, &body[1..], Instant::now()) {
                 Some(Answer::Params(p)) => (c.status_bits(), p),
+                Some(Answer::Refused(p)) => (c.status_bits() | status::INVALID, p),
                 Some(Answer::Invalid) | None => (c.status_bits() | status::INVALID, Vec::new()),
             };
             for notice in c.take_notices() {

@@ -5,6 +5,7 @@
 //! pad presses) and then run by the sim arm in the twin's clock; the controller reports it
 //! moving for the move's duration in wall time, divided by the time scale.
 
+use super::arm_joints;
 use glam::{DQuat, DVec3, EulerRot};
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -36,6 +37,8 @@ pub mod reg {
     pub const SET_TCP_MAXACC: u8 = 32;
     pub const GET_TCP_POSE: u8 = 41;
     pub const GET_JOINT_POS: u8 = 42;
+    pub const GET_IK: u8 = 43;
+    pub const GET_FK: u8 = 44;
     pub const MOVE_RELATIVE: u8 = 83;
 }
 
@@ -136,6 +139,8 @@ pub struct Snapshot {
     pub mode: u8,
     pub cmd_num: u16,
     pub pose: TcpPoseMm,
+    /// The UF850's joints that hold the pad at `pose` (rad).
+    pub joints: [f64; 6],
     pub enabled: bool,
     pub error: u8,
     pub warning: u8,
@@ -153,6 +158,8 @@ pub struct Controller {
     warning: u8,
     /// Where the pad is (SDK pose) when no move runs.
     pose: TcpPoseMm,
+    /// The UF850's joints last read for the pad's pose (rad): the branch the arm is on.
+    joints: [f64; 6],
     /// Moves accepted and not yet ended, in order: the controller's command queue.
     queue: VecDeque<Moving>,
     last_speed_mm_s: f64,
@@ -180,6 +187,9 @@ pub enum MoveTarget {
 pub enum Answer {
     Params(Vec<u8>),
     Invalid,
+    /// Refused with the reply's full length (the SDK reads it before it looks at the
+    /// status, and raises on a short one): an inverse kinematics with no solution.
+    Refused(Vec<u8>),
 }
 
 impl Controller {
@@ -197,6 +207,7 @@ impl Controller {
             error: 0,
             warning: 0,
             pose: HOME,
+            joints: arm_joints::HOME_SEED,
             queue: VecDeque::new(),
             last_speed_mm_s: 0.0,
             last_notice: None,
@@ -239,11 +250,13 @@ impl Controller {
             }
             _ => (self.pose, 0.0),
         };
+        let joints = self.joints_at(&pose);
         Snapshot {
             state: self.state,
             mode: self.mode,
             cmd_num: self.queue.len().min(usize::from(u16::MAX)) as u16,
             pose,
+            joints,
             enabled: self.enabled,
             error: self.error,
             warning: self.warning,
@@ -386,9 +399,26 @@ impl Controller {
                 _ => Answer::Invalid,
             },
             reg::GET_TCP_POSE => Answer::Params(f32_params(&self.snapshot(now).pose)),
-            // The twin moves the pad in Cartesian space and has no joint model yet: the
-            // joints read zero.
-            reg::GET_JOINT_POS => Answer::Params(f32_params(&[0.0; 7])),
+            reg::GET_JOINT_POS => Answer::Params(arm_joints::params(&self.snapshot(now).joints)),
+            reg::GET_FK => match params.len() {
+                28 => {
+                    let q = f32_values(params);
+                    Answer::Params(f32_params(&arm_joints::pose_at([
+                        q[0], q[1], q[2], q[3], q[4], q[5],
+                    ])))
+                }
+                _ => Answer::Invalid,
+            },
+            reg::GET_IK => match arm_joints::ik_params(params) {
+                Some((target, reference)) => {
+                    let from = reference.unwrap_or(self.joints);
+                    match arm_joints::joints_for(&target, from) {
+                        Ok(q) => Answer::Params(arm_joints::params(&q)),
+                        Err(_) => Answer::Refused(arm_joints::params(&[0.0; 6])),
+                    }
+                }
+                None => Answer::Invalid,
+            },
             reg::MOVE_LINE => match move_line_params(params) {
                 Some((target, speed_mm_s)) => {
                     self.planned_move(target, speed_mm_s, now);
@@ -432,6 +462,16 @@ impl Controller {
             },
             _ => return None,
         })
+    }
+
+    /// The joints that hold the pad at `pose`: those nearest to the last ones read (the
+    /// branch the arm is on); where the chain cannot reach the pose (the twin moves the pad
+    /// in Cartesian space and may take it past the arm's reach), the last joints.
+    fn joints_at(&mut self, pose: &TcpPoseMm) -> [f64; 6] {
+        if let Ok(q) = arm_joints::joints_for(pose, self.joints) {
+            self.joints = q;
+        }
+        self.joints
     }
 
     fn ready(&self) -> bool {
@@ -610,7 +650,7 @@ fn lerp(a: &TcpPoseMm, b: &TcpPoseMm, t: f64) -> TcpPoseMm {
 /// (pose, speed, acceleration, time), with 1-2 bytes of check and motion type, or 10 f32
 /// (with a blend radius) and 3-4 bytes (coordinate frame, axis-angle, check, motion type).
 /// A joint-interpolated move to a Cartesian pose (motion type 1 or 2) is run as a line:
-/// the twin has no joint model, and over a table the two end at the same pose.
+/// the twin does not plan joint paths yet, and over a table the two end at the same pose.
 fn move_line_params(params: &[u8]) -> Option<(MoveTarget, f64)> {
     let (floats, tool_frame) = match params.len() {
         36..=38 => (9, false),

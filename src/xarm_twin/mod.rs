@@ -4,6 +4,7 @@
 //! RealSense's frames come over HTTP, so the user's own reader code needs nothing of this
 //! project.
 
+mod arm_joints;
 mod control_port;
 pub mod controller;
 mod frames_http;

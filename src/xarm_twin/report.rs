@@ -63,8 +63,9 @@ pub fn encode(kind: ReportKind, s: &Snapshot, ctx: &ReportContext) -> Vec<u8> {
     out.extend_from_slice(&(kind.byte_len() as u32).to_be_bytes());
     out.push((s.state & 0x0f) | (s.mode << 4));
     out.extend_from_slice(&s.cmd_num.to_be_bytes());
-    // Joint angles (the twin has no joint model yet: zeros), the TCP pose, joint torques.
-    out.extend(f32_params(&[0.0; 7]));
+    // Joint angles (the UF850's, a seventh zero), the TCP pose, joint torques.
+    let [j1, j2, j3, j4, j5, j6] = s.joints;
+    out.extend(f32_params(&[j1, j2, j3, j4, j5, j6, 0.0]));
     out.extend(f32_params(&s.pose));
     out.extend(f32_params(&[0.0; 7]));
     debug_assert_eq!(out.len(), 87);
@@ -150,6 +151,7 @@ mod tests {
             mode: 0,
             cmd_num: 2,
             pose: [300.0, -20.0, 150.0, std::f64::consts::PI, 0.0, 0.25],
+            joints: [0.1, -0.2, -1.0, 0.0, 1.2, 0.3],
             enabled: true,
             error: 31,
             warning: 0,
@@ -172,6 +174,9 @@ mod tests {
             );
             assert_eq!(r[4] & 0x0f, 1);
             assert_eq!(u16::from_be_bytes([r[5], r[6]]), 2);
+            // Joint 2 where the SDK reads the joints (bytes 7..35).
+            let j2 = f32::from_le_bytes(r[11..15].try_into().unwrap());
+            assert_eq!(j2, -0.2);
             let z = f32::from_le_bytes(r[43..47].try_into().unwrap());
             assert_eq!(z, 150.0);
         }

@@ -318,3 +318,29 @@ def test_sdk_relative_tool_and_servo_moves_modes_and_emergency_stop(twin):
     arm.motion_enable(enable=True)
     arm.set_state(0)
     assert arm.set_position(*LIME_MM, 100, **DOWN, speed=100, wait=True) == 0
+
+
+def test_sdk_joint_reading_forward_and_inverse_kinematics_agree_with_the_pose(twin):
+    """The UF850's chain behind the twin: the joints `get_servo_angle` reads hold the pose
+    `get_position` reads (`get_forward_kinematics` of them), and `get_inverse_kinematics` of
+    that pose gives those joints back; an unreachable pose is refused."""
+    arm, _ = twin
+    arm.motion_enable(enable=True)
+    arm.set_mode(0)
+    arm.set_state(0)
+    for target in [(300, 0, 300), (420, -60, 180), (250, 120, 260)]:
+        assert arm.set_position(*target, **DOWN, speed=200, wait=True) == 0
+        code, pose = arm.get_position(is_radian=False)
+        assert code == 0
+        code, angles = arm.get_servo_angle(is_radian=False)
+        assert code == 0 and any(abs(a) > 1 for a in angles[:6]), angles
+        code, fk = arm.get_forward_kinematics(angles, input_is_radian=False, return_is_radian=False)
+        assert code == 0
+        assert max(abs(a - b) for a, b in zip(fk[:3], pose[:3])) < 0.1, (fk, pose)
+        for a, b in zip(fk[3:], pose[3:]):
+            assert abs((a - b + 180) % 360 - 180) < 0.01, (fk, pose)
+        code, ik = arm.get_inverse_kinematics(pose, input_is_radian=False, return_is_radian=False)
+        assert code == 0
+        assert max(abs(a - b) for a, b in zip(ik[:6], angles[:6])) < 0.1, (ik, angles)
+    code, _ = arm.get_inverse_kinematics([3000, 0, 0, 180, 0, 0], input_is_radian=False)
+    assert code != 0
