@@ -28,6 +28,12 @@ pub(super) fn pose_at(joints: [f64; 6]) -> TcpPoseMm {
     [p.x, p.y, p.z, roll, pitch, yaw]
 }
 
+/// How far `joints` tilt the flange's axis from straight down (degrees).
+pub(super) fn tilt_deg(joints: [f64; 6]) -> f64 {
+    let down = -uf850::forward(joints).rotation.z_axis.z;
+    down.clamp(-1.0, 1.0).acos().to_degrees()
+}
+
 /// The joints nearest to `from` that hold the flange at `pose`.
 pub(super) fn joints_for(pose: &TcpPoseMm, from: [f64; 6]) -> Result<[f64; 6], KinematicsError> {
     if pose.iter().any(|v| !v.is_finite()) {

@@ -31,6 +31,7 @@ pub mod reg {
     pub const CLEAN_WAR: u8 = 17;
     pub const SET_MODE: u8 = 19;
     pub const MOVE_LINE: u8 = 21;
+    pub const MOVE_JOINT: u8 = 23;
     pub const MOVE_HOME: u8 = 25;
     pub const MOVE_SERVO_CART: u8 = 30;
     pub const SET_TCP_JERK: u8 = 31;
@@ -58,6 +59,9 @@ pub const SERVO_STEP_MAX_MM: f64 = 10.0;
 /// A move slower than this that would last longer than `SLOW_MOVE_S` is noted.
 const SLOW_SPEED_MM_S: f64 = 1.0;
 const SLOW_MOVE_S: f64 = 30.0;
+/// The most a joint target may tilt the pad from straight down (degrees): the twin's contact
+/// and frames are of a pad parallel to the table.
+pub const MAX_TILT_DEG: f64 = 1.0;
 /// Servo targets run at the TCP's top speed.
 pub const SERVO_SPEED_MM_S: f64 = 1000.0;
 
@@ -433,6 +437,17 @@ impl Controller {
                 }
                 None => Answer::Invalid,
             },
+            reg::MOVE_JOINT => match params.len() {
+                40 | 41 => {
+                    let v = f32_values(&params[..40]);
+                    // A check-only request (the SDK's only_check_type) moves nothing.
+                    if params.get(40).is_none_or(|&check| check == 0) {
+                        self.joint_move([v[0], v[1], v[2], v[3], v[4], v[5]], v[7], now);
+                    }
+                    Answer::Params(vec![])
+                }
+                _ => Answer::Invalid,
+            },
             reg::MOVE_HOME => match params.len() {
                 12 | 13 => {
                     // Speed in rad/s of the joints: a Cartesian twin moves home at 100 mm/s
@@ -491,6 +506,65 @@ impl Controller {
         }
         let target = resolve(target, &self.planned_pose());
         self.move_to(target, speed_mm_s, now);
+    }
+
+    /// A move to `joints` (rad) at `speed_rad_s` of the joint that moves most. The twin's pad
+    /// does not tilt, so a target that would tilt it more than `MAX_TILT_DEG` from straight
+    /// down is not executed (warning 12), nor one past a joint's limit; the pad runs to the
+    /// target's pose in a line, timed as the joint move would take.
+    fn joint_move(&mut self, joints: [f64; 6], speed_rad_s: f64, now: Instant) {
+        let refuse = |c: &mut Self, why: String| {
+            c.warning = warn_code::PARAMETER;
+            c.notice(format!(
+                "set_servo_angle to {:?} degrees was not executed: warning {}, {why}",
+                joints.map(|q| (q.to_degrees() * 100.0).round() / 100.0),
+                warn_code::PARAMETER
+            ));
+        };
+        if !(joints.iter().all(|q| q.is_finite()) && speed_rad_s.is_finite() && speed_rad_s > 0.0) {
+            return refuse(
+                self,
+                "a joint or speed that is not a finite positive number".into(),
+            );
+        }
+        if let Some(j) = tactex_sim::arm::uf850::past_limit(joints) {
+            return refuse(self, format!("joint {j} past its limit"));
+        }
+        let tilt = arm_joints::tilt_deg(joints);
+        if tilt > MAX_TILT_DEG {
+            return refuse(
+                self,
+                format!(
+                    "it tilts the pad {tilt:.1} degrees from straight down; the twin presses with the pad down (at most {MAX_TILT_DEG} degrees)"
+                ),
+            );
+        }
+        let target = arm_joints::pose_at(joints);
+        let from = self.planned_pose();
+        let turn = joints
+            .iter()
+            .zip(self.joints)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let path_mm = (0..3)
+            .map(|i| (target[i] - from[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let duration_s = turn / speed_rad_s;
+        let speed_mm_s = if duration_s > 0.0 && path_mm > 0.0 {
+            (path_mm / duration_s).min(SERVO_SPEED_MM_S)
+        } else {
+            SERVO_SPEED_MM_S
+        };
+        let queued = self.queue.len();
+        let before = self.joints;
+        self.planned_move(MoveTarget::Base(target), speed_mm_s, now);
+        // The move ends on the commanded branch; the readings follow it from the start.
+        if self.queue.len() > queued || self.pose == target {
+            self.joints = joints;
+        } else {
+            self.joints = before;
+        }
     }
 
     /// A servo target (servo mode): no queue, the latest target replaces whatever runs, at

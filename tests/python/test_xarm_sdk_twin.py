@@ -344,3 +344,32 @@ def test_sdk_joint_reading_forward_and_inverse_kinematics_agree_with_the_pose(tw
         assert max(abs(a - b) for a, b in zip(ik[:6], angles[:6])) < 0.1, (ik, angles)
     code, _ = arm.get_inverse_kinematics([3000, 0, 0, 180, 0, 0], input_is_radian=False)
     assert code != 0
+
+
+def test_sdk_joint_moves_end_on_the_joints_commanded(twin):
+    """`set_servo_angle` (MOVE_JOINT): the arm ends on the joints it was sent, `get_position`
+    is their forward kinematics, and a target that would tilt the pad (the twin presses with
+    the pad down) is not executed, with warning 12."""
+    arm, _ = twin
+    arm.motion_enable(enable=True)
+    arm.set_mode(0)
+    arm.set_state(0)
+    assert arm.set_position(350, 0, 250, **DOWN, speed=200, wait=True) == 0
+    _, start = arm.get_servo_angle(is_radian=False)
+    target = list(start[:6])
+    target[0] += 15   # the base turns
+    target[5] -= 30   # the pad turns about its axis: still pointing down
+    assert arm.set_servo_angle(angle=target, speed=30, wait=True) == 0
+    code, now = arm.get_servo_angle(is_radian=False)
+    assert code == 0
+    assert max(abs(a - b) for a, b in zip(now[:6], target)) < 0.01, (now, target)
+    _, pose = arm.get_position(is_radian=False)
+    _, fk = arm.get_forward_kinematics(target, input_is_radian=False, return_is_radian=False)
+    assert max(abs(a - b) for a, b in zip(fk[:3], pose[:3])) < 0.1, (fk, pose)
+    tilted = list(target)
+    tilted[4] += 20
+    arm.set_servo_angle(angle=tilted, speed=30, wait=True)
+    _, after = arm.get_servo_angle(is_radian=False)
+    assert max(abs(a - b) for a, b in zip(after[:6], target)) < 0.01, (after, target)
+    assert arm.warn_code == 12
+    arm.clean_warn()
