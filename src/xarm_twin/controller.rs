@@ -18,6 +18,8 @@ use tactex_hw::xarm::frame::{f32_params, f32_values, status};
 use tactex_sim::devices::arm::SimArm;
 use tactex_sim::world::SharedWorld;
 
+mod joint_moves;
+
 /// The controller's registers the twin answers (`XCONF.UxbusReg` in the SDK).
 pub mod reg {
     pub const GET_VERSION: u8 = 1;
@@ -33,6 +35,7 @@ pub mod reg {
     pub const MOVE_LINE: u8 = 21;
     pub const MOVE_JOINT: u8 = 23;
     pub const MOVE_HOME: u8 = 25;
+    pub const MOVE_SERVOJ: u8 = 29;
     pub const MOVE_SERVO_CART: u8 = 30;
     pub const SET_TCP_JERK: u8 = 31;
     pub const SET_TCP_MAXACC: u8 = 32;
@@ -78,6 +81,8 @@ pub mod error_code {
 pub mod warn_code {
     /// A command parameter is out of range (a non-finite pose, a speed of zero).
     pub const PARAMETER: u8 = 12;
+    /// The command has no solution: a Cartesian target of a joint move the arm cannot reach.
+    pub const NO_SOLUTION: u8 = 14;
 }
 
 /// Motion states of the report and `get_state`.
@@ -424,15 +429,32 @@ impl Controller {
                 None => Answer::Invalid,
             },
             reg::MOVE_LINE => match move_line_params(params) {
-                Some((target, speed_mm_s)) => {
+                Some((target, speed_mm_s, JOINT_MOTION)) => {
+                    self.snapshot(now);
+                    self.joint_move_to_pose(target, speed_mm_s, now);
+                    Answer::Params(vec![])
+                }
+                // Motion type 1 runs a line where the line can be run, which over a table
+                // it can: the twin refuses the line's failures as a line's.
+                Some((target, speed_mm_s, _)) => {
                     self.planned_move(target, speed_mm_s, now);
                     Answer::Params(vec![])
                 }
                 None => Answer::Invalid,
             },
             reg::MOVE_RELATIVE => match move_relative_params(params) {
-                Some((offset, speed_mm_s)) => {
+                Some(RelativeMove::Cartesian(offset, speed_mm_s, JOINT_MOTION)) => {
+                    self.snapshot(now);
+                    self.joint_move_to_pose(MoveTarget::Relative(offset), speed_mm_s, now);
+                    Answer::Params(vec![])
+                }
+                Some(RelativeMove::Cartesian(offset, speed_mm_s, _)) => {
                     self.planned_move(MoveTarget::Relative(offset), speed_mm_s, now);
+                    Answer::Params(vec![])
+                }
+                Some(RelativeMove::Joints(offsets, speed_rad_s)) => {
+                    self.snapshot(now);
+                    self.relative_joint_move(offsets, speed_rad_s, now);
                     Answer::Params(vec![])
                 }
                 None => Answer::Invalid,
@@ -442,8 +464,19 @@ impl Controller {
                     let v = f32_values(&params[..40]);
                     // A check-only request (the SDK's only_check_type) moves nothing.
                     if params.get(40).is_none_or(|&check| check == 0) {
+                        self.snapshot(now);
                         self.joint_move([v[0], v[1], v[2], v[3], v[4], v[5]], v[7], now);
                     }
+                    Answer::Params(vec![])
+                }
+                _ => Answer::Invalid,
+            },
+            // Seven joints, speed, acceleration and time: the target runs at once.
+            reg::MOVE_SERVOJ => match params.len() {
+                40 => {
+                    let v = f32_values(params);
+                    self.snapshot(now);
+                    self.servo_joints([v[0], v[1], v[2], v[3], v[4], v[5]], now);
                     Answer::Params(vec![])
                 }
                 _ => Answer::Invalid,
@@ -508,65 +541,6 @@ impl Controller {
         self.move_to(target, speed_mm_s, now);
     }
 
-    /// A move to `joints` (rad) at `speed_rad_s` of the joint that moves most. The twin's pad
-    /// does not tilt, so a target that would tilt it more than `MAX_TILT_DEG` from straight
-    /// down is not executed (warning 12), nor one past a joint's limit; the pad runs to the
-    /// target's pose in a line, timed as the joint move would take.
-    fn joint_move(&mut self, joints: [f64; 6], speed_rad_s: f64, now: Instant) {
-        let refuse = |c: &mut Self, why: String| {
-            c.warning = warn_code::PARAMETER;
-            c.notice(format!(
-                "set_servo_angle to {:?} degrees was not executed: warning {}, {why}",
-                joints.map(|q| (q.to_degrees() * 100.0).round() / 100.0),
-                warn_code::PARAMETER
-            ));
-        };
-        if !(joints.iter().all(|q| q.is_finite()) && speed_rad_s.is_finite() && speed_rad_s > 0.0) {
-            return refuse(
-                self,
-                "a joint or speed that is not a finite positive number".into(),
-            );
-        }
-        if let Some(j) = tactex_sim::arm::uf850::past_limit(joints) {
-            return refuse(self, format!("joint {j} past its limit"));
-        }
-        let tilt = arm_joints::tilt_deg(joints);
-        if tilt > MAX_TILT_DEG {
-            return refuse(
-                self,
-                format!(
-                    "it tilts the pad {tilt:.1} degrees from straight down; the twin presses with the pad down (at most {MAX_TILT_DEG} degrees)"
-                ),
-            );
-        }
-        let target = arm_joints::pose_at(joints);
-        let from = self.planned_pose();
-        let turn = joints
-            .iter()
-            .zip(self.joints)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        let path_mm = (0..3)
-            .map(|i| (target[i] - from[i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let duration_s = turn / speed_rad_s;
-        let speed_mm_s = if duration_s > 0.0 && path_mm > 0.0 {
-            (path_mm / duration_s).min(SERVO_SPEED_MM_S)
-        } else {
-            SERVO_SPEED_MM_S
-        };
-        let queued = self.queue.len();
-        let before = self.joints;
-        self.planned_move(MoveTarget::Base(target), speed_mm_s, now);
-        // The move ends on the commanded branch; the readings follow it from the start.
-        if self.queue.len() > queued || self.pose == target {
-            self.joints = joints;
-        } else {
-            self.joints = before;
-        }
-    }
-
     /// A servo target (servo mode): no queue, the latest target replaces whatever runs, at
     /// the TCP's top speed; one more than 10 mm from the pad is not executed.
     fn servo_to(&mut self, target: MoveTarget, now: Instant) {
@@ -596,15 +570,16 @@ impl Controller {
         self.move_to(target, SERVO_SPEED_MM_S, now);
     }
 
-    /// A linear move of the pad to `target`, checked as a controller checks it.
-    fn move_to(&mut self, target: TcpPoseMm, speed_mm_s: f64, now: Instant) {
+    /// A linear move of the pad to `target`, checked as a controller checks it; whether it
+    /// was accepted.
+    fn move_to(&mut self, target: TcpPoseMm, speed_mm_s: f64, now: Instant) -> bool {
         if !(target.iter().all(|v| v.is_finite()) && speed_mm_s.is_finite() && speed_mm_s > 0.0) {
             self.warning = warn_code::PARAMETER;
             self.notice(format!(
                 "a move to {target:?} at {speed_mm_s} mm/s was not executed: warning {}, a pose or speed that is not a finite positive number",
                 warn_code::PARAMETER
             ));
-            return;
+            return false;
         }
         let pose = world_pose(&self.mount, &target);
         let p = pose.position;
@@ -619,14 +594,16 @@ impl Controller {
                 target[2],
                 -p.z * 1e3
             );
-            return self.fault(error_code::COLLISION, why, now);
+            self.fault(error_code::COLLISION, why, now);
+            return false;
         }
         if p.x.abs() > table[0] / 2.0 || p.y.abs() > table[1] / 2.0 || p.z > self.arm.max_z_m {
             let why = format!(
                 "target ({:.1}, {:.1}, {:.1}) mm is outside the safety boundary over the table",
                 target[0], target[1], target[2]
             );
-            return self.fault(error_code::SAFETY_BOUNDARY, why, now);
+            self.fault(error_code::SAFETY_BOUNDARY, why, now);
+            return false;
         }
         // Queued behind the moves not yet ended, from where the last of them ends.
         let (from, started) = match self.queue.back() {
@@ -652,9 +629,13 @@ impl Controller {
         match checked {
             Ok(()) => {}
             Err(DeviceError::UnsafeMove { reason, .. }) => {
-                return self.fault(error_code::COLLISION, reason, now);
+                self.fault(error_code::COLLISION, reason, now);
+                return false;
             }
-            Err(e) => return self.fault(error_code::COLLISION, e.to_string(), now),
+            Err(e) => {
+                self.fault(error_code::COLLISION, e.to_string(), now);
+                return false;
+            }
         }
         let seconds = (clock_after - clock_before).max(0.0) / self.mount.time_scale;
         // The SDK raises a speed of zero or below to the controller's slowest, 0.1 mm/s, as a
@@ -672,6 +653,7 @@ impl Controller {
         });
         self.last_speed_mm_s = speed_mm_s;
         self.state = motion::MOVING;
+        true
     }
 }
 
@@ -720,12 +702,15 @@ fn lerp(a: &TcpPoseMm, b: &TcpPoseMm, t: f64) -> TcpPoseMm {
     out
 }
 
-/// The target and speed of a MOVE_LINE request in any of the layouts the SDK sends: 9 f32
-/// (pose, speed, acceleration, time), with 1-2 bytes of check and motion type, or 10 f32
-/// (with a blend radius) and 3-4 bytes (coordinate frame, axis-angle, check, motion type).
-/// A joint-interpolated move to a Cartesian pose (motion type 1 or 2) is run as a line:
-/// the twin does not plan joint paths yet, and over a table the two end at the same pose.
-fn move_line_params(params: &[u8]) -> Option<(MoveTarget, f64)> {
+/// MOVE_LINE's motion type that reaches its Cartesian target by joint motion.
+const JOINT_MOTION: u8 = 2;
+
+/// The target, speed and motion type of a MOVE_LINE request in any of the layouts the SDK
+/// sends: 9 f32 (pose, speed, acceleration, time), with 1-2 bytes of check and motion type,
+/// or 10 f32 (with a blend radius) and 3-4 bytes (coordinate frame, axis-angle, check,
+/// motion type). Motion type 0 is a line, 1 a line where one can be run (else joint motion),
+/// 2 joint motion.
+fn move_line_params(params: &[u8]) -> Option<(MoveTarget, f64, u8)> {
     let (floats, tool_frame) = match params.len() {
         36..=38 => (9, false),
         43 | 44 => {
@@ -739,11 +724,14 @@ fn move_line_params(params: &[u8]) -> Option<(MoveTarget, f64)> {
     };
     let v = f32_values(&params[..floats * 4]);
     // Only a check of the move (only_check_type > 0) is not a move.
-    let check = match floats {
-        9 => params.get(36).copied().unwrap_or(0),
-        _ => params[42],
+    let (check, motion_type) = match floats {
+        9 => (
+            params.get(36).copied().unwrap_or(0),
+            params.get(37).copied().unwrap_or(0),
+        ),
+        _ => (params[42], params.get(43).copied().unwrap_or(0)),
     };
-    if check != 0 {
+    if check != 0 || motion_type > JOINT_MOTION {
         return None;
     }
     let pose = [v[0], v[1], v[2], v[3], v[4], v[5]];
@@ -752,21 +740,38 @@ fn move_line_params(params: &[u8]) -> Option<(MoveTarget, f64)> {
     } else {
         MoveTarget::Base(pose)
     };
-    Some((target, v[6]))
+    Some((target, v[6], motion_type))
 }
 
-/// The offset and speed of a MOVE_RELATIVE request: 11 f32 (7 offsets, of which a Cartesian
-/// move reads 6, speed, acceleration, time, radius), then joint-motion and axis-angle flags,
-/// optionally check and motion type. Joint and axis-angle offsets are not spoken.
-fn move_relative_params(params: &[u8]) -> Option<(TcpPoseMm, f64)> {
-    if !(46..=48).contains(&params.len()) || params[44] != 0 || params[45] != 0 {
+/// A MOVE_RELATIVE request: Cartesian offsets (mm, rad) at a speed in mm/s, or joint
+/// offsets (rad) at a joint speed in rad/s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum RelativeMove {
+    /// Offsets, speed and motion type (as MOVE_LINE's).
+    Cartesian(TcpPoseMm, f64, u8),
+    Joints([f64; 6], f64),
+}
+
+/// A MOVE_RELATIVE request: 11 f32 (7 offsets, of which the six-axis arm reads 6, speed,
+/// acceleration, time, radius), then joint-motion and axis-angle flags, optionally check and
+/// motion type. Axis-angle offsets are not spoken.
+fn move_relative_params(params: &[u8]) -> Option<RelativeMove> {
+    if !(46..=48).contains(&params.len()) || params[44] > 1 || params[45] != 0 {
         return None;
     }
     if params.get(46).is_some_and(|&check| check != 0) {
         return None;
     }
+    let motion_type = params.get(47).copied().unwrap_or(0);
+    if motion_type > JOINT_MOTION {
+        return None;
+    }
     let v = f32_values(&params[..44]);
-    Some(([v[0], v[1], v[2], v[3], v[4], v[5]], v[7]))
+    let six = [v[0], v[1], v[2], v[3], v[4], v[5]];
+    Some(match params[44] {
+        1 => RelativeMove::Joints(six, v[7]),
+        _ => RelativeMove::Cartesian(six, v[7], motion_type),
+    })
 }
 
 fn padded(text: &str, n: usize) -> Vec<u8> {
@@ -801,6 +806,11 @@ mod tests {
         assert_eq!(move_line_params(&nine).unwrap().1, 50.0);
         nine.push(0);
         assert!(move_line_params(&nine).is_some());
+        nine.push(2);
+        assert_eq!(move_line_params(&nine).unwrap().2, JOINT_MOTION);
+        nine[37] = 3;
+        assert!(move_line_params(&nine).is_none(), "no motion type 3");
+        nine.pop();
         nine[36] = 1;
         assert!(move_line_params(&nine).is_none(), "only a check");
         let mut ten = f32_params(&[300.0, 0.0, 200.0, 3.1, 0.0, 0.0, 50.0, 500.0, 0.0, -1.0]);
@@ -817,13 +827,20 @@ mod tests {
     }
 
     #[test]
-    fn move_relative_reads_the_sdk_layout_and_refuses_joint_offsets() {
+    fn move_relative_reads_cartesian_and_joint_offsets_and_refuses_axis_angles() {
         let mut p = f32_params(&[0.0, 0.0, -0.25, 0.0, 0.0, 0.0, 0.0, 20.0, 500.0, 0.0, -1.0]);
         p.extend([0, 0]);
-        let (offset, speed) = move_relative_params(&p).unwrap();
+        let Some(RelativeMove::Cartesian(offset, speed, 0)) = move_relative_params(&p) else {
+            panic!("a Cartesian offset");
+        };
         assert_eq!((offset[2], speed), (-0.25, 20.0));
         p[44] = 1;
-        assert!(move_relative_params(&p).is_none(), "joint offsets");
+        assert!(matches!(
+            move_relative_params(&p),
+            Some(RelativeMove::Joints(q, 20.0)) if q[2] == -0.25
+        ));
+        p[45] = 1;
+        assert!(move_relative_params(&p).is_none(), "axis-angle offsets");
     }
 
     #[test]

@@ -373,3 +373,82 @@ def test_sdk_joint_moves_end_on_the_joints_commanded(twin):
     assert max(abs(a - b) for a, b in zip(after[:6], target)) < 0.01, (after, target)
     assert arm.warn_code == 12
     arm.clean_warn()
+
+
+def test_sdk_relative_joint_moves_and_joint_motion_to_a_pose_follow_the_joints(twin):
+    """`set_servo_angle(relative=True)` adds to the joints; the pad follows the joints' arc
+    (a turn of the base keeps the pad at its distance from the base, where a line would cut
+    the chord); a Cartesian move by joint motion (motion type 2) from nearby joints comes
+    back to the same joints; an unreachable one is refused with warning 14."""
+    arm, http = twin
+    arm.motion_enable(enable=True)
+    arm.set_mode(0)
+    arm.set_state(0)
+    assert arm.set_position(380, -60, 200, **DOWN, speed=200, wait=True) == 0
+    _, start = arm.get_servo_angle(is_radian=False)
+    _, start_pose = arm.get_position(is_radian=False)
+    reach = math.hypot(start_pose[0], start_pose[1])
+
+    # The base turns 25 degrees: sampled on the way, the pad stays on its circle (the chord
+    # of a line would pass 9 mm inside it).
+    assert arm.set_servo_angle(angle=[25, 0, 0, 0, 0, 0], relative=True, speed=5,
+                               wait=False) == 0
+    radii = []
+    for _ in range(400):
+        code, pose = arm.get_position(is_radian=False)
+        radii.append(math.hypot(pose[0], pose[1]))
+        if arm.get_state()[1] != 1:
+            break
+        time.sleep(0.005)
+    assert len(radii) > 3, radii
+    assert max(abs(r - reach) for r in radii) < 1.0, (reach, min(radii), max(radii))
+    _, turned = arm.get_servo_angle(is_radian=False)
+    expected = list(start[:6])
+    expected[0] += 25
+    assert max(abs(a - b) for a, b in zip(turned[:6], expected)) < 0.01, (turned, expected)
+
+    # Back to the start pose by joint motion: the same joints as before, within 0.1 degree.
+    assert arm.set_position(*start_pose[:3], **DOWN, speed=100, motion_type=2, wait=True) == 0
+    _, back = arm.get_servo_angle(is_radian=False)
+    assert max(abs(a - b) for a, b in zip(back[:6], start[:6])) < 0.1, (back, start)
+    _, pose = arm.get_position(is_radian=False)
+    assert max(abs(a - b) for a, b in zip(pose[:3], start_pose[:3])) < 0.1, (pose, start_pose)
+
+    # Out of reach by joint motion: not executed, warning 14 (no solution).
+    arm.set_position(2000, 0, 200, **DOWN, speed=100, motion_type=2, wait=True)
+    assert arm.warn_code == 14, notice(http)
+    _, still = arm.get_servo_angle(is_radian=False)
+    assert max(abs(a - b) for a, b in zip(still[:6], start[:6])) < 0.1
+    arm.clean_warn()
+
+
+def test_sdk_servo_joint_targets_run_in_servo_mode(twin):
+    """`set_servo_angle_j` in servo mode (mode 1): each target runs at once, the joints read
+    back as sent; a target whose pad lies over 10 mm away is not executed, nor one in mode 0."""
+    arm, http = twin
+    arm.motion_enable(enable=True)
+    arm.set_mode(0)
+    arm.set_state(0)
+    assert arm.set_position(350, 0, 250, **DOWN, speed=200, wait=True) == 0
+    _, start = arm.get_servo_angle(is_radian=False)
+    arm.set_servo_angle_j([a + 0.2 * (i == 0) for i, a in enumerate(start)], is_radian=False)
+    time.sleep(0.2)
+    assert "mode 0" in notice(http)
+    arm.set_mode(1)
+    arm.set_state(0)
+    target = list(start[:6])
+    for step in range(5):
+        target[0] += 0.2
+        target[5] -= 0.5
+        assert arm.set_servo_angle_j(target + [0], is_radian=False) == 0
+        time.sleep(0.05)
+    time.sleep(0.2)
+    _, now = arm.get_servo_angle(is_radian=False)
+    assert max(abs(a - b) for a, b in zip(now[:6], target)) < 0.01, (now, target)
+    far = list(target)
+    far[0] += 20
+    arm.set_servo_angle_j(far + [0], is_radian=False)
+    time.sleep(0.2)
+    _, after = arm.get_servo_angle(is_radian=False)
+    assert max(abs(a - b) for a, b in zip(after[:6], target)) < 0.01, (after, target)
+    assert "10" in notice(http)
