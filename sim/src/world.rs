@@ -59,6 +59,18 @@ pub const SETTLE_LIMIT_M: f64 = 0.01;
 
 /// Height the tool parks at before a run (m).
 pub const TOOL_PARK_Z_M: f64 = 0.35;
+/// How far beyond the table's -x edge (the arm's side) the tool parks: out of the scene
+/// camera's view while it grounds the objects, as a real arm is parked.
+pub const TOOL_PARK_OUTSIDE_M: f64 = 0.05;
+
+/// Where the tool waits before a run: pointing down beyond the table's -x edge.
+pub fn tool_park_pose(table: &Table) -> Pose {
+    Pose::tool_down(DVec3::new(
+        -table.size_m[0] / 2.0 - TOOL_PARK_OUTSIDE_M,
+        0.0,
+        TOOL_PARK_Z_M,
+    ))
+}
 
 impl SimWorld {
     /// Builds the objects' meshes, drops them onto the table and lets them settle.
@@ -182,7 +194,7 @@ impl SimWorld {
             table: scene.table.clone(),
             camera_pose: scene.camera_pose,
             intrinsics: scene.intrinsics,
-            tool: Pose::tool_down(DVec3::new(0.0, 0.0, TOOL_PARK_Z_M)),
+            tool: tool_park_pose(&scene.table),
             time_s: 0.0,
         })
     }

@@ -34,8 +34,9 @@ pub struct SimCamera {
     intrinsics: CameraIntrinsics,
     pose: Pose,
     renderer: Arc<dyn SceneRenderer>,
-    /// The world does not move while it is watched: one clean render serves every frame.
-    clean: Option<CleanRender>,
+    /// The objects do not move while they are watched: one clean render serves every frame
+    /// until the arm's pad moves (the arm is in the picture once it enters the view).
+    clean: Option<(Pose, CleanRender)>,
     rng: ChaCha8Rng,
     /// Colour noise (grey levels, 1 sigma).
     pub color_noise: f64,
@@ -68,13 +69,20 @@ impl SimCamera {
         self.clean = None;
     }
 
-    /// The scene without noise, with instance ids (the ground truth); rendered once.
+    /// The scene without noise, with instance ids (the ground truth); rendered again only
+    /// when the pad has moved since the last render.
     pub fn clean(&mut self) -> Result<&CleanRender, RenderError> {
-        if self.clean.is_none() {
-            let geometry = SceneGeometry::of_world(&self.world.lock().expect("world lock"));
-            self.clean = Some(self.renderer.render(&geometry)?);
+        let world = self.world.lock().expect("world lock");
+        if self
+            .clean
+            .as_ref()
+            .is_none_or(|(tool, _)| *tool != world.tool)
+        {
+            let geometry = SceneGeometry::of_world(&world);
+            self.clean = Some((world.tool, self.renderer.render(&geometry)?));
         }
-        Ok(self.clean.as_ref().expect("rendered"))
+        drop(world);
+        Ok(&self.clean.as_ref().expect("rendered").1)
     }
 }
 
@@ -98,7 +106,7 @@ impl RgbdCamera for SimCamera {
             device: "sim-rgbd".into(),
             message: e.to_string(),
         })?;
-        let clean = self.clean.as_ref().expect("rendered");
+        let clean = &self.clean.as_ref().expect("rendered").1;
         let k = self.intrinsics;
         let unit = Normal::new(0.0, 1.0).expect("valid");
         let rng = &mut self.rng;

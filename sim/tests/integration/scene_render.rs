@@ -4,6 +4,7 @@
 use glam::DVec3;
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
+use tactex_core::geometry::Pose;
 use tactex_core::scene::Scene;
 use tactex_sim::render::device::DeviceChoice;
 use tactex_sim::render::scene::{
@@ -119,6 +120,81 @@ fn sphere_silhouette_covers_the_projected_disc() {
     );
     // The table is seen everywhere else within the image (the camera looks down at it).
     assert!(render.depth_m.iter().all(|z| *z > 0.0));
+}
+
+/// Every scene shipped in scenes/ (fruits.toml is the catalog), as its world.
+fn shipped_worlds() -> Vec<(String, SimWorld)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    ["demo.toml", "bananas.toml", "meshes.toml"]
+        .into_iter()
+        .map(|name| {
+            let scene = Scene::load(&dir.join(name), &FruitCatalog::builtin()).unwrap();
+            (name.to_string(), SimWorld::from_scene(&scene).unwrap())
+        })
+        .collect()
+}
+
+#[test]
+fn the_parked_arm_is_out_of_every_shipped_scenes_view_while_it_grounds() {
+    for (name, mut world) in shipped_worlds() {
+        let parked = CpuSceneRenderer
+            .render(&SceneGeometry::of_world(&world))
+            .unwrap();
+        // The same world with the arm far above the camera: nothing of it in view.
+        world.tool = Pose::tool_down(DVec3::new(0.0, 0.0, 50.0));
+        let away = CpuSceneRenderer
+            .render(&SceneGeometry::of_world(&world))
+            .unwrap();
+        assert!(
+            parked.depth_m == away.depth_m && parked.color == away.color,
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn the_arm_over_the_table_hides_it_at_the_wrists_depth() {
+    let mut world = sphere_world();
+    let table_only = CpuSceneRenderer
+        .render(&SceneGeometry::of_world(&world))
+        .unwrap();
+    // The pad 0.2 m above the table over the sphere, pointing down: the camera straight
+    // above sees only the top of the wrist link, 0.2 + 0.024 + 0.015 + 0.110 m up.
+    let pad = DVec3::new(0.0, 0.0, 0.2);
+    world.tool = Pose::tool_down(pad);
+    let render = CpuSceneRenderer
+        .render(&SceneGeometry::of_world(&world))
+        .unwrap();
+    let to_camera = world.camera_pose.inverse();
+    let top = to_camera.transform_point(pad + DVec3::Z * (0.024 + 0.015 + 0.110));
+    let (x, y) = world.intrinsics.project(top).unwrap();
+    let (x, y) = (x as u32, y as u32);
+    let i = (y * world.intrinsics.width + x) as usize;
+    assert!(
+        (render.depth_m[i] - top.z).abs() < 1e-4,
+        "{} m, {} m",
+        render.depth_m[i],
+        top.z
+    );
+    assert_eq!(
+        render.instances.get_pixel(x, y)[0],
+        0,
+        "the arm is no object"
+    );
+    // What it hides is the wrist's 75 mm disc seen from that distance: its area in pixels,
+    // within the 24-sided prism's 1%.
+    let k = world.intrinsics;
+    let disc = std::f64::consts::PI * (k.fx * 0.0375 / top.z) * (k.fy * 0.0375 / top.z);
+    let hidden = render
+        .depth_m
+        .iter()
+        .zip(&table_only.depth_m)
+        .filter(|(a, b)| (*a - *b).abs() > 1e-6)
+        .count() as f64;
+    assert!(
+        (hidden / disc - 1.0).abs() < 0.02,
+        "{hidden} px hidden, disc {disc:.0} px"
+    );
 }
 
 /// The GPU path; its tests run in CI (lavapipe) and are ignored elsewhere.

@@ -1,6 +1,7 @@
-//! What the camera sees, as triangles: the table top, the floor below it and every object's
+//! What the camera sees, as triangles: the table top, the floor below it, every object's
 //! mesh with per-vertex normals and a surface texture (a few percent of brightness variation
-//! fixed to the surface, so that two fruits of one kind are not identical).
+//! fixed to the surface, so that two fruits of one kind are not identical), and the arm's
+//! end where the pad is (`tool_body`).
 
 use super::Lighting;
 use crate::world::SimWorld;
@@ -21,7 +22,7 @@ pub struct SceneTriangle {
     pub n: [DVec3; 3],
     /// Linear colour at the corners.
     pub c: [[f64; 3]; 3],
-    /// 0 for the table and floor, i + 1 for object i.
+    /// 0 for the table, the floor and the arm, i + 1 for object i.
     pub id: u16,
 }
 
@@ -104,6 +105,7 @@ impl SceneGeometry {
                 });
             }
         }
+        triangles.extend(super::tool_body::tool_triangles(&world.tool));
         let to_camera = world.camera_pose.inverse();
         triangles.retain(|t| t.p.iter().all(|p| to_camera.transform_point(*p).z > NEAR_M));
         Self {

@@ -10,6 +10,7 @@ mod cpu;
 mod device;
 mod geometry;
 mod gpu;
+mod tool_body;
 
 pub use cpu::CpuSceneRenderer;
 pub use device::{SceneRendererChoice, open_scene_renderer};
@@ -20,7 +21,7 @@ use crate::render::device::RenderError;
 use glam::DVec3;
 use image::{ImageBuffer, Luma};
 
-/// Instance ids per pixel: 0 for the table and floor, i + 1 for object i.
+/// Instance ids per pixel: 0 for the table, the floor and the arm, i + 1 for object i.
 pub type InstanceImage = ImageBuffer<Luma<u16>, Vec<u16>>;
 
 /// A noise-free render with ground truth, row-major at the camera's resolution.
