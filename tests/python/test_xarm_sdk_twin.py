@@ -414,6 +414,15 @@ def test_sdk_relative_joint_moves_and_joint_motion_to_a_pose_follow_the_joints(t
     _, pose = arm.get_position(is_radian=False)
     assert max(abs(a - b) for a, b in zip(pose[:3], start_pose[:3])) < 0.1, (pose, start_pose)
 
+    # A relative turn that takes joint 2 past its limit (the SDK checks only absolute
+    # targets): not executed, warning 12, the joints where they were.
+    arm.set_servo_angle(angle=[0, 200, 0, 0, 0, 0], relative=True, speed=30, wait=True)
+    assert arm.warn_code == 12, notice(http)
+    assert "joint 2" in notice(http)
+    _, still = arm.get_servo_angle(is_radian=False)
+    assert max(abs(a - b) for a, b in zip(still[:6], start[:6])) < 0.1
+    arm.clean_warn()
+
     # Out of reach by joint motion: not executed, warning 14 (no solution).
     arm.set_position(2000, 0, 200, **DOWN, speed=100, motion_type=2, wait=True)
     assert arm.warn_code == 14, notice(http)

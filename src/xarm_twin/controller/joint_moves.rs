@@ -20,6 +20,8 @@ const JOINT_PATH_SEGMENTS: usize = 16;
 /// The SDK's default joint speed (rad/s), for a joint move to a Cartesian target that only
 /// turns the pad (no distance to time it by).
 const DEFAULT_JOINT_SPEED_RAD_S: f64 = 0.35;
+/// The joints' top speed (rad/s): 180 degrees a second, to which the SDK also clamps.
+const MAX_JOINT_SPEED_RAD_S: f64 = std::f64::consts::PI;
 
 impl Controller {
     /// The joints at the end of the queued moves: where a relative joint move starts.
@@ -58,7 +60,7 @@ impl Controller {
     }
 
     /// `set_servo_angle`: a move to `joints` (rad) at `speed_rad_s` of the joint that turns
-    /// most, queued behind the others. Not executed (warning 12) past a joint's limit, or
+    /// most (at most the joints' top speed), queued behind the others. Not executed (warning 12) past a joint's limit, or
     /// where the pad would tilt more than `MAX_TILT_DEG` at the target or on the way.
     pub(super) fn joint_move(&mut self, joints: [f64; 6], speed_rad_s: f64, now: Instant) {
         let command = "set_servo_angle";
@@ -72,6 +74,7 @@ impl Controller {
             .zip(from)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
+        let speed_rad_s = speed_rad_s.min(MAX_JOINT_SPEED_RAD_S);
         self.joint_path(command, from, joints, turn / speed_rad_s, now);
     }
 
@@ -122,10 +125,12 @@ impl Controller {
             .zip(from)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
+        // No joint faster than its top speed, however fast the line would be.
         let duration_s = match path_mm > 0.0 {
             true => path_mm / speed_mm_s,
             false => turn / DEFAULT_JOINT_SPEED_RAD_S,
-        };
+        }
+        .max(turn / MAX_JOINT_SPEED_RAD_S);
         self.joint_path("set_position", from, joints, duration_s, now);
     }
 
@@ -151,13 +156,12 @@ impl Controller {
         }
         let along =
             |t: f64| -> [f64; 6] { std::array::from_fn(|i| from[i] + t * (to[i] - from[i])) };
-        for k in 1..=JOINT_PATH_SEGMENTS {
-            let q = along(k as f64 / JOINT_PATH_SEGMENTS as f64);
-            if let Some(why) = Self::joints_refused(q) {
-                let why = match k == JOINT_PATH_SEGMENTS {
-                    true => why,
-                    false => format!("on the way: {why}"),
-                };
+        if let Some(why) = Self::joints_refused(to) {
+            return self.refuse_joints(command, to, warn_code::PARAMETER, why);
+        }
+        for k in 1..JOINT_PATH_SEGMENTS {
+            if let Some(why) = Self::joints_refused(along(k as f64 / JOINT_PATH_SEGMENTS as f64)) {
+                let why = format!("on the way: {why}");
                 return self.refuse_joints(command, to, warn_code::PARAMETER, why);
             }
         }
