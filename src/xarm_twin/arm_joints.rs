@@ -45,6 +45,18 @@ pub(super) fn joints_for(pose: &TcpPoseMm, from: [f64; 6]) -> Result<[f64; 6], K
     uf850::inverse(&flange(pose), from)
 }
 
+/// Whether `joints` hold the flange at `pose` (to a micrometre and a microradian): a
+/// reading that already holds the pose is kept rather than solved for again.
+pub(super) fn hold(joints: [f64; 6], pose: &TcpPoseMm) -> bool {
+    let at = uf850::forward(joints);
+    let want = flange(pose);
+    (at.position_mm - want.position_mm).length() < 1e-3
+        && (at.rotation.transpose() * want.rotation - glam::DMat3::IDENTITY)
+            .to_cols_array()
+            .iter()
+            .all(|v| v.abs() < 1e-6)
+}
+
 /// Joints as the controller sends them: seven floats, the seventh zero.
 pub(super) fn params(joints: &[f64; 6]) -> Vec<u8> {
     let mut seven = joints.to_vec();

@@ -43,6 +43,9 @@ pub mod reg {
     pub const GET_JOINT_POS: u8 = 42;
     pub const GET_IK: u8 = 43;
     pub const GET_FK: u8 = 44;
+    pub const GET_REDUCED_MODE: u8 = 49;
+    pub const GET_JOINT_TAU: u8 = 55;
+    pub const GET_TCP_POSE_AA: u8 = 91;
     pub const MOVE_RELATIVE: u8 = 83;
 }
 
@@ -61,12 +64,16 @@ pub mod mode {
 pub const SERVO_STEP_MAX_MM: f64 = 10.0;
 /// A move slower than this that would last longer than `SLOW_MOVE_S` is noted.
 const SLOW_SPEED_MM_S: f64 = 1.0;
+/// The controller's slowest TCP speed (mm/s): a slower request runs at it, as the SDK sends.
+const MIN_SPEED_MM_S: f64 = 0.1;
 const SLOW_MOVE_S: f64 = 30.0;
 /// The most a joint target may tilt the pad from straight down (degrees): the twin's contact
 /// and frames are of a pad parallel to the table.
 pub const MAX_TILT_DEG: f64 = 1.0;
 /// Servo targets run at the TCP's top speed.
 pub const SERVO_SPEED_MM_S: f64 = 1000.0;
+/// The pad turns at most this fast in a Cartesian move (rad/s): the joints' top speed.
+const MAX_TURN_RAD_S: f64 = std::f64::consts::PI;
 
 /// Controller error codes the twin raises (`x_code.py`; `tactex_hw::xarm::codes`).
 pub mod error_code {
@@ -137,8 +144,19 @@ pub const HOME: TcpPoseMm = [300.0, 0.0, 300.0, std::f64::consts::PI, 0.0, 0.0];
 struct Moving {
     from: TcpPoseMm,
     to: TcpPoseMm,
+    /// The joints at the move's ends where it runs along the joint path (a joint move's
+    /// line); None where the joints are read from the pose.
+    joints: Option<([f64; 6], [f64; 6])>,
     started: Instant,
     duration: Duration,
+}
+
+/// A part of a joint move's path: the joints at its ends and how long it takes (twin s).
+#[derive(Clone, Copy, Debug)]
+struct JointSegment {
+    from: [f64; 6],
+    to: [f64; 6],
+    seconds: f64,
 }
 
 /// What the report and the control port read of the controller.
@@ -240,6 +258,9 @@ impl Controller {
             && now >= m.started + m.duration
         {
             self.pose = m.to;
+            if let Some((_, to)) = m.joints {
+                self.joints = to;
+            }
             self.queue.pop_front();
         }
         if self.queue.is_empty() && self.state == motion::MOVING {
@@ -249,17 +270,28 @@ impl Controller {
 
     pub fn snapshot(&mut self, now: Instant) -> Snapshot {
         self.advance(now);
-        let (pose, speed) = match self.queue.front() {
+        let (pose, speed, joints) = match self.queue.front().copied() {
             Some(m) if now >= m.started => {
                 let t = (now - m.started).as_secs_f64() / m.duration.as_secs_f64().max(1e-9);
-                (
-                    lerp(&m.from, &m.to, t.clamp(0.0, 1.0)),
-                    self.last_speed_mm_s,
-                )
+                let t = t.clamp(0.0, 1.0);
+                match m.joints {
+                    // Along the joint path the joints are known, and the pose is theirs.
+                    Some((a, b)) => {
+                        let q = std::array::from_fn(|i| a[i] + t * (b[i] - a[i]));
+                        self.joints = q;
+                        (arm_joints::pose_at(q), self.last_speed_mm_s, q)
+                    }
+                    None => {
+                        let pose = lerp(&m.from, &m.to, t);
+                        (pose, self.last_speed_mm_s, self.joints_at(&pose))
+                    }
+                }
             }
-            _ => (self.pose, 0.0),
+            _ => {
+                let pose = self.pose;
+                (pose, 0.0, self.joints_at(&pose))
+            }
         };
-        let joints = self.joints_at(&pose);
         Snapshot {
             state: self.state,
             mode: self.mode,
@@ -378,12 +410,15 @@ impl Controller {
             reg::GET_STATE => Answer::Params(vec![self.snapshot(now).state]),
             reg::GET_CMDNUM => Answer::Params(self.snapshot(now).cmd_num.to_be_bytes().to_vec()),
             reg::GET_ERROR => Answer::Params(vec![self.error, self.warning]),
+            // The notice of what was cleared goes with it.
             reg::CLEAN_ERR => {
                 self.error = 0;
+                self.last_notice = None;
                 Answer::Params(vec![])
             }
             reg::CLEAN_WAR => {
                 self.warning = 0;
+                self.last_notice = None;
                 Answer::Params(vec![])
             }
             reg::SET_MODE => match params.len() {
@@ -408,16 +443,36 @@ impl Controller {
                 _ => Answer::Invalid,
             },
             reg::GET_TCP_POSE => Answer::Params(f32_params(&self.snapshot(now).pose)),
-            reg::GET_JOINT_POS => Answer::Params(arm_joints::params(&self.snapshot(now).joints)),
+            reg::GET_JOINT_POS => match params {
+                [] | [1] => Answer::Params(arm_joints::params(&self.snapshot(now).joints)),
+                // `get_joint_states`: velocities and efforts too, which the twin does not
+                // model; refused at the reply's full length so the SDK answers a code.
+                [n] => Answer::Refused(vec![0; 28 * usize::from(n & 0x0f)]),
+                _ => Answer::Invalid,
+            },
             reg::GET_FK => match params.len() {
                 28 => {
                     let q = f32_values(params);
-                    Answer::Params(f32_params(&arm_joints::pose_at([
-                        q[0], q[1], q[2], q[3], q[4], q[5],
-                    ])))
+                    let q = [q[0], q[1], q[2], q[3], q[4], q[5]];
+                    match q.iter().all(|v| v.is_finite()) {
+                        true => Answer::Params(f32_params(&arm_joints::pose_at(q))),
+                        false => Answer::Refused(vec![0; 24]),
+                    }
                 }
                 _ => Answer::Invalid,
             },
+            // The pose with its orientation as an axis-angle vector (rad).
+            reg::GET_TCP_POSE_AA => {
+                let p = self.snapshot(now).pose;
+                let (axis, angle) =
+                    DQuat::from_euler(EulerRot::ZYX, p[5], p[4], p[3]).to_axis_angle();
+                let r = axis * angle;
+                Answer::Params(f32_params(&[p[0], p[1], p[2], r.x, r.y, r.z]))
+            }
+            // No reduced mode on the twin.
+            reg::GET_REDUCED_MODE => Answer::Params(vec![0]),
+            // Joint torques are not modelled: refused at the reply's full length.
+            reg::GET_JOINT_TAU => Answer::Refused(vec![0; 28]),
             reg::GET_IK => match arm_joints::ik_params(params) {
                 Some((target, reference)) => {
                     let from = reference.unwrap_or(self.joints);
@@ -462,11 +517,13 @@ impl Controller {
             reg::MOVE_JOINT => match params.len() {
                 40 | 41 => {
                     let v = f32_values(&params[..40]);
-                    // A check-only request (the SDK's only_check_type) moves nothing.
-                    if params.get(40).is_none_or(|&check| check == 0) {
-                        self.snapshot(now);
-                        self.joint_move([v[0], v[1], v[2], v[3], v[4], v[5]], v[7], now);
+                    // A check-only request (the SDK's only_check_type) is not spoken, as
+                    // for MOVE_LINE.
+                    if params.get(40).is_some_and(|&check| check != 0) {
+                        return Some(Answer::Invalid);
                     }
+                    self.snapshot(now);
+                    self.joint_move([v[0], v[1], v[2], v[3], v[4], v[5]], v[7], now);
                     Answer::Params(vec![])
                 }
                 _ => Answer::Invalid,
@@ -516,6 +573,9 @@ impl Controller {
     /// branch the arm is on); where the chain cannot reach the pose (the twin moves the pad
     /// in Cartesian space and may take it past the arm's reach), the last joints.
     fn joints_at(&mut self, pose: &TcpPoseMm) -> [f64; 6] {
+        if arm_joints::hold(self.joints, pose) {
+            return self.joints;
+        }
         if let Ok(q) = arm_joints::joints_for(pose, self.joints) {
             self.joints = q;
         }
@@ -526,10 +586,22 @@ impl Controller {
         self.enabled && self.error == 0 && matches!(self.state, motion::MOVING | motion::READY)
     }
 
+    /// Says why a command was not executed by an arm not ready to move (the status byte
+    /// says so for a stopped or faulted arm, not for a paused one).
+    fn not_ready(&mut self, what: &str) {
+        let why = match (self.enabled, self.error, self.state) {
+            (false, _, _) => "motion is not enabled (motion_enable(True))".to_string(),
+            (_, e, _) if e != 0 => format!("error {e} is raised (clean_error())"),
+            (_, _, motion::PAUSED) => "the arm is paused (state 3: set_state(0))".to_string(),
+            (_, _, s) => format!("the arm is in state {s} (set_state(0))"),
+        };
+        self.notice(format!("{what} was not executed: {why}"));
+    }
+
     /// A planned move (position mode), queued behind the others.
     fn planned_move(&mut self, target: MoveTarget, speed_mm_s: f64, now: Instant) {
         if !self.ready() {
-            return;
+            return self.not_ready("a planned move");
         }
         if self.mode != mode::POSITION {
             let m = self.mode;
@@ -545,7 +617,7 @@ impl Controller {
     /// the TCP's top speed; one more than 10 mm from the pad is not executed.
     fn servo_to(&mut self, target: MoveTarget, now: Instant) {
         if !self.ready() {
-            return;
+            return self.not_ready("a servo target");
         }
         if self.mode != mode::SERVO {
             let m = self.mode;
@@ -573,14 +645,43 @@ impl Controller {
     /// A linear move of the pad to `target`, checked as a controller checks it; whether it
     /// was accepted.
     fn move_to(&mut self, target: TcpPoseMm, speed_mm_s: f64, now: Instant) -> bool {
+        self.move_along(target, speed_mm_s, None, now)
+    }
+
+    /// A linear move of the pad to `target`, or one part of a joint move's path (`segment`:
+    /// the joints at its ends and its time), checked as a controller checks it; whether it
+    /// was accepted.
+    fn move_along(
+        &mut self,
+        target: TcpPoseMm,
+        speed_mm_s: f64,
+        segment: Option<JointSegment>,
+        now: Instant,
+    ) -> bool {
         if !(target.iter().all(|v| v.is_finite()) && speed_mm_s.is_finite() && speed_mm_s > 0.0) {
             self.warning = warn_code::PARAMETER;
             self.notice(format!(
-                "a move to {target:?} at {speed_mm_s} mm/s was not executed: warning {}, a pose or speed that is not a finite positive number",
+                "a move to {} at {speed_mm_s} mm/s was not executed: warning {}, a pose or speed that is not a finite positive number",
+                describe_pose(&target),
                 warn_code::PARAMETER
             ));
             return false;
         }
+        let speed_mm_s = speed_mm_s.max(MIN_SPEED_MM_S);
+        let tilt = tilt_deg(&world_pose(&self.mount, &target));
+        if tilt > MAX_TILT_DEG {
+            self.warning = warn_code::PARAMETER;
+            self.notice(format!(
+                "a move to {} was not executed: warning {}, it tilts the pad {tilt:.1} degrees from straight down; the twin presses with the pad down (at most {MAX_TILT_DEG} degrees)",
+                describe_pose(&target),
+                warn_code::PARAMETER
+            ));
+            return false;
+        }
+        let on_path = |why: String| match segment {
+            Some(_) => format!("on the joint move's path: {why}"),
+            None => why,
+        };
         let pose = world_pose(&self.mount, &target);
         let p = pose.position;
         let table = self
@@ -594,7 +695,7 @@ impl Controller {
                 target[2],
                 -p.z * 1e3
             );
-            self.fault(error_code::COLLISION, why, now);
+            self.fault(error_code::COLLISION, on_path(why), now);
             return false;
         }
         if p.x.abs() > table[0] / 2.0 || p.y.abs() > table[1] / 2.0 || p.z > self.arm.max_z_m {
@@ -602,7 +703,20 @@ impl Controller {
                 "target ({:.1}, {:.1}, {:.1}) mm is outside the safety boundary over the table",
                 target[0], target[1], target[2]
             );
-            self.fault(error_code::SAFETY_BOUNDARY, why, now);
+            self.fault(error_code::SAFETY_BOUNDARY, on_path(why), now);
+            return false;
+        }
+        // A line's end the arm cannot hold (out of its reach, or a joint past its limit) is
+        // refused as the controller refuses it: "no solution".
+        if segment.is_none()
+            && let Err(e) = arm_joints::joints_for(&target, self.planned_joints())
+        {
+            self.warning = warn_code::NO_SOLUTION;
+            self.notice(format!(
+                "a move to {} was not executed: warning {}, {e}",
+                describe_pose(&target),
+                warn_code::NO_SOLUTION
+            ));
             return false;
         }
         // Queued behind the moves not yet ended, from where the last of them ends.
@@ -629,15 +743,40 @@ impl Controller {
         match checked {
             Ok(()) => {}
             Err(DeviceError::UnsafeMove { reason, .. }) => {
-                self.fault(error_code::COLLISION, reason, now);
+                self.fault(error_code::COLLISION, on_path(reason), now);
                 return false;
             }
             Err(e) => {
-                self.fault(error_code::COLLISION, e.to_string(), now);
+                self.fault(error_code::COLLISION, on_path(e.to_string()), now);
                 return false;
             }
         }
-        let seconds = (clock_after - clock_before).max(0.0) / self.mount.time_scale;
+        // A joint move's part takes its share of the joint move's time; a line the sim arm's
+        // time, and no less than its turn of the pad takes at the joints' top speed.
+        let twin_seconds = match segment {
+            Some(part) => part.seconds,
+            None => {
+                let turn = world_pose(&self.mount, &from)
+                    .rotation
+                    .angle_between(pose.rotation);
+                (clock_after - clock_before).max(turn / MAX_TURN_RAD_S)
+            }
+        };
+        if let Ok(mut w) = self.world.lock() {
+            w.time_s = clock_before + twin_seconds;
+        }
+        let Ok(duration) =
+            Duration::try_from_secs_f64(twin_seconds.max(0.0) / self.mount.time_scale)
+        else {
+            self.warning = warn_code::PARAMETER;
+            self.notice(format!(
+                "a move to {} lasting {twin_seconds:.3e} s was not executed: warning {}",
+                describe_pose(&target),
+                warn_code::PARAMETER
+            ));
+            return false;
+        };
+        let seconds = duration.as_secs_f64();
         // The SDK raises a speed of zero or below to the controller's slowest, 0.1 mm/s, as a
         // real controller then crawls: say so rather than leave a client waiting unexplained.
         if speed_mm_s < SLOW_SPEED_MM_S && seconds > SLOW_MOVE_S {
@@ -648,13 +787,33 @@ impl Controller {
         self.queue.push_back(Moving {
             from,
             to: target,
+            joints: segment.map(|part| (part.from, part.to)),
             started,
-            duration: Duration::from_secs_f64(seconds),
+            duration,
         });
         self.last_speed_mm_s = speed_mm_s;
         self.state = motion::MOVING;
         true
     }
+}
+
+/// How far a world pose tilts the pad's axis from straight down (degrees).
+fn tilt_deg(pose: &Pose) -> f64 {
+    let down = -pose.transform_vector(DVec3::Z).z;
+    down.clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// An SDK pose as a person reads it: mm and degrees, one decimal.
+fn describe_pose(p: &TcpPoseMm) -> String {
+    format!(
+        "({:.1}, {:.1}, {:.1}) mm, roll/pitch/yaw ({:.1}, {:.1}, {:.1}) degrees",
+        p[0],
+        p[1],
+        p[2],
+        p[3].to_degrees(),
+        p[4].to_degrees(),
+        p[5].to_degrees()
+    )
 }
 
 /// The world pose of the pad at SDK pose `p`: the base's axes are the table's, the

@@ -461,3 +461,78 @@ def test_sdk_servo_joint_targets_run_in_servo_mode(twin):
     _, after = arm.get_servo_angle(is_radian=False)
     assert max(abs(a - b) for a, b in zip(after[:6], target)) < 0.01, (after, target)
     assert "10" in notice(http)
+
+
+def twin_time(http):
+    return json.loads(urllib.request.urlopen(http + "/state").read())["twin_time_s"]
+
+
+def test_sdk_joint_moves_keep_time_wind_past_half_a_turn_and_refuse_a_tilted_line(twin):
+    """A joint move takes its largest turn over the speed sent; joint 6 wound past half a turn
+    and back reads what was sent (not a turn away) and relative moves go on from it; a
+    Cartesian target that tilts the pad is refused with warning 12, as a joint one is."""
+    arm, http = twin
+    arm.motion_enable(enable=True)
+    arm.set_mode(0)
+    arm.set_state(0)
+    assert arm.set_position(350, 0, 250, **DOWN, speed=200, wait=True) == 0
+    _, start = arm.get_servo_angle(is_radian=False)
+    before = twin_time(http)
+    assert arm.set_servo_angle(angle=[25, 0, 0, 0, 0, 0], relative=True, speed=10, wait=True) == 0
+    assert abs(twin_time(http) - before - 2.5) < 0.05, twin_time(http) - before
+
+    wound = list(start[:6])
+    wound[5] = 340
+    assert arm.set_servo_angle(angle=wound, speed=90, wait=True) == 0
+    assert arm.set_servo_angle(angle=list(start[:6]), speed=90, wait=True) == 0
+    _, back = arm.get_servo_angle(is_radian=False)
+    assert max(abs(a - b) for a, b in zip(back[:6], start[:6])) < 0.01, (back, start)
+    assert arm.set_servo_angle(angle=[0, 0, 0, 0, 0, -30], relative=True, speed=90,
+                               wait=True) == 0
+    _, turned = arm.get_servo_angle(is_radian=False)
+    assert abs(turned[5] - (start[5] - 30)) < 0.01, turned
+    assert arm.warn_code == 0, notice(http)
+
+    _, pose = arm.get_position(is_radian=False)
+    arm.set_position(350, 0, 250, roll=180, pitch=20, yaw=0, speed=100, wait=True)
+    assert arm.warn_code == 12, notice(http)
+    assert "tilts the pad" in notice(http)
+    _, still = arm.get_position(is_radian=False)
+    assert max(abs(a - b) for a, b in zip(still[:3], pose[:3])) < 1e-3
+    arm.clean_warn()
+    assert notice(http) == ""
+
+
+def test_raw_requests_with_the_slowest_speeds_neither_panic_nor_hang_the_controller(twin):
+    """Speeds of 1e-30 mm/s and rad/s sent as raw frames (the SDK raises them to the
+    controller's slowest): the moves run at the slowest speed, and the controller answers on."""
+    import struct
+    arm, http = twin
+    arm.motion_enable(enable=True)
+    arm.set_mode(0)
+    arm.set_state(0)
+    assert arm.set_position(350, 0, 250, **DOWN, speed=200, wait=True) == 0
+    _, start = arm.get_servo_angle(is_radian=True)
+
+    def request(sock, register, floats, tail=b""):
+        params = b"".join(struct.pack("<f", v) for v in floats) + tail
+        sock.sendall(struct.pack(">HHHB", 7, 2, 1 + len(params), register) + params)
+        head = sock.recv(7)
+        _, _, length, _ = struct.unpack(">HHHB", head)
+        body = b""
+        while len(body) < length - 1:
+            body += sock.recv(length - 1 - len(body))
+        return body
+
+    with socket.create_connection(("127.0.0.1", XCONF.SocketConf.TCP_CONTROL_PORT)) as s:
+        request(s, 21, [350, 0, 249, math.pi, 0, 0, 1e-30, 500, 0])
+        joints = list(start[:6]) + [0]
+        joints[0] += 0.01
+        request(s, 23, joints + [1e-30, 1, 0])
+        time.sleep(0.2)
+        assert arm.get_state()[1] == 1, "moving, slowly"
+        arm.emergency_stop()
+        arm.motion_enable(enable=True)
+        arm.set_state(0)
+    assert arm.set_position(350, 0, 240, **DOWN, speed=200, wait=True) == 0
+    assert abs(arm.get_position()[1][2] - 240) < 1e-3

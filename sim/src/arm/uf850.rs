@@ -14,6 +14,7 @@
 //! iteration is cheap beside a move's duration.
 
 use glam::{DMat3, DMat4, DVec3};
+use std::f64::consts::TAU;
 
 /// One row of the modified D-H table: the frame i-1 -> i transform is
 /// RotX(alpha_{i-1}) TransX(a_{i-1}) RotZ(theta_i + offset_i) TransZ(d_i).
@@ -257,6 +258,17 @@ pub fn inverse(target: &FlangePose, from: [f64; 6]) -> Result<[f64; 6], Kinemati
             position_mm,
             angle_deg: angle.to_degrees(),
         });
+    }
+    // Turns a whole revolution apart hold the same pose: of them, the one nearest to where
+    // the arm is that lies within the joint's limits (the descent may have wandered a
+    // revolution off, or started from a joint that wound past one).
+    for (j, [lo, hi]) in UF850_LIMITS_RAD.iter().enumerate() {
+        let nearest = q[j] + ((from[j] - q[j]) / TAU).round() * TAU;
+        let within = |v: f64| (*lo..=*hi).contains(&v);
+        q[j] = [nearest, nearest - TAU, nearest + TAU, q[j]]
+            .into_iter()
+            .find(|v| within(*v))
+            .unwrap_or(q[j]);
     }
     if let Some(joint) = past_limit(q) {
         return Err(KinematicsError::PastLimit {

@@ -6,8 +6,8 @@
 //! lines, so the table, the safety box and the crush limit are checked along the arc.
 
 use super::{
-    Controller, MAX_TILT_DEG, MoveTarget, SERVO_SPEED_MM_S, SERVO_STEP_MAX_MM, TcpPoseMm,
-    arm_joints, mode, resolve, warn_code,
+    Controller, JointSegment, MAX_TILT_DEG, MoveTarget, SERVO_SPEED_MM_S, SERVO_STEP_MAX_MM,
+    TcpPoseMm, arm_joints, describe_pose, mode, resolve, warn_code,
 };
 use std::time::Instant;
 use tactex_sim::arm::uf850;
@@ -22,15 +22,24 @@ const JOINT_PATH_SEGMENTS: usize = 16;
 const DEFAULT_JOINT_SPEED_RAD_S: f64 = 0.35;
 /// The joints' top speed (rad/s): 180 degrees a second, to which the SDK also clamps.
 const MAX_JOINT_SPEED_RAD_S: f64 = std::f64::consts::PI;
+/// The joints' slowest speed (rad/s), to which the SDK raises slower ones.
+const MIN_JOINT_SPEED_RAD_S: f64 = 1e-4;
+/// A joint this close past its limit (rad) is taken at the limit: a limit sent as 32-bit
+/// floats rounds a few microradians past it.
+const LIMIT_ROUNDING_RAD: f64 = 1e-5;
+/// The most any joint may turn in one servo-joint target (degrees): the twin's line, as the
+/// 10 mm of a servo Cartesian target (uFactory asks for small, frequent servo steps).
+const SERVO_JOINT_STEP_MAX_DEG: f64 = 3.0;
 
 impl Controller {
     /// The joints at the end of the queued moves: where a relative joint move starts.
-    fn planned_joints(&self) -> [f64; 6] {
-        match self.queue.is_empty() {
-            true => self.joints,
-            false => {
-                arm_joints::joints_for(&self.planned_pose(), self.joints).unwrap_or(self.joints)
-            }
+    pub(super) fn planned_joints(&self) -> [f64; 6] {
+        match self.queue.back() {
+            None => self.joints,
+            Some(last) => match last.joints {
+                Some((_, to)) => to,
+                None => arm_joints::joints_for(&last.to, self.joints).unwrap_or(self.joints),
+            },
         }
     }
 
@@ -74,7 +83,7 @@ impl Controller {
             .zip(from)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
-        let speed_rad_s = speed_rad_s.min(MAX_JOINT_SPEED_RAD_S);
+        let speed_rad_s = speed_rad_s.clamp(MIN_JOINT_SPEED_RAD_S, MAX_JOINT_SPEED_RAD_S);
         self.joint_path(command, from, joints, turn / speed_rad_s, now);
     }
 
@@ -101,19 +110,20 @@ impl Controller {
     pub(super) fn joint_move_to_pose(&mut self, target: MoveTarget, speed_mm_s: f64, now: Instant) {
         let target = resolve(target, &self.planned_pose());
         let from = self.planned_joints();
+        let refuse = |c: &mut Self, code: u8, why: String| {
+            c.warning = code;
+            c.notice(format!(
+                "set_position to {} by joint motion was not executed: warning {code}, {why}",
+                describe_pose(&target)
+            ));
+        };
         let joints = match arm_joints::joints_for(&target, from) {
             Ok(q) => q,
-            Err(e) => {
-                self.warning = warn_code::NO_SOLUTION;
-                return self.notice(format!(
-                    "a joint move to {target:?} was not executed: warning {}, {e}",
-                    warn_code::NO_SOLUTION
-                ));
-            }
+            Err(e) => return refuse(self, warn_code::NO_SOLUTION, e.to_string()),
         };
         if !(speed_mm_s.is_finite() && speed_mm_s > 0.0) {
             let why = format!("a speed of {speed_mm_s} mm/s");
-            return self.refuse_joints("set_position", joints, warn_code::PARAMETER, why);
+            return refuse(self, warn_code::PARAMETER, why);
         }
         let here = self.planned_pose();
         let path_mm = (0..3)
@@ -146,7 +156,7 @@ impl Controller {
         now: Instant,
     ) {
         if !self.ready() {
-            return;
+            return self.not_ready(command);
         }
         if self.mode != mode::POSITION {
             let m = self.mode;
@@ -154,6 +164,7 @@ impl Controller {
                 "a planned move in mode {m} was not executed: planned moves run in mode 0 (set_mode(0), set_state(0))"
             ));
         }
+        let to = onto_limits(to);
         let along =
             |t: f64| -> [f64; 6] { std::array::from_fn(|i| from[i] + t * (to[i] - from[i])) };
         if let Some(why) = Self::joints_refused(to) {
@@ -165,25 +176,32 @@ impl Controller {
                 return self.refuse_joints(command, to, warn_code::PARAMETER, why);
             }
         }
-        let per_segment_s = duration_s.max(0.0) / JOINT_PATH_SEGMENTS as f64;
-        let mut at = self.planned_pose();
+        // The joints run at a constant rate (no acceleration ramp), each part of the path
+        // a line the sim arm checks, together taking the joint move's time.
+        let seconds = duration_s.max(0.0) / JOINT_PATH_SEGMENTS as f64;
+        let mut at = (self.planned_pose(), from);
         for k in 1..=JOINT_PATH_SEGMENTS {
-            let next = arm_joints::pose_at(along(k as f64 / JOINT_PATH_SEGMENTS as f64));
+            let q = along(k as f64 / JOINT_PATH_SEGMENTS as f64);
+            let next = arm_joints::pose_at(q);
             let step_mm = (0..3)
-                .map(|i| (next[i] - at[i]).powi(2))
+                .map(|i| (next[i] - at.0[i]).powi(2))
                 .sum::<f64>()
                 .sqrt();
-            let speed_mm_s = match per_segment_s > 0.0 && step_mm > 0.0 {
-                true => (step_mm / per_segment_s).min(SERVO_SPEED_MM_S),
+            let speed_mm_s = match seconds > 0.0 && step_mm > 0.0 {
+                true => step_mm / seconds,
                 false => SERVO_SPEED_MM_S,
             };
-            if !self.move_to(next, speed_mm_s, now) {
+            let segment = JointSegment {
+                from: at.1,
+                to: q,
+                seconds,
+            };
+            if !self.move_along(next, speed_mm_s, Some(segment), now) {
                 // Stopped on the way (a fault): the readings are the pad's where it stopped.
                 return;
             }
-            at = next;
+            at = (next, q);
         }
-        self.joints = to;
     }
 
     /// `set_servo_angle_j` (servo mode): the joints' pose at once, replacing whatever runs;
@@ -191,7 +209,7 @@ impl Controller {
     /// limit or tilting the pad, is not executed.
     pub(super) fn servo_joints(&mut self, joints: [f64; 6], now: Instant) {
         if !self.ready() {
-            return;
+            return self.not_ready("a servo-joint target");
         }
         if self.mode != mode::SERVO {
             let m = self.mode;
@@ -199,23 +217,51 @@ impl Controller {
                 "a servo-joint target in mode {m} was not executed: servo targets run in mode 1 (set_mode(1), set_state(0))"
             ));
         }
+        let joints = onto_limits(joints);
         if let Some(why) = Self::joints_refused(joints) {
             return self.refuse_joints("set_servo_angle_j", joints, warn_code::PARAMETER, why);
         }
         self.halt(now);
-        let here = self.pose;
+        let (here, from) = (self.pose, self.joints_at_rest());
         let target: TcpPoseMm = arm_joints::pose_at(joints);
         let step = (0..3)
             .map(|i| (target[i] - here[i]).powi(2))
             .sum::<f64>()
             .sqrt();
-        if step > SERVO_STEP_MAX_MM {
+        let turn = joints
+            .iter()
+            .zip(from)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        if step > SERVO_STEP_MAX_MM || turn.to_degrees() > SERVO_JOINT_STEP_MAX_DEG {
             return self.notice(format!(
-                "a servo-joint target whose pad is {step:.1} mm from the pad was not executed: servo steps are at most {SERVO_STEP_MAX_MM} mm"
+                "a servo-joint target {step:.1} mm and {:.1} degrees from where the arm is was not executed: servo steps are at most {SERVO_STEP_MAX_MM} mm and {SERVO_JOINT_STEP_MAX_DEG} degrees a joint",
+                turn.to_degrees()
             ));
         }
-        if self.move_to(target, SERVO_SPEED_MM_S, now) {
-            self.joints = joints;
-        }
+        let segment = JointSegment {
+            from,
+            to: joints,
+            seconds: (step / SERVO_SPEED_MM_S).max(turn / MAX_JOINT_SPEED_RAD_S),
+        };
+        self.move_along(target, SERVO_SPEED_MM_S, Some(segment), now);
     }
+
+    /// The joints where the arm stands once halted: the reading that holds its pose.
+    fn joints_at_rest(&mut self) -> [f64; 6] {
+        let pose = self.pose;
+        self.joints_at(&pose)
+    }
+}
+
+/// Joints within `LIMIT_ROUNDING_RAD` past a limit, put on it.
+fn onto_limits(joints: [f64; 6]) -> [f64; 6] {
+    std::array::from_fn(|j| {
+        let [lo, hi] = uf850::UF850_LIMITS_RAD[j];
+        match joints[j] {
+            q if q > hi && q <= hi + LIMIT_ROUNDING_RAD => hi,
+            q if q < lo && q >= lo - LIMIT_ROUNDING_RAD => lo,
+            q => q,
+        }
+    })
 }
