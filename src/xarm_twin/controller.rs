@@ -582,32 +582,43 @@ impl Controller {
         self.joints
     }
 
-    fn ready(&self) -> bool {
-        self.enabled && self.error == 0 && matches!(self.state, motion::MOVING | motion::READY)
-    }
-
-    /// Says why a command was not executed by an arm not ready to move (the status byte
-    /// says so for a stopped or faulted arm, not for a paused one).
-    fn not_ready(&mut self, what: &str) {
-        let why = match (self.enabled, self.error, self.state) {
-            (false, _, _) => "motion is not enabled (motion_enable(True))".to_string(),
-            (_, e, _) if e != 0 => format!("error {e} is raised (clean_error())"),
-            (_, _, motion::PAUSED) => "the arm is paused (state 3: set_state(0))".to_string(),
-            (_, _, s) => format!("the arm is in state {s} (set_state(0))"),
+    /// Whether `what` can run now: the arm ready to move and in `wanted` mode (planned moves
+    /// in position mode, servo targets in servo mode, as uFactory's manual says); else the
+    /// notice says why it was not executed (the status byte says so for a stopped or
+    /// faulted arm, not for a paused one or one in another mode).
+    fn runs_in(&mut self, what: &str, wanted: u8) -> bool {
+        let why = match (self.enabled, self.error, self.state, self.mode) {
+            (false, ..) => "motion is not enabled (motion_enable(True))".to_string(),
+            (_, e, ..) if e != 0 => format!("error {e} is raised (clean_error())"),
+            (_, _, motion::PAUSED, _) => "the arm is paused (state 3: set_state(0))".to_string(),
+            (_, _, s, _) if !matches!(s, motion::MOVING | motion::READY) => {
+                format!("the arm is in state {s} (set_state(0))")
+            }
+            (.., m) if m != wanted => {
+                let runs = match wanted {
+                    mode::SERVO => "servo targets",
+                    _ => "planned moves",
+                };
+                format!(
+                    "it is in mode {m}: {runs} run in mode {wanted} (set_mode({wanted}), set_state(0))"
+                )
+            }
+            _ => return true,
         };
         self.notice(format!("{what} was not executed: {why}"));
+        false
+    }
+
+    /// Raises warning `code` for `what`, not executed, saying why.
+    fn refuse(&mut self, what: &str, code: u8, why: impl std::fmt::Display) {
+        self.warning = code;
+        self.notice(format!("{what} was not executed: warning {code}, {why}"));
     }
 
     /// A planned move (position mode), queued behind the others.
     fn planned_move(&mut self, target: MoveTarget, speed_mm_s: f64, now: Instant) {
-        if !self.ready() {
-            return self.not_ready("a planned move");
-        }
-        if self.mode != mode::POSITION {
-            let m = self.mode;
-            return self.notice(format!(
-                "a planned move in mode {m} was not executed: planned moves run in mode 0 (set_mode(0), set_state(0))"
-            ));
+        if !self.runs_in("a planned move", mode::POSITION) {
+            return;
         }
         let target = resolve(target, &self.planned_pose());
         self.move_to(target, speed_mm_s, now);
@@ -616,27 +627,16 @@ impl Controller {
     /// A servo target (servo mode): no queue, the latest target replaces whatever runs, at
     /// the TCP's top speed; one more than 10 mm from the pad is not executed.
     fn servo_to(&mut self, target: MoveTarget, now: Instant) {
-        if !self.ready() {
-            return self.not_ready("a servo target");
-        }
-        if self.mode != mode::SERVO {
-            let m = self.mode;
-            return self.notice(format!(
-                "a servo target in mode {m} was not executed: servo targets run in mode 1 (set_mode(1), set_state(0))"
-            ));
+        if !self.runs_in("a servo target", mode::SERVO) {
+            return;
         }
         self.halt(now);
         let here = self.pose;
         let target = resolve(target, &here);
-        let step = DVec3::new(
-            target[0] - here[0],
-            target[1] - here[1],
-            target[2] - here[2],
-        );
-        if step.length() > SERVO_STEP_MAX_MM {
+        let step = distance_mm(&target, &here);
+        if step > SERVO_STEP_MAX_MM {
             return self.notice(format!(
-                "a servo target {:.1} mm from the pad was not executed: servo steps are at most {SERVO_STEP_MAX_MM} mm",
-                step.length()
+                "a servo target {step:.1} mm from the pad was not executed: servo steps are at most {SERVO_STEP_MAX_MM} mm"
             ));
         }
         self.move_to(target, SERVO_SPEED_MM_S, now);
@@ -658,24 +658,18 @@ impl Controller {
         segment: Option<JointSegment>,
         now: Instant,
     ) -> bool {
+        let what = format!("a move to {}", describe_pose(&target));
         if !(target.iter().all(|v| v.is_finite()) && speed_mm_s.is_finite() && speed_mm_s > 0.0) {
-            self.warning = warn_code::PARAMETER;
-            self.notice(format!(
-                "a move to {} at {speed_mm_s} mm/s was not executed: warning {}, a pose or speed that is not a finite positive number",
-                describe_pose(&target),
-                warn_code::PARAMETER
-            ));
+            let why = format!(
+                "a pose or a speed ({speed_mm_s} mm/s) that is not a finite positive number"
+            );
+            self.refuse(&what, warn_code::PARAMETER, why);
             return false;
         }
         let speed_mm_s = speed_mm_s.max(MIN_SPEED_MM_S);
         let tilt = tilt_deg(&world_pose(&self.mount, &target));
         if tilt > MAX_TILT_DEG {
-            self.warning = warn_code::PARAMETER;
-            self.notice(format!(
-                "a move to {} was not executed: warning {}, it tilts the pad {tilt:.1} degrees from straight down; the twin presses with the pad down (at most {MAX_TILT_DEG} degrees)",
-                describe_pose(&target),
-                warn_code::PARAMETER
-            ));
+            self.refuse(&what, warn_code::PARAMETER, tilt_refusal(tilt));
             return false;
         }
         let on_path = |why: String| match segment {
@@ -711,12 +705,7 @@ impl Controller {
         if segment.is_none()
             && let Err(e) = arm_joints::joints_for(&target, self.planned_joints())
         {
-            self.warning = warn_code::NO_SOLUTION;
-            self.notice(format!(
-                "a move to {} was not executed: warning {}, {e}",
-                describe_pose(&target),
-                warn_code::NO_SOLUTION
-            ));
+            self.refuse(&what, warn_code::NO_SOLUTION, e);
             return false;
         }
         // Queued behind the moves not yet ended, from where the last of them ends.
@@ -762,18 +751,14 @@ impl Controller {
                 (clock_after - clock_before).max(turn / MAX_TURN_RAD_S)
             }
         };
+        let duration = Duration::try_from_secs_f64(twin_seconds.max(0.0) / self.mount.time_scale);
         if let Ok(mut w) = self.world.lock() {
-            w.time_s = clock_before + twin_seconds;
+            w.time_s = clock_before + if duration.is_ok() { twin_seconds } else { 0.0 };
         }
-        let Ok(duration) =
-            Duration::try_from_secs_f64(twin_seconds.max(0.0) / self.mount.time_scale)
-        else {
-            self.warning = warn_code::PARAMETER;
-            self.notice(format!(
-                "a move to {} lasting {twin_seconds:.3e} s was not executed: warning {}",
-                describe_pose(&target),
-                warn_code::PARAMETER
-            ));
+        let Ok(duration) = duration else {
+            self.place_pad(&from);
+            let why = format!("it would last {twin_seconds:.3e} s");
+            self.refuse(&what, warn_code::PARAMETER, why);
             return false;
         };
         let seconds = duration.as_secs_f64();
@@ -795,6 +780,18 @@ impl Controller {
         self.state = motion::MOVING;
         true
     }
+}
+
+/// How far apart two SDK poses' positions are (mm).
+fn distance_mm(a: &TcpPoseMm, b: &TcpPoseMm) -> f64 {
+    DVec3::new(a[0] - b[0], a[1] - b[1], a[2] - b[2]).length()
+}
+
+/// Why a pose tilted `tilt_deg` from straight down is not run.
+fn tilt_refusal(tilt_deg: f64) -> String {
+    format!(
+        "it tilts the pad {tilt_deg:.1} degrees from straight down; the twin presses with the pad down (at most {MAX_TILT_DEG} degrees)"
+    )
 }
 
 /// How far a world pose tilts the pad's axis from straight down (degrees).

@@ -13,6 +13,7 @@ import os
 import re
 import signal
 import socket
+import struct
 import subprocess
 import time
 import urllib.request
@@ -269,16 +270,21 @@ def test_sdk_press_equals_what_ask_presses_at_the_same_pose_and_seed(recording_t
 
 
 
+def ready_down_at(arm, x, y, z, speed=200):
+    """Enabled, in position mode and ready, the pad pointing down at (x, y, z) mm."""
+    arm.motion_enable(enable=True)
+    arm.set_mode(0)
+    arm.set_state(0)
+    assert arm.set_position(x, y, z, **DOWN, speed=speed, wait=True) == 0
+
+
 def notice(http):
     return json.loads(urllib.request.urlopen(http + "/state").read())["last_notice"] or ""
 
 
 def test_sdk_relative_tool_and_servo_moves_modes_and_emergency_stop(twin):
     arm, http = twin
-    arm.motion_enable(enable=True)
-    arm.set_mode(0)
-    arm.set_state(0)
-    assert arm.set_position(*LIME_MM, 80, **DOWN, speed=100, wait=True) == 0
+    ready_down_at(arm, *LIME_MM, 80, speed=100)
     # Relative moves add in the base frame; tool-frame moves go along the pad (its +z is
     # down when it points down).
     assert arm.set_position(z=-10, relative=True, speed=50, wait=True) == 0
@@ -351,10 +357,7 @@ def test_sdk_joint_moves_end_on_the_joints_commanded(twin):
     is their forward kinematics, and a target that would tilt the pad (the twin presses with
     the pad down) is not executed, with warning 12."""
     arm, _ = twin
-    arm.motion_enable(enable=True)
-    arm.set_mode(0)
-    arm.set_state(0)
-    assert arm.set_position(350, 0, 250, **DOWN, speed=200, wait=True) == 0
+    ready_down_at(arm, 350, 0, 250)
     _, start = arm.get_servo_angle(is_radian=False)
     target = list(start[:6])
     target[0] += 15   # the base turns
@@ -381,10 +384,7 @@ def test_sdk_relative_joint_moves_and_joint_motion_to_a_pose_follow_the_joints(t
     the chord); a Cartesian move by joint motion (motion type 2) from nearby joints comes
     back to the same joints; an unreachable one is refused with warning 14."""
     arm, http = twin
-    arm.motion_enable(enable=True)
-    arm.set_mode(0)
-    arm.set_state(0)
-    assert arm.set_position(380, -60, 200, **DOWN, speed=200, wait=True) == 0
+    ready_down_at(arm, 380, -60, 200)
     _, start = arm.get_servo_angle(is_radian=False)
     _, start_pose = arm.get_position(is_radian=False)
     reach = math.hypot(start_pose[0], start_pose[1])
@@ -435,10 +435,7 @@ def test_sdk_servo_joint_targets_run_in_servo_mode(twin):
     """`set_servo_angle_j` in servo mode (mode 1): each target runs at once, the joints read
     back as sent; a target whose pad lies over 10 mm away is not executed, nor one in mode 0."""
     arm, http = twin
-    arm.motion_enable(enable=True)
-    arm.set_mode(0)
-    arm.set_state(0)
-    assert arm.set_position(350, 0, 250, **DOWN, speed=200, wait=True) == 0
+    ready_down_at(arm, 350, 0, 250)
     _, start = arm.get_servo_angle(is_radian=False)
     arm.set_servo_angle_j([a + 0.2 * (i == 0) for i, a in enumerate(start)], is_radian=False)
     time.sleep(0.2)
@@ -472,10 +469,7 @@ def test_sdk_joint_moves_keep_time_wind_past_half_a_turn_and_refuse_a_tilted_lin
     and back reads what was sent (not a turn away) and relative moves go on from it; a
     Cartesian target that tilts the pad is refused with warning 12, as a joint one is."""
     arm, http = twin
-    arm.motion_enable(enable=True)
-    arm.set_mode(0)
-    arm.set_state(0)
-    assert arm.set_position(350, 0, 250, **DOWN, speed=200, wait=True) == 0
+    ready_down_at(arm, 350, 0, 250)
     _, start = arm.get_servo_angle(is_radian=False)
     before = twin_time(http)
     assert arm.set_servo_angle(angle=[25, 0, 0, 0, 0, 0], relative=True, speed=10, wait=True) == 0
@@ -506,12 +500,8 @@ def test_sdk_joint_moves_keep_time_wind_past_half_a_turn_and_refuse_a_tilted_lin
 def test_raw_requests_with_the_slowest_speeds_neither_panic_nor_hang_the_controller(twin):
     """Speeds of 1e-30 mm/s and rad/s sent as raw frames (the SDK raises them to the
     controller's slowest): the moves run at the slowest speed, and the controller answers on."""
-    import struct
     arm, http = twin
-    arm.motion_enable(enable=True)
-    arm.set_mode(0)
-    arm.set_state(0)
-    assert arm.set_position(350, 0, 250, **DOWN, speed=200, wait=True) == 0
+    ready_down_at(arm, 350, 0, 250)
     _, start = arm.get_servo_angle(is_radian=True)
 
     def request(sock, register, floats, tail=b""):

@@ -7,7 +7,7 @@
 
 use super::{
     Controller, JointSegment, MAX_TILT_DEG, MoveTarget, SERVO_SPEED_MM_S, SERVO_STEP_MAX_MM,
-    TcpPoseMm, arm_joints, describe_pose, mode, resolve, warn_code,
+    TcpPoseMm, arm_joints, describe_pose, distance_mm, mode, resolve, tilt_refusal, warn_code,
 };
 use std::time::Instant;
 use tactex_sim::arm::uf850;
@@ -44,11 +44,8 @@ impl Controller {
     }
 
     fn refuse_joints(&mut self, command: &str, joints: [f64; 6], code: u8, why: String) {
-        self.warning = code;
-        self.notice(format!(
-            "{command} to {:?} degrees was not executed: warning {code}, {why}",
-            joints.map(|q| (q.to_degrees() * 100.0).round() / 100.0),
-        ));
+        let degrees = joints.map(|q| (q.to_degrees() * 100.0).round() / 100.0);
+        self.refuse(&format!("{command} to {degrees:?} degrees"), code, why);
     }
 
     /// Why the pad cannot stand at `joints` (a joint past its limit, a tilt past
@@ -61,16 +58,13 @@ impl Controller {
             return Some(format!("joint {j} past its limit"));
         }
         let tilt = arm_joints::tilt_deg(joints);
-        (tilt > MAX_TILT_DEG).then(|| {
-            format!(
-                "it tilts the pad {tilt:.1} degrees from straight down; the twin presses with the pad down (at most {MAX_TILT_DEG} degrees)"
-            )
-        })
+        (tilt > MAX_TILT_DEG).then(|| tilt_refusal(tilt))
     }
 
     /// `set_servo_angle`: a move to `joints` (rad) at `speed_rad_s` of the joint that turns
-    /// most (at most the joints' top speed), queued behind the others. Not executed (warning 12) past a joint's limit, or
-    /// where the pad would tilt more than `MAX_TILT_DEG` at the target or on the way.
+    /// most (at most the joints' top speed), queued behind the others. Not executed (warning
+    /// 12) past a joint's limit, or where the pad would tilt more than `MAX_TILT_DEG` at the
+    /// target or on the way.
     pub(super) fn joint_move(&mut self, joints: [f64; 6], speed_rad_s: f64, now: Instant) {
         let command = "set_servo_angle";
         if !(speed_rad_s.is_finite() && speed_rad_s > 0.0) {
@@ -78,13 +72,9 @@ impl Controller {
             return self.refuse_joints(command, joints, warn_code::PARAMETER, why);
         }
         let from = self.planned_joints();
-        let turn = joints
-            .iter()
-            .zip(from)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
         let speed_rad_s = speed_rad_s.clamp(MIN_JOINT_SPEED_RAD_S, MAX_JOINT_SPEED_RAD_S);
-        self.joint_path(command, from, joints, turn / speed_rad_s, now);
+        let duration_s = largest_turn(&joints, &from) / speed_rad_s;
+        self.joint_path(command, from, joints, duration_s, now);
     }
 
     /// `set_servo_angle(..., relative=True)`: the offsets added to the joints the queued
@@ -108,33 +98,20 @@ impl Controller {
     /// would take at `speed_mm_s`. A target the arm cannot reach is not executed (warning
     /// 14, the controller's "no solution").
     pub(super) fn joint_move_to_pose(&mut self, target: MoveTarget, speed_mm_s: f64, now: Instant) {
-        let target = resolve(target, &self.planned_pose());
+        let here = self.planned_pose();
+        let target = resolve(target, &here);
         let from = self.planned_joints();
-        let refuse = |c: &mut Self, code: u8, why: String| {
-            c.warning = code;
-            c.notice(format!(
-                "set_position to {} by joint motion was not executed: warning {code}, {why}",
-                describe_pose(&target)
-            ));
-        };
+        let what = format!("set_position to {} by joint motion", describe_pose(&target));
         let joints = match arm_joints::joints_for(&target, from) {
             Ok(q) => q,
-            Err(e) => return refuse(self, warn_code::NO_SOLUTION, e.to_string()),
+            Err(e) => return self.refuse(&what, warn_code::NO_SOLUTION, e),
         };
         if !(speed_mm_s.is_finite() && speed_mm_s > 0.0) {
             let why = format!("a speed of {speed_mm_s} mm/s");
-            return refuse(self, warn_code::PARAMETER, why);
+            return self.refuse(&what, warn_code::PARAMETER, why);
         }
-        let here = self.planned_pose();
-        let path_mm = (0..3)
-            .map(|i| (target[i] - here[i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let turn = joints
-            .iter()
-            .zip(from)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let path_mm = distance_mm(&target, &here);
+        let turn = largest_turn(&joints, &from);
         // No joint faster than its top speed, however fast the line would be.
         let duration_s = match path_mm > 0.0 {
             true => path_mm / speed_mm_s,
@@ -155,14 +132,8 @@ impl Controller {
         duration_s: f64,
         now: Instant,
     ) {
-        if !self.ready() {
-            return self.not_ready(command);
-        }
-        if self.mode != mode::POSITION {
-            let m = self.mode;
-            return self.notice(format!(
-                "a planned move in mode {m} was not executed: planned moves run in mode 0 (set_mode(0), set_state(0))"
-            ));
+        if !self.runs_in(command, mode::POSITION) {
+            return;
         }
         let to = onto_limits(to);
         let along =
@@ -183,10 +154,7 @@ impl Controller {
         for k in 1..=JOINT_PATH_SEGMENTS {
             let q = along(k as f64 / JOINT_PATH_SEGMENTS as f64);
             let next = arm_joints::pose_at(q);
-            let step_mm = (0..3)
-                .map(|i| (next[i] - at.0[i]).powi(2))
-                .sum::<f64>()
-                .sqrt();
+            let step_mm = distance_mm(&next, &at.0);
             let speed_mm_s = match seconds > 0.0 && step_mm > 0.0 {
                 true => step_mm / seconds,
                 false => SERVO_SPEED_MM_S,
@@ -208,14 +176,8 @@ impl Controller {
     /// a target whose pad lies more than `SERVO_STEP_MAX_MM` from the pad, past a joint's
     /// limit or tilting the pad, is not executed.
     pub(super) fn servo_joints(&mut self, joints: [f64; 6], now: Instant) {
-        if !self.ready() {
-            return self.not_ready("a servo-joint target");
-        }
-        if self.mode != mode::SERVO {
-            let m = self.mode;
-            return self.notice(format!(
-                "a servo-joint target in mode {m} was not executed: servo targets run in mode 1 (set_mode(1), set_state(0))"
-            ));
+        if !self.runs_in("a servo-joint target", mode::SERVO) {
+            return;
         }
         let joints = onto_limits(joints);
         if let Some(why) = Self::joints_refused(joints) {
@@ -224,15 +186,8 @@ impl Controller {
         self.halt(now);
         let (here, from) = (self.pose, self.joints_at_rest());
         let target: TcpPoseMm = arm_joints::pose_at(joints);
-        let step = (0..3)
-            .map(|i| (target[i] - here[i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let turn = joints
-            .iter()
-            .zip(from)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let step = distance_mm(&target, &here);
+        let turn = largest_turn(&joints, &from);
         if step > SERVO_STEP_MAX_MM || turn.to_degrees() > SERVO_JOINT_STEP_MAX_DEG {
             return self.notice(format!(
                 "a servo-joint target {step:.1} mm and {:.1} degrees from where the arm is was not executed: servo steps are at most {SERVO_STEP_MAX_MM} mm and {SERVO_JOINT_STEP_MAX_DEG} degrees a joint",
@@ -264,4 +219,12 @@ fn onto_limits(joints: [f64; 6]) -> [f64; 6] {
             q => q,
         }
     })
+}
+
+/// The largest turn of any joint between two sets of joints (rad).
+fn largest_turn(a: &[f64; 6], b: &[f64; 6]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }

@@ -49,38 +49,47 @@ fn surface_noise(v: DVec3, seed: u64) -> f64 {
     (h % 10_000) as f64 / 10_000.0 - 0.5
 }
 
+/// A flat quad (corners in order round it) with one normal, of the table, floor or arm (id 0).
+pub(super) fn flat_quad(
+    corners: [DVec3; 4],
+    normal: DVec3,
+    color: [f64; 3],
+    out: &mut Vec<SceneTriangle>,
+) {
+    for idx in [[0, 1, 2], [0, 2, 3]] {
+        out.push(SceneTriangle {
+            p: idx.map(|i| corners[i]),
+            n: [normal; 3],
+            c: [color; 3],
+            id: 0,
+        });
+    }
+}
+
 impl SceneGeometry {
     pub fn of_world(world: &SimWorld) -> Self {
         let mut triangles = Vec::new();
-        let flat = |corners: [DVec3; 4], color: [f64; 3], triangles: &mut Vec<SceneTriangle>| {
-            for idx in [[0, 1, 2], [0, 2, 3]] {
-                triangles.push(SceneTriangle {
-                    p: idx.map(|i| corners[i]),
-                    n: [DVec3::Z; 3],
-                    c: [color; 3],
-                    id: 0,
-                });
-            }
-        };
         let [hx, hy] = world.table.size_m.map(|s| s / 2.0);
-        flat(
+        flat_quad(
             [
                 DVec3::new(-hx, -hy, 0.0),
                 DVec3::new(hx, -hy, 0.0),
                 DVec3::new(hx, hy, 0.0),
                 DVec3::new(-hx, hy, 0.0),
             ],
+            DVec3::Z,
             world.table.color,
             &mut triangles,
         );
         let f = FLOOR_HALF_SIZE_M;
-        flat(
+        flat_quad(
             [
                 DVec3::new(-f, -f, -TABLE_HEIGHT_M),
                 DVec3::new(f, -f, -TABLE_HEIGHT_M),
                 DVec3::new(f, f, -TABLE_HEIGHT_M),
                 DVec3::new(-f, f, -TABLE_HEIGHT_M),
             ],
+            DVec3::Z,
             FLOOR_COLOR,
             &mut triangles,
         );

@@ -3,7 +3,7 @@
 //! the extent they occlude the table by, not their detail). They carry instance id 0: the
 //! arm is not an object a question is about.
 
-use super::geometry::SceneTriangle;
+use super::geometry::{SceneTriangle, flat_quad};
 use glam::DVec3;
 use tactex_core::geometry::Pose;
 
@@ -57,18 +57,6 @@ pub(super) fn tool_triangles(tool: &Pose) -> Vec<SceneTriangle> {
     out
 }
 
-/// A flat quad (corners in order) with one normal.
-fn quad(corners: [DVec3; 4], normal: DVec3, color: [f64; 3], out: &mut Vec<SceneTriangle>) {
-    for idx in [[0, 1, 2], [0, 2, 3]] {
-        out.push(SceneTriangle {
-            p: idx.map(|i| corners[i]),
-            n: [normal; 3],
-            c: [color; 3],
-            id: 0,
-        });
-    }
-}
-
 /// An axis-aligned box between corners `lo` and `hi` (tool frame, m).
 fn cuboid(lo: [f64; 3], hi: [f64; 3], color: [f64; 3], out: &mut Vec<SceneTriangle>) {
     let at = |x: usize, y: usize, z: usize| {
@@ -86,7 +74,7 @@ fn cuboid(lo: [f64; 3], hi: [f64; 3], color: [f64; 3], out: &mut Vec<SceneTriang
             };
             let mut normal = DVec3::ZERO;
             normal[axis] = if side == 1 { 1.0 } else { -1.0 };
-            quad(
+            flat_quad(
                 [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)],
                 normal,
                 color,
