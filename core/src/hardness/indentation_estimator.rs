@@ -8,6 +8,7 @@
 //! as a softer object. The object's modulus follows from the compliance ratio and the gel's
 //! modulus.
 
+use crate::hardness::border_level::read_share_of_indentation;
 use crate::hardness::estimate::{
     EstimateError, Evidence, HardnessEstimate, HardnessEstimator, ModulusInterval,
     OWN_FIT_INTERVAL, PhysicsEvidence, PressSequence, Z95, check_gel_share,
@@ -63,7 +64,14 @@ impl HardnessEstimator for IndentationEstimator {
                 })?;
             contact_axes.push(reading.contact_axes_mm);
             within_frame.push(reading.within_frame);
-            peaks.push(reading.peak_mm);
+            // The peak read against the frame's border, as the gel's indentation.
+            let share = read_share_of_indentation(
+                &reading,
+                reading.contact_radius_mm(),
+                spec.gel.thickness_mm,
+                spec.gel.poisson,
+            );
+            peaks.push(reading.peak_mm / share);
             // Once the imprint reaches the frame's edge, the deeper frames' imprints reach it
             // too, and they are not fitted: they are not read (a fruit's contact outgrows a
             // real sensor's frame after about three of the eight).

@@ -5,6 +5,7 @@
 //! whose coverage is measured (`interval_calibration`). The learned estimator is in
 //! tactex-learned.
 
+pub mod border_level;
 pub mod estimate;
 pub mod gel_share_fit;
 pub mod indentation_estimator;

@@ -67,6 +67,16 @@ pub fn integrate_slopes(field: &SlopeField) -> Vec<f64> {
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .map(|(x, y)| z[y * w2 + x].re * scale)
         .collect();
+    let zero = zero_level(&depth, w, h);
+    depth.iter_mut().for_each(|d| *d -= zero);
+    depth
+}
+
+/// The level an indentation map of `w` x `h` is zeroed at: the median of the frame's
+/// border, or its lowest side's where the border is far from level. The gel's surface has
+/// no other reference in a frame; what the estimators model of a reading is read against
+/// the same level.
+pub fn zero_level(depth: &[f64], w: usize, h: usize) -> f64 {
     let mut border: Vec<f64> = (0..w)
         .flat_map(|x| [depth[x], depth[(h - 1) * w + x]])
         .chain((0..h).flat_map(|y| [depth[y * w], depth[y * w + w - 1]]))
@@ -100,8 +110,7 @@ pub fn integrate_slopes(field: &SlopeField) -> Vec<f64> {
         let t = ((unlevel - UNLEVEL_SHARE) / UNLEVEL_BAND + 0.5).clamp(0.0, 1.0);
         zero += t * (lowest - zero);
     }
-    depth.iter_mut().for_each(|d| *d -= zero);
-    depth
+    zero
 }
 
 #[cfg(test)]

@@ -33,6 +33,11 @@ pub struct FrameReading {
     pub contact_outline_px: Option<Vec<[f64; 2]>>,
     /// The imprint's half-depth region stays off the frame's border and the border is level.
     pub within_frame: bool,
+    /// The middle of the imprint's half-depth region (px of this reading); None without one.
+    pub imprint_middle_px: Option<[f64; 2]>,
+    /// The gel's size of one pixel of this reading (mm): the frame's, or twice it where the
+    /// frame was read on 2 x 2 blocks.
+    pub mm_per_px: f64,
 }
 
 impl FrameReading {
@@ -83,7 +88,8 @@ pub fn read_frame(
     // The circle is in the frame's pixels; a fine frame's slopes are read on blocks, so a
     // frame pixel is this many of the reading's.
     let frame_px = slopes.width as f64 / frame.width() as f64;
-    let circle = region_middle(&depth, slopes.width, deep)
+    let middle = region_middle(&depth, slopes.width, deep);
+    let circle = middle
         .and_then(|(x, y)| {
             let middle = ((x + 0.5) / frame_px - 0.5, (y + 0.5) / frame_px - 0.5);
             contact_circle_around(frame, reference, middle)
@@ -117,6 +123,8 @@ pub fn read_frame(
         contact_axes_mm,
         contact_outline_px,
         within_frame,
+        imprint_middle_px: middle.map(|(x, y)| [x, y]),
+        mm_per_px: slopes.mm_per_px,
     })
 }
 
