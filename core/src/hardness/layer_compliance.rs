@@ -116,11 +116,27 @@ fn hertz_half_space_surface(rho: f64) -> f64 {
 /// K(kh): w(rho) / w_half_space(0) = H(rho) - (4 / pi) int_0^inf j1(x)/x (1 - K(x h / a))
 /// J0(x rho) dx, H the half-space's profile; divided by the same at rho = 0.
 pub fn hertz_surface_over_centre(rho: f64, contact_over_thickness: f64, nu: f64) -> f64 {
+    hertz_surface_profile(&[rho], contact_over_thickness, nu)[0]
+}
+
+/// `hertz_surface_over_centre` at each of `rhos`, the centre's value computed once.
+pub fn hertz_surface_profile(rhos: &[f64], contact_over_thickness: f64, nu: f64) -> Vec<f64> {
     let aoh = contact_over_thickness;
-    let half_space = hertz_half_space_surface(rho.abs());
     if aoh.is_nan() || aoh <= 0.0 {
-        return half_space;
+        return rhos
+            .iter()
+            .map(|r| hertz_half_space_surface(r.abs()))
+            .collect();
     }
+    // The same integral at the centre (`hertz_centre_compliance_ratio`), on the same nodes.
+    let centre = layer_surface_under_hertz(0.0, aoh, nu);
+    rhos.iter()
+        .map(|&rho| layer_surface_under_hertz(rho.abs(), aoh, nu) / centre)
+        .collect()
+}
+
+/// The layer's surface at rho, over the half-space's centre displacement.
+fn layer_surface_under_hertz(rho: f64, aoh: f64, nu: f64) -> f64 {
     let j1_over_x = |x: f64| {
         if x < 1e-3 {
             1.0 / 3.0 - x * x / 30.0
@@ -130,17 +146,17 @@ pub fn hertz_surface_over_centre(rho: f64, contact_over_thickness: f64, nu: f64)
     };
     let f =
         |x: f64| j1_over_x(x) * (1.0 - normal_compliance_ratio(x / aoh, nu)) * bessel_j0(x * rho);
-    let end = 40.0 * aoh;
+    // 1 - K is below 1e-8 of its start past kh = 15 (it decays like e^(-2kh)).
+    let end = 15.0 * aoh;
     // Simpson's rule at 40 nodes or more per period of j1 and of J0(x rho).
-    let step = 0.15f64.min(0.15 / rho.abs().max(1e-9));
+    let step = 0.15f64.min(0.15 / rho.max(1e-9));
     let n = ((end / step).ceil() as usize).clamp(400, 200_000) & !1;
     let dx = end / n as f64;
     let mut sum = f(0.0) + f(end);
     for i in 1..n {
         sum += if i % 2 == 1 { 4.0 } else { 2.0 } * f(i as f64 * dx);
     }
-    let layer = half_space - 4.0 / std::f64::consts::PI * sum * dx / 3.0;
-    layer / hertz_centre_compliance_ratio(aoh, nu)
+    hertz_half_space_surface(rho) - 4.0 / std::f64::consts::PI * sum * dx / 3.0
 }
 
 /// The same ratio under an elliptical Hertz pressure p0 sqrt(1 - x^2/a^2 - y^2/b^2) of semi-axes

@@ -77,10 +77,20 @@ pub fn integrate_slopes(field: &SlopeField) -> Vec<f64> {
 /// no other reference in a frame; what the estimators model of a reading is read against
 /// the same level.
 pub fn zero_level(depth: &[f64], w: usize, h: usize) -> f64 {
-    let mut border: Vec<f64> = (0..w)
-        .flat_map(|x| [depth[x], depth[(h - 1) * w + x]])
-        .chain((0..h).flat_map(|y| [depth[y * w], depth[y * w + w - 1]]))
-        .collect();
+    let sides = [
+        (0..w).map(|x| depth[x]).collect(),
+        (0..w).map(|x| depth[(h - 1) * w + x]).collect(),
+        (0..h).map(|y| depth[y * w]).collect(),
+        (0..h).map(|y| depth[y * w + w - 1]).collect(),
+    ];
+    let peak = depth.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    zero_level_of_border(&sides, peak)
+}
+
+/// `zero_level` from the map's four sides (top, bottom, left, right, each with its corners)
+/// and its highest value: all of the map the level depends on.
+pub fn zero_level_of_border(sides: &[Vec<f64>; 4], peak: f64) -> f64 {
+    let mut border: Vec<f64> = sides.iter().flatten().copied().collect();
     border.sort_by(f64::total_cmp);
     let mut zero = border[border.len() / 2];
     // An imprint that runs off the frame along one side (a banana lying along the rows,
@@ -91,20 +101,15 @@ pub fn zero_level(depth: &[f64], w: usize, h: usize) -> f64 {
         let k = v.len() / 2;
         *v.select_nth_unstable_by(k, f64::total_cmp).1
     };
-    let sides = [
-        side_median((0..w).map(|x| depth[x]).collect()),
-        side_median((0..w).map(|x| depth[(h - 1) * w + x]).collect()),
-        side_median((0..h).map(|y| depth[y * w]).collect()),
-        side_median((0..h).map(|y| depth[y * w + w - 1]).collect()),
-    ];
-    let (lowest, highest) = sides
+    let medians = sides.clone().map(side_median);
+    let (lowest, highest) = medians
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
             (lo.min(*s), hi.max(*s))
         });
     // Blended across a band round the threshold rather than switched: the level of an
     // imprint running off the frame must not jump with a tenth of a grey level.
-    let peak = depth.iter().copied().fold(f64::NEG_INFINITY, f64::max) - zero;
+    let peak = peak - zero;
     if peak > 0.0 {
         let unlevel = (highest - lowest) / peak;
         let t = ((unlevel - UNLEVEL_SHARE) / UNLEVEL_BAND + 0.5).clamp(0.0, 1.0);
