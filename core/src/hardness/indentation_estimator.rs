@@ -64,13 +64,18 @@ impl HardnessEstimator for IndentationEstimator {
                 })?;
             contact_axes.push(reading.contact_axes_mm);
             within_frame.push(reading.within_frame);
-            // The peak read against the frame's border, as the gel's indentation.
-            let share = read_share_of_indentation(
-                &reading,
-                reading.contact_radius_mm(),
-                spec.gel.thickness_mm,
-                spec.gel.poisson,
-            );
+            // The peak read against the frame's border, as the gel's indentation. An imprint
+            // that reaches the border is zeroed on it and read short instead, which the
+            // layer's surface does not describe: its peak is taken as read.
+            let share = match reading.within_frame {
+                true => read_share_of_indentation(
+                    &reading,
+                    reading.contact_radius_mm(),
+                    spec.gel.thickness_mm,
+                    spec.gel.poisson,
+                ),
+                false => 1.0,
+            };
             peaks.push(reading.peak_mm / share);
             // Once the imprint reaches the frame's edge, the deeper frames' imprints reach it
             // too, and they are not fitted: they are not read (a fruit's contact outgrows a
