@@ -14,6 +14,7 @@ use crate::hardness::estimate::{
     OWN_FIT_INTERVAL, PhysicsEvidence, PressSequence, Z95, check_gel_share,
 };
 use crate::hardness::gel_share_fit::{ShareFit, fit_gel_share, gel_share};
+use crate::hardness::interval_calibration::ELONGATED_ASPECT;
 use crate::hardness::layer_compliance::hertz_ellipse_centre_compliance_ratio;
 use crate::hardness::scale::Hardness;
 use crate::hertz::Elastic;
@@ -67,7 +68,8 @@ impl HardnessEstimator for IndentationEstimator {
             // The peak read against the frame's border, as the gel's indentation. An imprint
             // that reaches the border is zeroed on it and read short instead, which the
             // layer's surface does not describe: its peak is taken as read.
-            let share = match reading.within_frame {
+            let [wide, narrow] = reading.contact_axes_mm;
+            let share = match wide < ELONGATED_ASPECT * narrow {
                 true => read_share_of_indentation(
                     &reading,
                     reading.contact_radius_mm(),
