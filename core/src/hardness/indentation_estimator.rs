@@ -65,9 +65,10 @@ impl HardnessEstimator for IndentationEstimator {
                 })?;
             contact_axes.push(reading.contact_axes_mm);
             within_frame.push(reading.within_frame);
-            // The peak read against the frame's border, as the gel's indentation. An imprint
-            // that reaches the border is zeroed on it and read short instead, which the
-            // layer's surface does not describe: its peak is taken as read.
+            // The peak read against the frame's border, as the gel's indentation. The model
+            // is a round contact: an elongated one (a banana's) reaches the border along its
+            // long axis, where the circle of its area does not, so its peak is taken as read
+            // (it is recentred by its own calibration group).
             let [wide, narrow] = reading.contact_axes_mm;
             let share = match wide < ELONGATED_ASPECT * narrow {
                 true => read_share_of_indentation(
