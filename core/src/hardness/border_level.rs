@@ -2,39 +2,43 @@
 //! the frame's border (`tactile::depth::zero_level`), and a thin, near-incompressible gel
 //! rises round a wide contact, so where the contact fills the frame the border stands above
 //! the undisturbed gel and the peak reads deeper than the gel was pressed (the deeper, the
-//! more). The layer model (`layer_compliance::hertz_surface_over_centre`) gives the gel's
+//! more). The layer model (`layer_compliance::hertz_surface_profile`) gives the gel's
 //! surface round a contact of the size read; zeroed on the same border as the reading, its
 //! peak is the share of the true indentation the reading shows.
 
+use crate::hardness::interval_calibration::ELONGATED_ASPECT;
 use crate::hardness::layer_compliance::hertz_surface_profile;
 use crate::tactile::depth::zero_level_of_border;
 use crate::tactile::frame_reading::FrameReading;
+use crate::tactile::spec::GelSpec;
 
-/// Points along the frame's long sides (the short ones in proportion): the level needs the border's shape, not every pixel.
+/// Points along the frame's long sides (the short ones in proportion): the level needs the
+/// border's shape, not every pixel.
 const SIDE_SAMPLES: usize = 64;
 /// Radii the surface is computed at between the border's nearest and furthest points: it is
 /// smooth there (outside the contact or across a wide one), and each costs an integral.
 const PROFILE_SAMPLES: usize = 24;
 
-/// The reading's peak over the gel's centre indentation, for a reading whose contact has
-/// radius `contact_radius_mm` (the circle of its area) on a gel of `thickness_mm` and
-/// Poisson ratio `poisson`; 1 where the reading has no imprint middle to centre it on.
-pub fn read_share_of_indentation(
-    reading: &FrameReading,
-    contact_radius_mm: f64,
-    thickness_mm: f64,
-    poisson: f64,
-) -> f64 {
+/// The reading's peak over the gel's centre indentation, its contact taken as the circle of
+/// its area on `gel`; 1 where the reading has no imprint middle to centre it on, or where its
+/// contact is elongated (aspect `ELONGATED_ASPECT` or more, a banana's): that one reaches the
+/// border along its long axis, where the circle does not, and is recentred by its own
+/// calibration group instead.
+pub fn read_share_of_indentation(reading: &FrameReading, gel: &GelSpec) -> f64 {
     let Some(middle_px) = reading.imprint_middle_px else {
         return 1.0;
     };
+    let [wide, narrow] = reading.contact_axes_mm;
+    if wide >= ELONGATED_ASPECT * narrow {
+        return 1.0;
+    }
     share_in_frame(
         [reading.width, reading.height],
         reading.mm_per_px,
         middle_px,
-        contact_radius_mm,
-        thickness_mm,
-        poisson,
+        reading.contact_radius_mm(),
+        gel.thickness_mm,
+        gel.poisson,
     )
 }
 
@@ -130,6 +134,43 @@ mod tests {
         assert!(
             (share - expected).abs() < 0.01 * expected,
             "{share} vs {expected}"
+        );
+    }
+
+    #[test]
+    fn a_reading_takes_the_share_of_its_round_contact_and_none_for_an_elongated_one() {
+        let gel = GelSpec {
+            modulus_mpa: 0.3,
+            poisson: 0.49,
+            thickness_mm: 4.0,
+        };
+        let reading = |axes: [f64; 2], middle: Option<[f64; 2]>| FrameReading {
+            width: FRAME[0],
+            height: FRAME[1],
+            indentation_mm: vec![0.0; FRAME[0] * FRAME[1]],
+            valid: vec![true; FRAME[0] * FRAME[1]],
+            peak_mm: 0.5,
+            contact_axes_mm: axes,
+            contact_outline_px: None,
+            within_frame: true,
+            imprint_middle_px: middle,
+            mm_per_px: MM_PER_PX,
+        };
+        // A round contact: the share of the circle of its area (5 mm).
+        let round = read_share_of_indentation(&reading([6.25, 4.0], Some(MIDDLE)), &gel);
+        let circle = share_in_frame(FRAME, MM_PER_PX, MIDDLE, 5.0, 4.0, 0.49);
+        assert!(
+            (round - circle).abs() < 1e-12 && round > 1.05,
+            "{round} vs {circle}"
+        );
+        // A banana's contact of the same area, and a reading with no imprint: as read.
+        assert_eq!(
+            read_share_of_indentation(&reading([10.0, 2.5], Some(MIDDLE)), &gel),
+            1.0
+        );
+        assert_eq!(
+            read_share_of_indentation(&reading([6.25, 4.0], None), &gel),
+            1.0
         );
     }
 }

@@ -14,7 +14,6 @@ use crate::hardness::estimate::{
     OWN_FIT_INTERVAL, PhysicsEvidence, PressSequence, Z95, check_gel_share,
 };
 use crate::hardness::gel_share_fit::{ShareFit, fit_gel_share, gel_share};
-use crate::hardness::interval_calibration::ELONGATED_ASPECT;
 use crate::hardness::layer_compliance::hertz_ellipse_centre_compliance_ratio;
 use crate::hardness::scale::Hardness;
 use crate::hertz::Elastic;
@@ -65,20 +64,8 @@ impl HardnessEstimator for IndentationEstimator {
                 })?;
             contact_axes.push(reading.contact_axes_mm);
             within_frame.push(reading.within_frame);
-            // The peak read against the frame's border, as the gel's indentation. The model
-            // is a round contact: an elongated one (a banana's) reaches the border along its
-            // long axis, where the circle of its area does not, so its peak is taken as read
-            // (it is recentred by its own calibration group).
-            let [wide, narrow] = reading.contact_axes_mm;
-            let share = match wide < ELONGATED_ASPECT * narrow {
-                true => read_share_of_indentation(
-                    &reading,
-                    reading.contact_radius_mm(),
-                    spec.gel.thickness_mm,
-                    spec.gel.poisson,
-                ),
-                false => 1.0,
-            };
+            // The peak read against the frame's border, as the gel's indentation.
+            let share = read_share_of_indentation(&reading, &spec.gel);
             peaks.push(reading.peak_mm / share);
             // Once the imprint reaches the frame's edge, the deeper frames' imprints reach it
             // too, and they are not fitted: they are not read (a fruit's contact outgrows a
