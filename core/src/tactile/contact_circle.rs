@@ -91,7 +91,7 @@ fn circle_of(magnitude: &FloatImage, starts: Vec<(f64, f64)>) -> Option<ContactC
     let (centre, radius, edge) = starts
         .into_iter()
         .filter_map(|start| circle_from(magnitude, start, reach))
-        .filter(|(_, radius, _)| (3.0..=reach).contains(radius))
+        .filter(|(_, radius, _)| (3.0..=0.5 * w.max(h)).contains(radius))
         .max_by_key(|(_, _, edge)| edge.len())?;
     let rms = (edge
         .iter()
@@ -203,39 +203,62 @@ fn imprint_starts(change: &[FloatImage; 3]) -> Vec<(f64, f64)> {
     starts
 }
 
-/// On each ray from `centre`, the edge: halfway between the colour change's peak and its
-/// steepest fall just outside it. Rays that leave the frame before half their length, or
-/// peak at either end, give none.
+/// On each ray from `centre`, the edge: halfway between the change's peak within `reach`
+/// and its steepest fall just outside it. When most rays are still rising at the reach (a
+/// round contact wider than it), those follow on towards the frame's border until the change
+/// falls below half its peak; a few rising rays are a strip's length or noise, not a wider
+/// contact, and give none. Rays that leave the frame before half the reach, or before the
+/// fall, or peak at the start, give none.
 fn ray_edges(magnitude: &FloatImage, centre: (f64, f64), reach: f64) -> Vec<[f64; 2]> {
     let (w, h) = (magnitude.width() as f64, magnitude.height() as f64);
     let steps = ((reach - RAY_START_PX) / RAY_STEP_PX) as usize;
+    let search = (FALL_SEARCH_PX / RAY_STEP_PX) as usize;
+    let sample = |(dx, dy): (f64, f64), i: usize| {
+        let r = RAY_START_PX + i as f64 * RAY_STEP_PX;
+        let (x, y) = (centre.0 + r * dx, centre.1 + r * dy);
+        (x >= 0.0 && y >= 0.0 && x <= w - 1.0 && y <= h - 1.0).then(|| bilinear(magnitude, x, y))
+    };
+    // Each ray within the reach: its direction, samples and peak.
+    let rays: Vec<((f64, f64), Vec<f32>, usize)> = (0..RAYS)
+        .filter_map(|k| {
+            let angle = std::f64::consts::TAU * k as f64 / RAYS as f64;
+            let direction = (angle.cos(), angle.sin());
+            let samples: Vec<f32> = (0..steps).map_while(|i| sample(direction, i)).collect();
+            let peak = samples
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.total_cmp(b.1))
+                .map_or(0, |(i, _)| i);
+            (samples.len() >= steps / 2).then_some((direction, samples, peak))
+        })
+        .collect();
+    let rising = rays.iter().filter(|(_, _, peak)| peak + 1 == steps).count();
+    let follow_on = rising >= RAYS / 2;
     let mut edges = Vec::with_capacity(RAYS);
-    for k in 0..RAYS {
-        let angle = std::f64::consts::TAU * k as f64 / RAYS as f64;
-        let (dx, dy) = (angle.cos(), angle.sin());
-        let mut samples = Vec::with_capacity(steps);
-        for i in 0..steps {
-            let r = RAY_START_PX + i as f64 * RAY_STEP_PX;
-            let (x, y) = (centre.0 + r * dx, centre.1 + r * dy);
-            if x < 0.0 || y < 0.0 || x > w - 1.0 || y > h - 1.0 {
-                break;
+    for (direction, mut samples, mut peak) in rays {
+        if peak + 1 == steps {
+            if !follow_on {
+                continue;
             }
-            samples.push(bilinear(magnitude, x, y));
+            let mut fell = false;
+            while let Some(v) = sample(direction, samples.len()) {
+                samples.push(v);
+                if v < 0.5 * samples[peak] && samples.len() > peak + search {
+                    fell = true;
+                    break;
+                }
+                if v > samples[peak] {
+                    peak = samples.len() - 1;
+                }
+            }
+            if !fell {
+                continue;
+            }
         }
-        if samples.len() < steps / 2 {
-            continue;
-        }
-        let peak = samples
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.total_cmp(b.1))
-            .map(|(i, _)| i)
-            .unwrap_or(0);
         if peak == 0 {
             continue;
         }
         // The steepest fall (central differences) within FALL_SEARCH_PX past the peak.
-        let search = (FALL_SEARCH_PX / RAY_STEP_PX) as usize;
         let fall = (peak..(peak + search).min(samples.len() - 1))
             .map(|i| (i, samples[i + 1] - samples[i.max(1) - 1]))
             .min_by(|a, b| a.1.total_cmp(&b.1))
@@ -244,7 +267,7 @@ fn ray_edges(magnitude: &FloatImage, centre: (f64, f64), reach: f64) -> Vec<[f64
             continue;
         };
         let r = RAY_START_PX + (peak + fall) as f64 / 2.0 * RAY_STEP_PX;
-        edges.push([centre.0 + r * dx, centre.1 + r * dy]);
+        edges.push([centre.0 + r * direction.0, centre.1 + r * direction.1]);
     }
     edges
 }
@@ -424,6 +447,21 @@ mod tests {
                 (c.region_area_px2 / disc - 1.0).abs() < 0.1,
                 "{}",
                 c.region_area_px2
+            );
+        }
+    }
+
+    #[test]
+    fn a_contact_wider_than_the_rays_reach_is_followed_to_its_edge() {
+        // Reach 0.45 x 200 = 90 px: one contact inside the frame beyond it, one cut by the
+        // frame's long sides (whose rays along the short side give no edge).
+        for a in [94.0, 108.0] {
+            let (frame, reference) = hertz_press((240, 200), (120.0, 100.0), a, 2.0 * a);
+            let c = estimate_contact_circle(&frame, &reference).expect("a circle");
+            assert!(
+                (c.radius_px - a).abs() < 1.0,
+                "radius {} vs {a}",
+                c.radius_px
             );
         }
     }
