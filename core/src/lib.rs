@@ -22,6 +22,7 @@ pub mod file_failure;
 pub mod frames;
 pub mod geometry;
 pub mod ground;
+pub mod hand_eye;
 pub mod hardness;
 pub mod hertz;
 pub mod image_file;

@@ -1,0 +1,198 @@
+//! Hand-eye calibration, eye-to-hand: where a fixed camera stands in the robot's base frame,
+//! from stations at which the arm holds a calibration board on its flange and the camera
+//! sees it (TactEx calibrates its RealSense to the xArm so with a ChArUco board). At station
+//! i the flange's pose F_i (the arm's kinematics) and the board's pose C_i in the camera
+//! (from its corners) close a loop with the two unknowns, the camera in the base X and the
+//! board on the flange Z: F_i Z = X C_i. Between stations i and j that is A X = X B, with
+//! A = F_j F_i^-1 (the flange's motion, base frame) and B = C_j C_i^-1 (the board's motion,
+//! camera frame).
+//!
+//! The rotation comes from either closed form (`HandEyeMethod`), the translation from the
+//! stacked (R_A - I) t_X = R_X t_B - t_A by least squares; each station's residual is the
+//! board's pose predicted from X and Z against the one seen.
+
+mod rotation_fit;
+
+use crate::geometry::Pose;
+use glam::{DMat3, DQuat, DVec3};
+use serde::Serialize;
+
+/// One station: the flange in the base frame and the board as the camera saw it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Station {
+    pub flange_in_base: Pose,
+    pub board_in_camera: Pose,
+}
+
+/// How the camera's rotation is solved from the stations' motions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum HandEyeMethod {
+    /// Tsai and Lenz (1989): modified Rodrigues vectors, linear least squares.
+    TsaiLenz,
+    /// Park and Martin (1994): rotation logarithms aligned by orthogonal Procrustes.
+    ParkMartin,
+}
+
+/// The calibration: the camera in the base, the board on the flange, and how well they
+/// explain each station.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HandEyeSolution {
+    pub method: HandEyeMethod,
+    pub camera_in_base: Pose,
+    pub board_in_flange: Pose,
+    pub residuals: Vec<StationResidual>,
+}
+
+/// A station's board pose predicted by the solution against the one seen.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct StationResidual {
+    pub rotation_deg: f64,
+    pub translation_mm: f64,
+}
+
+/// Station sets that cannot fix the camera's pose, each named for what is missing.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum HandEyeError {
+    #[error("hand-eye needs at least 3 stations; got {0}")]
+    TooFewStations(usize),
+    #[error(
+        "the stations' motions do not rotate the flange (pure translations fix no camera rotation); turn the flange between stations"
+    )]
+    NoRotation,
+    #[error(
+        "every motion turns the flange about one axis, so the camera's turn about it and its offset along it are unknown; turn it about at least two axes"
+    )]
+    OneAxis,
+}
+
+/// The smallest turn (degrees) a pair of stations must make to count as a rotation: below
+/// it, a pose estimate's noise is the motion's axis.
+const MIN_TURN_DEG: f64 = 2.0;
+/// The second rotation axis must carry at least this share of the first's weight.
+const MIN_SECOND_AXIS_SHARE: f64 = 1e-3;
+
+/// The camera's pose in the base from the stations, by `method`.
+pub fn solve_hand_eye(
+    stations: &[Station],
+    method: HandEyeMethod,
+) -> Result<HandEyeSolution, HandEyeError> {
+    if stations.len() < 3 {
+        return Err(HandEyeError::TooFewStations(stations.len()));
+    }
+    let motions = motions(stations);
+    if motions.is_empty() {
+        return Err(HandEyeError::NoRotation);
+    }
+    let rotation = match method {
+        HandEyeMethod::TsaiLenz => rotation_fit::tsai_lenz(&motions),
+        HandEyeMethod::ParkMartin => rotation_fit::park_martin(&motions),
+    }?;
+    let position = translation(&motions, rotation)?;
+    let camera_in_base = Pose::new(position, rotation);
+    let board_in_flange = board_on_flange(stations, &camera_in_base);
+    let residuals = stations
+        .iter()
+        .map(|s| residual(s, &camera_in_base, &board_in_flange))
+        .collect();
+    Ok(HandEyeSolution {
+        method,
+        camera_in_base,
+        board_in_flange,
+        residuals,
+    })
+}
+
+/// `a` after `b`: the transform taking b's local frame through b, then a.
+pub(crate) fn compose(a: &Pose, b: &Pose) -> Pose {
+    Pose::new(a.transform_point(b.position), a.rotation * b.rotation)
+}
+
+/// A pair of stations' motions: A (the flange, base frame) and B (the board, camera frame).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Motion {
+    pub a: Pose,
+    pub b: Pose,
+}
+
+/// Every pair of stations whose flange turned by at least `MIN_TURN_DEG`: all pairs, not only
+/// consecutive ones, so that no station's noise weighs more than another's.
+fn motions(stations: &[Station]) -> Vec<Motion> {
+    let mut out = Vec::new();
+    for (i, si) in stations.iter().enumerate() {
+        for sj in &stations[i + 1..] {
+            let a = compose(&sj.flange_in_base, &si.flange_in_base.inverse());
+            let b = compose(&sj.board_in_camera, &si.board_in_camera.inverse());
+            if turn_deg(a.rotation) >= MIN_TURN_DEG {
+                out.push(Motion { a, b });
+            }
+        }
+    }
+    out
+}
+
+/// A rotation's angle in degrees, 0 to 180.
+fn turn_deg(q: DQuat) -> f64 {
+    // atan2 of the vector part's length keeps small turns exact (acos near 1 does not).
+    (2.0 * DVec3::new(q.x, q.y, q.z).length().atan2(q.w.abs())).to_degrees()
+}
+
+/// t_X from (R_A - I) t_X = R_X t_B - t_A over every motion (normal equations); a motion
+/// about one axis leaves t_X's part along it free.
+fn translation(motions: &[Motion], rotation: DQuat) -> Result<DVec3, HandEyeError> {
+    let mut normal = DMat3::ZERO;
+    let mut rhs = DVec3::ZERO;
+    for m in motions {
+        let c = DMat3::from_quat(m.a.rotation) - DMat3::IDENTITY;
+        let d = rotation * m.b.position - m.a.position;
+        normal += c.transpose() * c;
+        rhs += c.transpose() * d;
+    }
+    let [largest, _, smallest] = rotation_fit::symmetric_eigenvalues(normal);
+    if smallest <= MIN_SECOND_AXIS_SHARE * largest {
+        return Err(HandEyeError::OneAxis);
+    }
+    Ok(normal.inverse() * rhs)
+}
+
+/// Z = F_i^-1 X C_i averaged over the stations (rotations by their normalised quaternion sum,
+/// signs aligned to the first).
+fn board_on_flange(stations: &[Station], camera_in_base: &Pose) -> Pose {
+    let each: Vec<Pose> = stations
+        .iter()
+        .map(|s| {
+            compose(
+                &s.flange_in_base.inverse(),
+                &compose(camera_in_base, &s.board_in_camera),
+            )
+        })
+        .collect();
+    let first = each[0].rotation;
+    let mut sum = DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0);
+    let mut position = DVec3::ZERO;
+    for z in &each {
+        let q = if z.rotation.dot(first) < 0.0 {
+            -z.rotation
+        } else {
+            z.rotation
+        };
+        sum += q;
+        position += z.position;
+    }
+    Pose::new(position / each.len() as f64, sum.normalize())
+}
+
+/// The board's pose the solution predicts at a station (X^-1 F_i Z) against the one seen.
+fn residual(station: &Station, camera_in_base: &Pose, board_in_flange: &Pose) -> StationResidual {
+    let predicted = compose(
+        &camera_in_base.inverse(),
+        &compose(&station.flange_in_base, board_in_flange),
+    );
+    let seen = station.board_in_camera;
+    StationResidual {
+        rotation_deg: turn_deg(predicted.rotation.inverse() * seen.rotation),
+        translation_mm: 1000.0 * (predicted.position - seen.position).length(),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,190 @@
+use super::*;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+
+/// A scene camera above the table's front, looking at its middle: a turn of 142 degrees from
+/// the base frame, towards the half turn where Tsai-Lenz's form grows.
+fn true_camera() -> Pose {
+    Pose::camera_looking_at(DVec3::new(0.05, -0.45, 0.65), DVec3::new(0.0, 0.05, 0.0)).unwrap()
+}
+
+/// A board 6 cm below the flange, turned a little on it.
+fn true_board() -> Pose {
+    Pose::new(
+        DVec3::new(0.01, -0.02, 0.06),
+        DQuat::from_euler(glam::EulerRot::XYZ, 0.1, -0.05, 0.3),
+    )
+}
+
+/// `n` flange poses over the table, tool down, turned about x, y and z by up to 25 degrees.
+fn flange_poses(n: usize) -> Vec<Pose> {
+    (0..n)
+        .map(|i| {
+            let t = i as f64 / n as f64 * std::f64::consts::TAU;
+            let position = DVec3::new(
+                0.1 * t.cos(),
+                0.1 + 0.08 * t.sin(),
+                0.25 + 0.03 * (2.0 * t).sin(),
+            );
+            let turn = DQuat::from_euler(
+                glam::EulerRot::XYZ,
+                0.35 * (3.0 * t).sin(),
+                0.35 * (2.0 * t + 1.0).cos(),
+                0.45 * t.sin(),
+            );
+            Pose::new(
+                position,
+                turn * DQuat::from_rotation_x(std::f64::consts::PI),
+            )
+        })
+        .collect()
+}
+
+/// The stations the true camera and board give, the board's pose perturbed by `noise` (its
+/// position's sigma in m and its rotation's in radians, per axis).
+fn stations(flanges: &[Pose], noise: (f64, f64), seed: u64) -> Vec<Station> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let (pos, rot) = (
+        Normal::new(0.0, noise.0.max(1e-300)).unwrap(),
+        Normal::new(0.0, noise.1.max(1e-300)).unwrap(),
+    );
+    let (camera, board) = (true_camera(), true_board());
+    flanges
+        .iter()
+        .map(|flange| {
+            let seen = compose(&camera.inverse(), &compose(flange, &board));
+            let jitter = DQuat::from_scaled_axis(DVec3::new(
+                rot.sample(&mut rng),
+                rot.sample(&mut rng),
+                rot.sample(&mut rng),
+            ));
+            let shift = DVec3::new(
+                pos.sample(&mut rng),
+                pos.sample(&mut rng),
+                pos.sample(&mut rng),
+            );
+            Station {
+                flange_in_base: *flange,
+                board_in_camera: Pose::new(seen.position + shift, jitter * seen.rotation),
+            }
+        })
+        .collect()
+}
+
+/// Position error (mm) and rotation error (degrees) against the true camera.
+fn errors(found: &Pose) -> (f64, f64) {
+    let truth = true_camera();
+    (
+        1000.0 * (found.position - truth.position).length(),
+        turn_deg(found.rotation.inverse() * truth.rotation),
+    )
+}
+
+#[test]
+fn noise_free_stations_give_the_true_camera_by_both_methods() {
+    let stations = stations(&flange_poses(15), (0.0, 0.0), 1);
+    for method in [HandEyeMethod::TsaiLenz, HandEyeMethod::ParkMartin] {
+        let solution = solve_hand_eye(&stations, method).unwrap();
+        let (mm, deg) = errors(&solution.camera_in_base);
+        assert!(mm < 1e-6 && deg < 1e-6, "{method:?}: {mm} mm, {deg} deg");
+        let board = true_board();
+        assert!((solution.board_in_flange.position - board.position).length() < 1e-9);
+        assert!(
+            solution
+                .residuals
+                .iter()
+                .all(|r| r.translation_mm < 1e-6 && r.rotation_deg < 1e-6)
+        );
+    }
+}
+
+#[test]
+fn fifteen_stations_with_board_pose_noise_place_the_camera_to_millimetres() {
+    // Each board pose off by 0.5 mm and 0.05 degrees per axis (1 sigma): the size to measure
+    // on the twin's renders once its camera sees a board.
+    let noise = (0.0005, 0.05f64.to_radians());
+    for method in [HandEyeMethod::TsaiLenz, HandEyeMethod::ParkMartin] {
+        let (mut mms, mut degs) = (Vec::new(), Vec::new());
+        for seed in 0..20 {
+            let stations = stations(&flange_poses(15), noise, seed);
+            let solution = solve_hand_eye(&stations, method).unwrap();
+            let (mm, deg) = errors(&solution.camera_in_base);
+            mms.push(mm);
+            degs.push(deg);
+            // Each station's residual is of the noise's size, not of an error in X.
+            let median = {
+                let mut r: Vec<f64> = solution
+                    .residuals
+                    .iter()
+                    .map(|r| r.translation_mm)
+                    .collect();
+                r.sort_by(f64::total_cmp);
+                r[r.len() / 2]
+            };
+            assert!(
+                median < 3.0,
+                "{method:?} seed {seed}: median residual {median} mm"
+            );
+        }
+        mms.sort_by(f64::total_cmp);
+        degs.sort_by(f64::total_cmp);
+        let (median, worst) = ((mms[10], degs[10]), (mms[19], degs[19]));
+        assert!(
+            median.0 < 1.5 && median.1 < 0.1 && worst.0 < 2.5 && worst.1 < 0.25,
+            "{method:?}: median {median:?}, worst {worst:?} (mm, degrees)"
+        );
+    }
+}
+
+#[test]
+fn degenerate_station_sets_are_refused_with_what_is_missing() {
+    let flanges = flange_poses(15);
+    let two = stations(&flanges[..2], (0.0, 0.0), 1);
+    assert_eq!(
+        solve_hand_eye(&two, HandEyeMethod::ParkMartin),
+        Err(HandEyeError::TooFewStations(2))
+    );
+    // Pure translations: the flange never turns.
+    let shifted: Vec<Pose> = flanges
+        .iter()
+        .map(|f| Pose::new(f.position, flanges[0].rotation))
+        .collect();
+    for method in [HandEyeMethod::TsaiLenz, HandEyeMethod::ParkMartin] {
+        assert_eq!(
+            solve_hand_eye(&stations(&shifted, (0.0, 0.0), 1), method),
+            Err(HandEyeError::NoRotation)
+        );
+    }
+    // Turns about the vertical only (a SCARA's motions).
+    let about_z: Vec<Pose> = (0..10)
+        .map(|i| {
+            Pose::new(
+                DVec3::new(0.02 * i as f64, 0.1, 0.3),
+                DQuat::from_rotation_z(0.2 * i as f64)
+                    * DQuat::from_rotation_x(std::f64::consts::PI),
+            )
+        })
+        .collect();
+    for method in [HandEyeMethod::TsaiLenz, HandEyeMethod::ParkMartin] {
+        assert_eq!(
+            solve_hand_eye(&stations(&about_z, (0.0, 0.0), 1), method),
+            Err(HandEyeError::OneAxis)
+        );
+    }
+}
+
+#[test]
+fn the_symmetric_eigensolver_gives_each_pair() {
+    let m = DMat3::from_cols(
+        DVec3::new(4.0, 1.0, -2.0),
+        DVec3::new(1.0, 3.0, 0.5),
+        DVec3::new(-2.0, 0.5, 1.0),
+    );
+    let (values, vectors) = rotation_fit::symmetric_eigen(m);
+    assert!(values[0] >= values[1] && values[1] >= values[2]);
+    for (l, v) in values.iter().zip(vectors) {
+        assert!((v.length() - 1.0).abs() < 1e-12);
+        assert!((m * v - v * *l).length() < 1e-10, "{l} {v}");
+    }
+    assert!((values.iter().sum::<f64>() - 8.0).abs() < 1e-10);
+}
