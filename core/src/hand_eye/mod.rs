@@ -9,9 +9,13 @@
 //!
 //! The rotation comes from either closed form (`HandEyeMethod`), the translation from the
 //! stacked (R_A - I) t_X = R_X t_B - t_A by least squares; each station's residual is the
-//! board's pose predicted from X and Z against the one seen.
+//! board's pose predicted from X and Z against the one seen. `refine_on_corners` then
+//! refines X and Z together on the board corners' reprojection error.
 
+mod refine;
 mod rotation_fit;
+
+pub use refine::{CornerStation, RefinedHandEye, refine_on_corners};
 
 use crate::geometry::Pose;
 use glam::{DMat3, DQuat, DVec3};
@@ -59,6 +63,10 @@ pub enum HandEyeError {
         "the stations' motions do not rotate the flange (pure translations fix no camera rotation); turn the flange between stations"
     )]
     NoRotation,
+    #[error(
+        "the corners' refinement needs at least 12 corners over the stations (6 unknowns each for the camera and the board); got {0}"
+    )]
+    TooFewCorners(usize),
     #[error(
         "every motion turns the flange about one axis, so the camera's turn about it and its offset along it are unknown; turn it about at least two axes"
     )]

@@ -1,0 +1,194 @@
+//! The closed forms' answer refined on what the camera really measured: the board's corners
+//! in the image. Each closed form sees a station only through the board's pose, whose depth
+//! along the optical axis is its least certain part; minimising the corners' reprojection
+//! error over the camera in the base (X) and the board on the flange (Z) together weighs
+//! every corner by what the image fixes. Levenberg-Marquardt over the 12 parameters (a turn
+//! and a shift applied to each), central-difference Jacobian.
+
+use super::{HandEyeError, HandEyeSolution, compose};
+use crate::geometry::{CameraIntrinsics, Pose};
+use glam::{DQuat, DVec3};
+use serde::Serialize;
+
+/// A station with the board's corners as seen: each corner's place on the board (m, board
+/// frame) and where the camera saw it (px).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CornerStation {
+    pub flange_in_base: Pose,
+    pub corners: Vec<(DVec3, [f64; 2])>,
+}
+
+/// The refined calibration and its reprojection error (px, RMS over every corner and per
+/// station).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RefinedHandEye {
+    pub camera_in_base: Pose,
+    pub board_in_flange: Pose,
+    pub rms_px: f64,
+    pub station_rms_px: Vec<f64>,
+}
+
+const PARAMETERS: usize = 12;
+const MAX_ITERATIONS: usize = 100;
+
+/// Refines `start` (a closed form's solution) on the stations' corners.
+pub fn refine_on_corners(
+    stations: &[CornerStation],
+    intrinsics: &CameraIntrinsics,
+    start: &HandEyeSolution,
+) -> Result<RefinedHandEye, HandEyeError> {
+    let corners: usize = stations.iter().map(|s| s.corners.len()).sum();
+    if stations.len() < 3 {
+        return Err(HandEyeError::TooFewStations(stations.len()));
+    }
+    if corners < PARAMETERS {
+        return Err(HandEyeError::TooFewCorners(corners));
+    }
+    let base = (start.camera_in_base, start.board_in_flange);
+    let residuals = |p: &[f64; PARAMETERS]| residuals(stations, intrinsics, &moved(&base, p));
+    let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+    let mut p = [0.0f64; PARAMETERS];
+    let mut r = residuals(&p);
+    let mut err = cost(&r);
+    let mut damping = 1e-3;
+    for _ in 0..MAX_ITERATIONS {
+        let jacobian = jacobian(&residuals, &p, r.len());
+        // Normal equations J^T J d = -J^T r, damped on the diagonal.
+        let mut jtj = [[0.0f64; PARAMETERS]; PARAMETERS];
+        let mut jtr = [0.0f64; PARAMETERS];
+        for (row, ri) in jacobian.iter().zip(&r) {
+            for a in 0..PARAMETERS {
+                jtr[a] += row[a] * ri;
+                for b in 0..PARAMETERS {
+                    jtj[a][b] += row[a] * row[b];
+                }
+            }
+        }
+        let mut improved = false;
+        for _ in 0..10 {
+            let mut damped = jtj;
+            for (a, row) in damped.iter_mut().enumerate() {
+                row[a] *= 1.0 + damping;
+            }
+            let Some(step) = solve(damped, jtr.map(|v| -v)) else {
+                damping *= 10.0;
+                continue;
+            };
+            let trial: [f64; PARAMETERS] = std::array::from_fn(|k| p[k] + step[k]);
+            let tr = residuals(&trial);
+            let te = cost(&tr);
+            if te < err {
+                let converged = err - te < 1e-12 * err.max(1e-300);
+                (p, r, err) = (trial, tr, te);
+                damping = (damping / 10.0).max(1e-12);
+                improved = !converged;
+                break;
+            }
+            damping *= 10.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    let (camera_in_base, board_in_flange) = moved(&base, &p);
+    let mut station_rms_px = Vec::with_capacity(stations.len());
+    let mut at = 0;
+    for s in stations {
+        let n = 2 * s.corners.len();
+        station_rms_px.push((cost(&r[at..at + n]) / s.corners.len().max(1) as f64).sqrt());
+        at += n;
+    }
+    Ok(RefinedHandEye {
+        camera_in_base,
+        board_in_flange,
+        rms_px: (err / corners as f64).sqrt(),
+        station_rms_px,
+    })
+}
+
+/// X and Z turned by p's rotation vectors and shifted by its translations (m).
+fn moved(base: &(Pose, Pose), p: &[f64; PARAMETERS]) -> (Pose, Pose) {
+    let apply = |pose: &Pose, q: &[f64]| {
+        Pose::new(
+            pose.position + DVec3::new(q[3], q[4], q[5]),
+            DQuat::from_scaled_axis(DVec3::new(q[0], q[1], q[2])) * pose.rotation,
+        )
+    };
+    (apply(&base.0, &p[..6]), apply(&base.1, &p[6..]))
+}
+
+/// Each corner's seen pixel less its projection through X^-1 F_i Z (u then v); a corner
+/// behind the camera counts as far off.
+fn residuals(
+    stations: &[CornerStation],
+    intrinsics: &CameraIntrinsics,
+    (camera_in_base, board_in_flange): &(Pose, Pose),
+) -> Vec<f64> {
+    let base_in_camera = camera_in_base.inverse();
+    let mut out = Vec::new();
+    for s in stations {
+        let board_in_camera = compose(
+            &base_in_camera,
+            &compose(&s.flange_in_base, board_in_flange),
+        );
+        for (on_board, seen) in &s.corners {
+            let (u, v) = intrinsics
+                .project(board_in_camera.transform_point(*on_board))
+                .unwrap_or((1e6, 1e6));
+            out.push(u - seen[0]);
+            out.push(v - seen[1]);
+        }
+    }
+    out
+}
+
+fn jacobian(
+    residuals: &dyn Fn(&[f64; PARAMETERS]) -> Vec<f64>,
+    p: &[f64; PARAMETERS],
+    rows: usize,
+) -> Vec<[f64; PARAMETERS]> {
+    // 1e-7 rad and 1e-7 m: far above f64's rounding of a metre, far below a pixel's worth.
+    let h = 1e-7;
+    let mut jacobian = vec![[0.0f64; PARAMETERS]; rows];
+    for k in 0..PARAMETERS {
+        let (mut plus, mut minus) = (*p, *p);
+        plus[k] += h;
+        minus[k] -= h;
+        let (rp, rm) = (residuals(&plus), residuals(&minus));
+        for (row, (a, b)) in jacobian.iter_mut().zip(rp.iter().zip(&rm)) {
+            row[k] = (a - b) / (2.0 * h);
+        }
+    }
+    jacobian
+}
+
+/// `a x = b` by Gaussian elimination with partial pivoting; None when `a` is singular.
+fn solve(
+    mut a: [[f64; PARAMETERS]; PARAMETERS],
+    mut b: [f64; PARAMETERS],
+) -> Option<[f64; PARAMETERS]> {
+    let scale = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    for col in 0..PARAMETERS {
+        let pivot =
+            (col..PARAMETERS).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[pivot][col].abs() <= 1e-14 * scale {
+            return None;
+        }
+        a.swap(col, pivot);
+        b.swap(col, pivot);
+        for row in col + 1..PARAMETERS {
+            let f = a[row][col] / a[col][col];
+            let pivot_row = a[col];
+            for (x, p) in a[row].iter_mut().zip(pivot_row).skip(col) {
+                *x -= f * p;
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0f64; PARAMETERS];
+    for row in (0..PARAMETERS).rev() {
+        let tail: f64 = (row + 1..PARAMETERS).map(|k| a[row][k] * x[k]).sum();
+        x[row] = (b[row] - tail) / a[row][row];
+    }
+    Some(x)
+}
