@@ -21,7 +21,8 @@ use crate::geometry::Pose;
 use glam::{DMat3, DQuat, DVec3};
 use serde::Serialize;
 
-/// One station: the flange in the base frame and the board as the camera saw it.
+/// One station: the flange in the base frame and the board as the camera saw it (positions
+/// in metres).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Station {
     pub flange_in_base: Pose,

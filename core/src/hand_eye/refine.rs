@@ -11,7 +11,7 @@ use glam::{DQuat, DVec3};
 use serde::Serialize;
 
 /// A station with the board's corners as seen: each corner's place on the board (m, board
-/// frame) and where the camera saw it (px).
+/// frame) and where the camera saw it (px, undistorted: the intrinsics are a pinhole).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CornerStation {
     pub flange_in_base: Pose,

@@ -6,23 +6,39 @@ use glam::{DMat3, DQuat, DVec3};
 /// Tsai-Lenz: with a and b the vector parts of R_A's and R_B's quaternions (sin of half the
 /// turn times the axis, signs chosen with a positive scalar part), the quaternion algebra of
 /// q_A q_X = q_X q_B gives [a + b]x P = b - a for P = tan(half R_X's turn) times its axis,
-/// linear in P and stacked over the motions. P grows without bound as R_X nears a half
-/// turn, where this form loses precision.
+/// linear in P and stacked over the motions. At a half turn of R_X every [a + b]x shares its
+/// axis as null vector (a camera looking straight down is one), so the system is solved for
+/// X' = X R0^-1 (A X' = X' R0 B R0^-1) with R0 the best conditioned of no turn and quarter
+/// turns about x and y.
 pub(super) fn tsai_lenz(motions: &[Motion]) -> Result<DQuat, HandEyeError> {
-    let mut normal = DMat3::ZERO;
-    let mut rhs = DVec3::ZERO;
-    for m in motions {
-        let (a, b) = (vector_part(m.a.rotation), vector_part(m.b.rotation));
-        let s = skew(a + b);
-        normal += s.transpose() * s;
-        rhs += s.transpose() * (b - a);
-    }
-    let [largest, _, smallest] = symmetric_eigenvalues(normal);
-    if smallest <= MIN_SECOND_AXIS_SHARE * largest {
+    use std::f64::consts::FRAC_PI_2;
+    let offsets = [
+        DQuat::IDENTITY,
+        DQuat::from_rotation_x(FRAC_PI_2),
+        DQuat::from_rotation_y(FRAC_PI_2),
+    ];
+    let (conditioning, normal, rhs, offset) = offsets
+        .into_iter()
+        .map(|r0| {
+            let mut normal = DMat3::ZERO;
+            let mut rhs = DVec3::ZERO;
+            for m in motions {
+                let b_turned = r0 * m.b.rotation * r0.inverse();
+                let (a, b) = (vector_part(m.a.rotation), vector_part(b_turned));
+                let s = skew(a + b);
+                normal += s.transpose() * s;
+                rhs += s.transpose() * (b - a);
+            }
+            let [largest, _, smallest] = symmetric_eigenvalues(normal);
+            (smallest / largest.max(1e-300), normal, rhs, r0)
+        })
+        .max_by(|x, y| x.0.total_cmp(&y.0))
+        .expect("three offsets");
+    if conditioning <= MIN_SECOND_AXIS_SHARE {
         return Err(HandEyeError::OneAxis);
     }
     let p = normal.inverse() * rhs;
-    Ok(DQuat::from_xyzw(p.x, p.y, p.z, 1.0).normalize())
+    Ok(DQuat::from_xyzw(p.x, p.y, p.z, 1.0).normalize() * offset)
 }
 
 /// Park-Martin: the rotations' logarithms satisfy log R_A = R_X log R_B, so R_X is the
