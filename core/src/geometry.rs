@@ -67,6 +67,15 @@ impl Pose {
         self.rotation * v
     }
 
+    /// This pose after `local`: the transform taking `local`'s frame through `local`, then
+    /// this pose (a flange's pose composed with a board's pose on the flange).
+    pub fn compose(&self, local: &Pose) -> Pose {
+        Pose::new(
+            self.transform_point(local.position),
+            self.rotation * local.rotation,
+        )
+    }
+
     pub fn inverse(&self) -> Self {
         let rotation = self.rotation.inverse();
         Self {

@@ -111,11 +111,6 @@ pub fn solve_hand_eye(
     })
 }
 
-/// `a` after `b`: the transform taking b's local frame through b, then a.
-pub(crate) fn compose(a: &Pose, b: &Pose) -> Pose {
-    Pose::new(a.transform_point(b.position), a.rotation * b.rotation)
-}
-
 /// A pair of stations' motions: A (the flange, base frame) and B (the board, camera frame).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Motion {
@@ -129,8 +124,8 @@ fn motions(stations: &[Station]) -> Vec<Motion> {
     let mut out = Vec::new();
     for (i, si) in stations.iter().enumerate() {
         for sj in &stations[i + 1..] {
-            let a = compose(&sj.flange_in_base, &si.flange_in_base.inverse());
-            let b = compose(&sj.board_in_camera, &si.board_in_camera.inverse());
+            let a = sj.flange_in_base.compose(&si.flange_in_base.inverse());
+            let b = sj.board_in_camera.compose(&si.board_in_camera.inverse());
             if turn_deg(a.rotation) >= MIN_TURN_DEG {
                 out.push(Motion { a, b });
             }
@@ -156,7 +151,7 @@ fn translation(motions: &[Motion], rotation: DQuat) -> Result<DVec3, HandEyeErro
         normal += c.transpose() * c;
         rhs += c.transpose() * d;
     }
-    let [largest, _, smallest] = rotation_fit::symmetric_eigenvalues(normal);
+    let [largest, _, smallest] = rotation_fit::symmetric_eigen(normal).0;
     if smallest <= MIN_SECOND_AXIS_SHARE * largest {
         return Err(HandEyeError::OneAxis);
     }
@@ -169,10 +164,9 @@ fn board_on_flange(stations: &[Station], camera_in_base: &Pose) -> Pose {
     let each: Vec<Pose> = stations
         .iter()
         .map(|s| {
-            compose(
-                &s.flange_in_base.inverse(),
-                &compose(camera_in_base, &s.board_in_camera),
-            )
+            s.flange_in_base
+                .inverse()
+                .compose(&camera_in_base.compose(&s.board_in_camera))
         })
         .collect();
     let first = each[0].rotation;
@@ -192,10 +186,9 @@ fn board_on_flange(stations: &[Station], camera_in_base: &Pose) -> Pose {
 
 /// The board's pose the solution predicts at a station (X^-1 F_i Z) against the one seen.
 fn residual(station: &Station, camera_in_base: &Pose, board_in_flange: &Pose) -> StationResidual {
-    let predicted = compose(
-        &camera_in_base.inverse(),
-        &compose(&station.flange_in_base, board_in_flange),
-    );
+    let predicted = camera_in_base
+        .inverse()
+        .compose(&station.flange_in_base.compose(board_in_flange));
     let seen = station.board_in_camera;
     StationResidual {
         rotation_deg: turn_deg(predicted.rotation.inverse() * seen.rotation),

@@ -5,7 +5,7 @@
 //! every corner by what the image fixes. Levenberg-Marquardt over the 12 parameters (a turn
 //! and a shift applied to each), central-difference Jacobian.
 
-use super::{HandEyeError, HandEyeSolution, compose};
+use super::{HandEyeError, HandEyeSolution};
 use crate::geometry::{CameraIntrinsics, Pose};
 use glam::{DQuat, DVec3};
 use serde::Serialize;
@@ -127,10 +127,7 @@ fn residuals(
     let base_in_camera = camera_in_base.inverse();
     let mut out = Vec::new();
     for s in stations {
-        let board_in_camera = compose(
-            &base_in_camera,
-            &compose(&s.flange_in_base, board_in_flange),
-        );
+        let board_in_camera = base_in_camera.compose(&s.flange_in_base.compose(board_in_flange));
         for (on_board, seen) in &s.corners {
             let (u, v) = intrinsics
                 .project(board_in_camera.transform_point(*on_board))

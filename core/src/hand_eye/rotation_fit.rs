@@ -29,7 +29,7 @@ pub(super) fn tsai_lenz(motions: &[Motion]) -> Result<DQuat, HandEyeError> {
                 normal += s.transpose() * s;
                 rhs += s.transpose() * (b - a);
             }
-            let [largest, _, smallest] = symmetric_eigenvalues(normal);
+            let [largest, _, smallest] = symmetric_eigen(normal).0;
             (smallest / largest.max(1e-300), normal, rhs, r0)
         })
         .max_by(|x, y| x.0.total_cmp(&y.0))
@@ -90,11 +90,6 @@ fn skew(v: DVec3) -> DMat3 {
 /// a b^T.
 fn outer(a: DVec3, b: DVec3) -> DMat3 {
     DMat3::from_cols(a * b.x, a * b.y, a * b.z)
-}
-
-/// A symmetric matrix's eigenvalues, largest first.
-pub(super) fn symmetric_eigenvalues(m: DMat3) -> [f64; 3] {
-    symmetric_eigen(m).0
 }
 
 /// A symmetric 3 x 3 matrix's eigenvalues and unit eigenvectors, largest first (cyclic

@@ -44,16 +44,21 @@ fn flange_poses(n: usize) -> Vec<Pose> {
 /// The stations the true camera and board give, the board's pose perturbed by `noise` (its
 /// position's sigma in m and its rotation's in radians, per axis).
 fn stations(flanges: &[Pose], noise: (f64, f64), seed: u64) -> Vec<Station> {
+    stations_seen_by(&true_camera(), flanges, noise, seed)
+}
+
+/// `stations` for another camera.
+fn stations_seen_by(camera: &Pose, flanges: &[Pose], noise: (f64, f64), seed: u64) -> Vec<Station> {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let (pos, rot) = (
         Normal::new(0.0, noise.0.max(1e-300)).unwrap(),
         Normal::new(0.0, noise.1.max(1e-300)).unwrap(),
     );
-    let (camera, board) = (true_camera(), true_board());
+    let board = true_board();
     flanges
         .iter()
         .map(|flange| {
-            let seen = compose(&camera.inverse(), &compose(flange, &board));
+            let seen = camera.inverse().compose(&flange.compose(&board));
             let jitter = DQuat::from_scaled_axis(DVec3::new(
                 rot.sample(&mut rng),
                 rot.sample(&mut rng),
@@ -74,7 +79,10 @@ fn stations(flanges: &[Pose], noise: (f64, f64), seed: u64) -> Vec<Station> {
 
 /// Position error (mm) and rotation error (degrees) against the true camera.
 fn errors(found: &Pose) -> (f64, f64) {
-    let truth = true_camera();
+    errors_against(&true_camera(), found)
+}
+
+fn errors_against(truth: &Pose, found: &Pose) -> (f64, f64) {
     (
         1000.0 * (found.position - truth.position).length(),
         turn_deg(found.rotation.inverse() * truth.rotation),
@@ -104,18 +112,10 @@ fn a_camera_looking_straight_down_is_found_by_both_methods() {
     // A half turn about x from the base frame: Tsai-Lenz's [a + b]x are all singular there.
     let camera =
         Pose::camera_looking_at(DVec3::new(0.02, 0.05, 0.7), DVec3::new(0.02, 0.05, 0.0)).unwrap();
-    let board = true_board();
-    let stations: Vec<Station> = flange_poses(15)
-        .iter()
-        .map(|flange| Station {
-            flange_in_base: *flange,
-            board_in_camera: compose(&camera.inverse(), &compose(flange, &board)),
-        })
-        .collect();
+    let stations = stations_seen_by(&camera, &flange_poses(15), (0.0, 0.0), 1);
     for method in [HandEyeMethod::TsaiLenz, HandEyeMethod::ParkMartin] {
         let found = solve_hand_eye(&stations, method).unwrap().camera_in_base;
-        let mm = 1000.0 * (found.position - camera.position).length();
-        let deg = turn_deg(found.rotation.inverse() * camera.rotation);
+        let (mm, deg) = errors_against(&camera, &found);
         assert!(mm < 1e-6 && deg < 1e-6, "{method:?}: {mm} mm, {deg} deg");
     }
 }
@@ -229,7 +229,7 @@ fn corner_stations(flanges: &[Pose], pixel_sigma: f64, seed: u64) -> Vec<CornerS
     flanges
         .iter()
         .map(|flange| {
-            let board_in_camera = compose(&camera.inverse(), &compose(flange, &board));
+            let board_in_camera = camera.inverse().compose(&flange.compose(&board));
             let corners = board_corners()
                 .into_iter()
                 .map(|c| {
