@@ -15,7 +15,7 @@
 mod refine;
 mod rotation_fit;
 
-pub use refine::{CornerStation, RefinedHandEye, refine_on_corners};
+pub use refine::{BoardCorner, CornerStation, RefinedHandEye, refine_on_corners};
 
 use crate::geometry::Pose;
 use glam::{DMat3, DQuat, DVec3};
@@ -61,22 +61,32 @@ pub enum HandEyeError {
     #[error("hand-eye needs at least 3 stations; got {0}")]
     TooFewStations(usize),
     #[error(
-        "the stations' motions do not rotate the flange (pure translations fix no camera rotation); turn the flange between stations"
+        "no pair of stations turns the flange by 2 to 175 degrees (pure translations fix no camera rotation); turn the flange between stations"
     )]
     NoRotation,
     #[error(
-        "the corners' refinement needs at least 12 corners over the stations (6 unknowns each for the camera and the board); got {0}"
+        "the corners' refinement needs at least 12 corners over all stations (6 unknowns each for the camera and the board); got {0}"
     )]
     TooFewCorners(usize),
     #[error(
         "every motion turns the flange about one axis, so the camera's turn about it and its offset along it are unknown; turn it about at least two axes"
     )]
     OneAxis,
+    #[error("station {station}: {what}")]
+    BadStation { station: usize, what: String },
+    #[error("the camera's intrinsics: {0}")]
+    BadIntrinsics(String),
 }
 
 /// The smallest turn (degrees) a pair of stations must make to count as a rotation: below
 /// it, a pose estimate's noise is the motion's axis.
 const MIN_TURN_DEG: f64 = 2.0;
+/// The largest turn (degrees) a pair may make: near a half turn the motion's axis keeps its
+/// line but loses its sign (Park-Martin's logarithm) and Tsai-Lenz's tan(angle/2) runs off.
+const MAX_TURN_DEG: f64 = 175.0;
+/// How far from 1 a station's quaternion's length may be (rounding in a file) before it is
+/// taken for a mistake rather than normalised.
+const UNIT_QUATERNION_TOLERANCE: f64 = 1e-3;
 /// The second rotation axis must carry at least this share of the first's weight.
 const MIN_SECOND_AXIS_SHARE: f64 = 1e-3;
 
@@ -88,6 +98,8 @@ pub fn solve_hand_eye(
     if stations.len() < 3 {
         return Err(HandEyeError::TooFewStations(stations.len()));
     }
+    let stations = checked_stations(stations)?;
+    let stations = stations.as_slice();
     let motions = motions(stations);
     if motions.is_empty() {
         return Err(HandEyeError::NoRotation);
@@ -118,15 +130,49 @@ pub(crate) struct Motion {
     pub b: Pose,
 }
 
-/// Every pair of stations whose flange turned by at least `MIN_TURN_DEG`: all pairs, not only
-/// consecutive ones, so that no station's noise weighs more than another's.
+/// The stations with their quaternions normalised, or the first whose pose is not a pose:
+/// a NaN would otherwise pass through every sum into the answer.
+fn checked_stations(stations: &[Station]) -> Result<Vec<Station>, HandEyeError> {
+    stations
+        .iter()
+        .enumerate()
+        .map(|(station, s)| {
+            let flange_in_base = checked_pose(&s.flange_in_base, "the flange's pose")
+                .map_err(|what| HandEyeError::BadStation { station, what })?;
+            let board_in_camera = checked_pose(&s.board_in_camera, "the board's pose")
+                .map_err(|what| HandEyeError::BadStation { station, what })?;
+            Ok(Station {
+                flange_in_base,
+                board_in_camera,
+            })
+        })
+        .collect()
+}
+
+/// `pose` with its quaternion normalised, or why it is not a pose.
+pub(crate) fn checked_pose(pose: &Pose, name: &str) -> Result<Pose, String> {
+    if !pose.position.is_finite() {
+        return Err(format!("{name} has a position that is not a finite number"));
+    }
+    let length = pose.rotation.length();
+    if !length.is_finite() || (length - 1.0).abs() > UNIT_QUATERNION_TOLERANCE {
+        return Err(format!(
+            "{name} has a rotation quaternion of length {length:.4} (a rotation's is 1)"
+        ));
+    }
+    Ok(Pose::new(pose.position, pose.rotation / length))
+}
+
+/// Every pair of stations whose flange turned by at least `MIN_TURN_DEG` and at most
+/// `MAX_TURN_DEG`: all pairs, not only consecutive ones, so that no station's noise weighs
+/// more than another's.
 fn motions(stations: &[Station]) -> Vec<Motion> {
     let mut out = Vec::new();
     for (i, si) in stations.iter().enumerate() {
         for sj in &stations[i + 1..] {
             let a = sj.flange_in_base.compose(&si.flange_in_base.inverse());
             let b = sj.board_in_camera.compose(&si.board_in_camera.inverse());
-            if turn_deg(a.rotation) >= MIN_TURN_DEG {
+            if (MIN_TURN_DEG..=MAX_TURN_DEG).contains(&turn_deg(a.rotation)) {
                 out.push(Motion { a, b });
             }
         }

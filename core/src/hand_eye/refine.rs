@@ -5,27 +5,37 @@
 //! every corner by what the image fixes. Levenberg-Marquardt over the 12 parameters (a turn
 //! and a shift applied to each), central-difference Jacobian.
 
-use super::{HandEyeError, HandEyeSolution};
+use super::{HandEyeError, HandEyeSolution, checked_pose};
 use crate::geometry::{CameraIntrinsics, Pose};
 use glam::{DQuat, DVec3};
 use serde::Serialize;
 
-/// A station with the board's corners as seen: each corner's place on the board (m, board
-/// frame) and where the camera saw it (px, undistorted: the intrinsics are a pinhole).
+/// A station with the board's corners as the camera saw them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CornerStation {
     pub flange_in_base: Pose,
-    pub corners: Vec<(DVec3, [f64; 2])>,
+    pub corners: Vec<BoardCorner>,
 }
 
-/// The refined calibration and its reprojection error (px, RMS over every corner and per
-/// station).
+/// One corner: its place on the board (m, board frame) and where the camera saw it (px,
+/// undistorted: the intrinsics are a pinhole).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoardCorner {
+    pub on_board_m: DVec3,
+    pub seen_px: [f64; 2],
+}
+
+/// The refined calibration, its reprojection error (px, RMS over every corner and per
+/// station), and whether the steps stopped for lack of improvement (converged) or at the
+/// iteration limit.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RefinedHandEye {
     pub camera_in_base: Pose,
     pub board_in_flange: Pose,
     pub rms_px: f64,
     pub station_rms_px: Vec<f64>,
+    pub iterations: usize,
+    pub converged: bool,
 }
 
 const PARAMETERS: usize = 12;
@@ -41,6 +51,9 @@ pub fn refine_on_corners(
     if stations.len() < 3 {
         return Err(HandEyeError::TooFewStations(stations.len()));
     }
+    intrinsics.check().map_err(HandEyeError::BadIntrinsics)?;
+    let stations = checked_corner_stations(stations)?;
+    let stations = stations.as_slice();
     if corners < PARAMETERS {
         return Err(HandEyeError::TooFewCorners(corners));
     }
@@ -51,7 +64,9 @@ pub fn refine_on_corners(
     let mut r = residuals(&p);
     let mut err = cost(&r);
     let mut damping = 1e-3;
-    for _ in 0..MAX_ITERATIONS {
+    let (mut iterations, mut converged) = (0, false);
+    while iterations < MAX_ITERATIONS {
+        iterations += 1;
         let jacobian = jacobian(&residuals, &p, r.len());
         // Normal equations J^T J d = -J^T r, damped on the diagonal.
         let mut jtj = [[0.0f64; PARAMETERS]; PARAMETERS];
@@ -78,15 +93,17 @@ pub fn refine_on_corners(
             let tr = residuals(&trial);
             let te = cost(&tr);
             if te < err {
-                let converged = err - te < 1e-12 * err.max(1e-300);
+                let small = err - te < 1e-12 * err.max(1e-300);
                 (p, r, err) = (trial, tr, te);
                 damping = (damping / 10.0).max(1e-12);
-                improved = !converged;
+                improved = !small;
                 break;
             }
             damping *= 10.0;
         }
         if !improved {
+            // No step lowers the error, or only by rounding: a minimum.
+            converged = true;
             break;
         }
     }
@@ -95,7 +112,7 @@ pub fn refine_on_corners(
     let mut at = 0;
     for s in stations {
         let n = 2 * s.corners.len();
-        station_rms_px.push((cost(&r[at..at + n]) / s.corners.len().max(1) as f64).sqrt());
+        station_rms_px.push((cost(&r[at..at + n]) / s.corners.len() as f64).sqrt());
         at += n;
     }
     Ok(RefinedHandEye {
@@ -103,7 +120,37 @@ pub fn refine_on_corners(
         board_in_flange,
         rms_px: (err / corners as f64).sqrt(),
         station_rms_px,
+        iterations,
+        converged,
     })
+}
+
+/// The stations with their flange quaternions normalised, or the first with no corners, a
+/// pose that is not one, or a corner that is not a finite number.
+fn checked_corner_stations(stations: &[CornerStation]) -> Result<Vec<CornerStation>, HandEyeError> {
+    stations
+        .iter()
+        .enumerate()
+        .map(|(station, s)| {
+            let bad = |what: String| HandEyeError::BadStation { station, what };
+            if s.corners.is_empty() {
+                return Err(bad("no board corner was seen".into()));
+            }
+            let flange_in_base =
+                checked_pose(&s.flange_in_base, "the flange's pose").map_err(bad)?;
+            if let Some(k) = s
+                .corners
+                .iter()
+                .position(|c| !c.on_board_m.is_finite() || !c.seen_px.iter().all(|v| v.is_finite()))
+            {
+                return Err(bad(format!("corner {k} is not a finite number")));
+            }
+            Ok(CornerStation {
+                flange_in_base,
+                corners: s.corners.clone(),
+            })
+        })
+        .collect()
 }
 
 /// X and Z turned by p's rotation vectors and shifted by its translations (m).
@@ -128,12 +175,12 @@ fn residuals(
     let mut out = Vec::new();
     for s in stations {
         let board_in_camera = base_in_camera.compose(&s.flange_in_base.compose(board_in_flange));
-        for (on_board, seen) in &s.corners {
+        for corner in &s.corners {
             let (u, v) = intrinsics
-                .project(board_in_camera.transform_point(*on_board))
+                .project(board_in_camera.transform_point(corner.on_board_m))
                 .unwrap_or((1e6, 1e6));
-            out.push(u - seen[0]);
-            out.push(v - seen[1]);
+            out.push(u - corner.seen_px[0]);
+            out.push(v - corner.seen_px[1]);
         }
     }
     out

@@ -236,7 +236,10 @@ fn corner_stations(flanges: &[Pose], pixel_sigma: f64, seed: u64) -> Vec<CornerS
                     let (u, v) = intrinsics
                         .project(board_in_camera.transform_point(c))
                         .unwrap();
-                    (c, [u + noise.sample(&mut rng), v + noise.sample(&mut rng)])
+                    BoardCorner {
+                        on_board_m: c,
+                        seen_px: [u + noise.sample(&mut rng), v + noise.sample(&mut rng)],
+                    }
                 })
                 .collect();
             CornerStation {
@@ -264,6 +267,11 @@ fn refining_on_the_corners_places_the_camera_closer_than_its_park_martin_start()
         refined.push(errors(&r.camera_in_base));
         rms.push(r.rms_px);
         assert_eq!(r.station_rms_px.len(), 15);
+        assert!(
+            r.converged,
+            "seed {seed}: stopped at {} iterations",
+            r.iterations
+        );
     }
     let median = |v: &[(f64, f64)], k: usize| {
         let mut x: Vec<f64> = v.iter().map(|e| if k == 0 { e.0 } else { e.1 }).collect();
@@ -295,4 +303,62 @@ fn a_refinement_with_too_few_corners_is_refused() {
         refine_on_corners(&corners, &CameraIntrinsics::default(), &start),
         Err(HandEyeError::TooFewCorners(8))
     );
+}
+
+#[test]
+fn stations_that_are_not_poses_are_refused_by_index() {
+    let flanges = flange_poses(5);
+    let good = stations(&flanges, (0.0, 0.0), 1);
+    let mut nan = good.clone();
+    nan[3].board_in_camera.position.y = f64::NAN;
+    let err = solve_hand_eye(&nan, HandEyeMethod::TsaiLenz).unwrap_err();
+    assert!(
+        matches!(&err, HandEyeError::BadStation { station: 3, what } if what.contains("board's pose")),
+        "{err}"
+    );
+    let mut scaled = good.clone();
+    scaled[1].flange_in_base.rotation *= 2.0;
+    let err = solve_hand_eye(&scaled, HandEyeMethod::ParkMartin).unwrap_err();
+    assert!(
+        err.to_string()
+            .starts_with("station 1: the flange's pose has a rotation quaternion of length 2"),
+        "{err}"
+    );
+    // Rounding in a file is not a mistake: a quaternion off by 1e-5 is normalised.
+    let mut rounded = good;
+    rounded[2].flange_in_base.rotation *= 1.0 + 1e-5;
+    let found = solve_hand_eye(&rounded, HandEyeMethod::ParkMartin).unwrap();
+    let (mm, deg) = errors(&found.camera_in_base);
+    assert!(mm < 1e-3 && deg < 1e-4, "{mm} mm {deg} deg");
+}
+
+#[test]
+fn a_station_without_corners_or_with_a_nan_corner_is_refused() {
+    let flanges = flange_poses(4);
+    let start = solve_hand_eye(
+        &stations(&flanges, (0.0, 0.0), 1),
+        HandEyeMethod::ParkMartin,
+    )
+    .unwrap();
+    let intrinsics = CameraIntrinsics::default();
+    let mut corners = corner_stations(&flanges, 0.0, 1);
+    corners[2].corners.clear();
+    let err = refine_on_corners(&corners, &intrinsics, &start).unwrap_err();
+    assert_eq!(err.to_string(), "station 2: no board corner was seen");
+    let mut corners = corner_stations(&flanges, 0.0, 1);
+    corners[0].corners[5].seen_px[1] = f64::INFINITY;
+    let err = refine_on_corners(&corners, &intrinsics, &start).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "station 0: corner 5 is not a finite number"
+    );
+    let bad = CameraIntrinsics {
+        fx: f64::NAN,
+        ..intrinsics
+    };
+    let corners = corner_stations(&flanges, 0.0, 1);
+    assert!(matches!(
+        refine_on_corners(&corners, &bad, &start),
+        Err(HandEyeError::BadIntrinsics(_))
+    ));
 }
