@@ -14,6 +14,7 @@
 #![forbid(unsafe_code)]
 
 pub mod catalog;
+pub mod charuco;
 pub mod devices;
 pub mod dir_claim;
 pub mod dummy;

@@ -57,6 +57,8 @@ pub(crate) enum Command {
     /// frames (SSIM, mean absolute intensity error); or, with --session, rebuild a recorded
     /// session's presses in the twin (SSIM, marker displacement error, hardness agreement).
     Compare(sim2real::compare::CompareArgs),
+    /// The ChArUco calibration board to print (PNG, SVG at true scale) and its description.
+    Board(commands::board::BoardArgs),
     /// Marker centroids on a tactile frame, and displacements against a reference frame.
     Markers(commands::markers::MarkersArgs),
     /// Contact or not against a no-contact frame (the paper's SSIM criterion), and the
@@ -200,6 +202,7 @@ pub(crate) fn run(command: Command) -> Result<()> {
         Command::Calibrate(args) => sim2real::calibrate::run(&args),
         Command::Sensor { command } => commands::sensor::run(&command),
         Command::Compare(args) => sim2real::compare::run(&args),
+        Command::Board(args) => commands::board::run(&args),
         Command::Markers(args) => commands::markers::run(&args),
         Command::Contact(args) => commands::contact::run(&args),
         Command::Read(args) => commands::read::run(&args),

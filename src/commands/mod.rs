@@ -3,6 +3,7 @@
 
 pub mod arm;
 pub mod ask;
+pub mod board;
 pub mod contact;
 pub mod detect;
 pub mod markers;

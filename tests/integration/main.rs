@@ -4,6 +4,7 @@
 
 mod arm;
 mod ask;
+mod board;
 mod cli;
 mod datagen;
 mod datagen_scenes;
