@@ -5,9 +5,11 @@
 //! z into the board), what it looks like at any point (for the twin's camera), and its
 //! printable forms (`print`: a PNG and an SVG at true scale).
 
+mod detect;
 mod dictionary;
 mod print;
 
+pub use detect::{BoardDetector, BoardSighting, DetectError, SeenCorner};
 pub use dictionary::ArucoDictionary;
 pub use print::{board_image, board_svg};
 
@@ -174,6 +176,11 @@ pub struct BoardFace {
 }
 
 impl BoardFace {
+    /// The board this is the face of.
+    pub fn board(&self) -> &CharucoBoard {
+        &self.board
+    }
+
     /// Whether the face is white at (x, y) mm in the board frame; the paper round the board
     /// is white.
     pub fn is_white(&self, x_mm: f64, y_mm: f64) -> bool {

@@ -12,9 +12,12 @@
 //! board's pose predicted from X and Z against the one seen. `refine_on_corners` then
 //! refines X and Z together on the board corners' reprojection error.
 
+mod board_pose;
+mod least_squares;
 mod refine;
 mod rotation_fit;
 
+pub use board_pose::{BoardPose, MIN_POSE_CORNERS, board_pose_from_corners};
 pub use refine::{BoardCorner, CornerStation, RefinedHandEye, refine_on_corners};
 
 use crate::geometry::Pose;
@@ -72,6 +75,12 @@ pub enum HandEyeError {
         "every motion turns the flange about one axis, so the camera's turn about it and its offset along it are unknown; turn it about at least two axes"
     )]
     OneAxis,
+    #[error("a board's pose needs at least 6 of its corners seen; got {0}")]
+    TooFewBoardCorners(usize),
+    #[error("the board's corners lie on one line, which fixes no pose")]
+    CornersOnALine,
+    #[error("a board corner's position or pixel is not a finite number")]
+    BoardCornersNotFinite,
     #[error("station {station}: {what}")]
     BadStation { station: usize, what: String },
     #[error("the camera's intrinsics: {0}")]

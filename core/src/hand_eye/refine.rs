@@ -2,9 +2,10 @@
 //! in the image. Each closed form sees a station only through the board's pose, whose depth
 //! along the optical axis is its least certain part; minimising the corners' reprojection
 //! error over the camera in the base (X) and the board on the flange (Z) together weighs
-//! every corner by what the image fixes. Levenberg-Marquardt over the 12 parameters (a turn
-//! and a shift applied to each), central-difference Jacobian.
+//! every corner by what the image fixes. Levenberg-Marquardt (`least_squares`) over the 12
+//! parameters: a turn and a shift applied to each.
 
+use super::least_squares::levenberg_marquardt;
 use super::{HandEyeError, HandEyeSolution, checked_pose};
 use crate::geometry::{CameraIntrinsics, Pose};
 use glam::{DQuat, DVec3};
@@ -39,7 +40,6 @@ pub struct RefinedHandEye {
 }
 
 const PARAMETERS: usize = 12;
-const MAX_ITERATIONS: usize = 100;
 
 /// Refines `start` (a closed form's solution) on the stations' corners.
 pub fn refine_on_corners(
@@ -58,55 +58,12 @@ pub fn refine_on_corners(
         return Err(HandEyeError::TooFewCorners(corners));
     }
     let base = (start.camera_in_base, start.board_in_flange);
-    let residuals = |p: &[f64; PARAMETERS]| residuals(stations, intrinsics, &moved(&base, p));
+    let fit = levenberg_marquardt(&|p: &[f64; PARAMETERS]| {
+        residuals(stations, intrinsics, &moved(&base, p))
+    });
+    let (p, r) = (fit.parameters, fit.residuals);
     let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
-    let mut p = [0.0f64; PARAMETERS];
-    let mut r = residuals(&p);
-    let mut err = cost(&r);
-    let mut damping = 1e-3;
-    let (mut iterations, mut converged) = (0, false);
-    while iterations < MAX_ITERATIONS {
-        iterations += 1;
-        let jacobian = jacobian(&residuals, &p, r.len());
-        // Normal equations J^T J d = -J^T r, damped on the diagonal.
-        let mut jtj = [[0.0f64; PARAMETERS]; PARAMETERS];
-        let mut jtr = [0.0f64; PARAMETERS];
-        for (row, ri) in jacobian.iter().zip(&r) {
-            for a in 0..PARAMETERS {
-                jtr[a] += row[a] * ri;
-                for b in 0..PARAMETERS {
-                    jtj[a][b] += row[a] * row[b];
-                }
-            }
-        }
-        let mut improved = false;
-        for _ in 0..10 {
-            let mut damped = jtj;
-            for (a, row) in damped.iter_mut().enumerate() {
-                row[a] *= 1.0 + damping;
-            }
-            let Some(step) = solve(damped, jtr.map(|v| -v)) else {
-                damping *= 10.0;
-                continue;
-            };
-            let trial: [f64; PARAMETERS] = std::array::from_fn(|k| p[k] + step[k]);
-            let tr = residuals(&trial);
-            let te = cost(&tr);
-            if te < err {
-                let small = err - te < 1e-12 * err.max(1e-300);
-                (p, r, err) = (trial, tr, te);
-                damping = (damping / 10.0).max(1e-12);
-                improved = !small;
-                break;
-            }
-            damping *= 10.0;
-        }
-        if !improved {
-            // No step lowers the error, or only by rounding: a minimum.
-            converged = true;
-            break;
-        }
-    }
+    let err = cost(&r);
     let (camera_in_base, board_in_flange) = moved(&base, &p);
     let mut station_rms_px = Vec::with_capacity(stations.len());
     let mut at = 0;
@@ -120,8 +77,8 @@ pub fn refine_on_corners(
         board_in_flange,
         rms_px: (err / corners as f64).sqrt(),
         station_rms_px,
-        iterations,
-        converged,
+        iterations: fit.iterations,
+        converged: fit.converged,
     })
 }
 
@@ -184,55 +141,4 @@ fn residuals(
         }
     }
     out
-}
-
-fn jacobian(
-    residuals: &dyn Fn(&[f64; PARAMETERS]) -> Vec<f64>,
-    p: &[f64; PARAMETERS],
-    rows: usize,
-) -> Vec<[f64; PARAMETERS]> {
-    // 1e-7 rad and 1e-7 m: far above f64's rounding of a metre, far below a pixel's worth.
-    let h = 1e-7;
-    let mut jacobian = vec![[0.0f64; PARAMETERS]; rows];
-    for k in 0..PARAMETERS {
-        let (mut plus, mut minus) = (*p, *p);
-        plus[k] += h;
-        minus[k] -= h;
-        let (rp, rm) = (residuals(&plus), residuals(&minus));
-        for (row, (a, b)) in jacobian.iter_mut().zip(rp.iter().zip(&rm)) {
-            row[k] = (a - b) / (2.0 * h);
-        }
-    }
-    jacobian
-}
-
-/// `a x = b` by Gaussian elimination with partial pivoting; None when `a` is singular.
-fn solve(
-    mut a: [[f64; PARAMETERS]; PARAMETERS],
-    mut b: [f64; PARAMETERS],
-) -> Option<[f64; PARAMETERS]> {
-    let scale = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-    for col in 0..PARAMETERS {
-        let pivot =
-            (col..PARAMETERS).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[pivot][col].abs() <= 1e-14 * scale {
-            return None;
-        }
-        a.swap(col, pivot);
-        b.swap(col, pivot);
-        for row in col + 1..PARAMETERS {
-            let f = a[row][col] / a[col][col];
-            let pivot_row = a[col];
-            for (x, p) in a[row].iter_mut().zip(pivot_row).skip(col) {
-                *x -= f * p;
-            }
-            b[row] -= f * b[col];
-        }
-    }
-    let mut x = [0.0f64; PARAMETERS];
-    for row in (0..PARAMETERS).rev() {
-        let tail: f64 = (row + 1..PARAMETERS).map(|k| a[row][k] * x[k]).sum();
-        x[row] = (b[row] - tail) / a[row][row];
-    }
-    Some(x)
 }
