@@ -89,6 +89,15 @@ pub fn run(args: &BoardArgs) -> Result<()> {
         args.out.with_extension("svg"),
         args.out.with_extension("toml"),
     );
+    // All three or none: a path that cannot take a file is refused before any is written.
+    for path in [&args.out, &svg_path, &toml_path] {
+        if path.is_dir() {
+            bail!(
+                "{}: is a directory; the board writes a file there",
+                path.display()
+            );
+        }
+    }
     let image = board_image(&board, args.px_per_mm, args.margin_mm);
     let mut png = std::io::Cursor::new(Vec::new());
     image

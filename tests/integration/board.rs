@@ -85,4 +85,13 @@ fn a_board_that_cannot_be_made_is_refused_by_flag_and_nothing_is_written() {
             "{args:?} wrote files"
         );
     }
+    // The SVG's place taken by a folder: refused before the PNG is written.
+    std::fs::create_dir(dir.path().join("b.svg")).unwrap();
+    let out = tactex(&["board", "--out", png]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("b.svg: is a directory"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("b.png").exists(), "a PNG without its SVG");
 }
