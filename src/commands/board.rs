@@ -20,10 +20,10 @@ pub struct BoardArgs {
     /// Squares across and down, e.g. 7x5 (2 to 40 each).
     #[arg(long, default_value = "7x5", value_parser = squares)]
     pub squares: (usize, usize),
-    /// A square's side (mm), in (0, 1000].
+    /// A square's side (mm), 1 to 1000.
     #[arg(long, default_value_t = 30.0, value_parser = above(0.0, 1000.0))]
     pub square_mm: f64,
-    /// A marker's side (mm), smaller than a square's.
+    /// A marker's side (mm), 0.5 to 1000 and smaller than a square's.
     #[arg(long, default_value_t = 22.0, value_parser = above(0.0, 1000.0))]
     pub marker_mm: f64,
     /// OpenCV's predefined ArUco dictionary the markers come from.
@@ -83,6 +83,12 @@ pub fn run(args: &BoardArgs) -> Result<()> {
     if side_px > MAX_SIDE_PX {
         bail!(
             "--px-per-mm: the image would be {side_px:.0} px a side; at most {MAX_SIDE_PX:.0} (lower --px-per-mm or --margin-mm)"
+        );
+    }
+    let cell_px = board.marker_mm / (board.dictionary.marker_bits() + 2) as f64 * args.px_per_mm;
+    if cell_px < 1.0 {
+        bail!(
+            "--px-per-mm: a marker's bit would be {cell_px:.2} px in the PNG; at least 1 (raise --px-per-mm)"
         );
     }
     let (svg_path, toml_path) = (

@@ -68,6 +68,14 @@ fn a_board_that_cannot_be_made_is_refused_by_flag_and_nothing_is_written() {
         (vec!["--square-mm", "nan"], "--square-mm"),
         (vec!["--px-per-mm", "90"], "--px-per-mm: the image would be"),
         (
+            vec!["--px-per-mm", "0.1"],
+            "--px-per-mm: a marker's bit would be 0.31 px",
+        ),
+        (
+            vec!["--square-mm", "0.5", "--marker-mm", "0.4"],
+            "--square-mm must be 1 to 1000 mm; got 0.5",
+        ),
+        (
             vec!["--squares", "11x10", "--dictionary", "DICT_4X4_50"],
             "needs 55 markers; DICT_4X4_50 has 50",
         ),

@@ -87,19 +87,21 @@ impl CharucoBoard {
                 value: value.to_string(),
             })
         };
-        let length = |field, value: f64| {
-            (!(value.is_finite() && value > 0.0 && value <= 1000.0)).then(|| {
+        // A square under a millimetre, or a marker under half of one, is finer than a
+        // printer or a camera resolves.
+        let length = |field, value: f64, range: &'static str, lo: f64| {
+            (!(value.is_finite() && value >= lo && value <= 1000.0)).then(|| {
                 BoardError::OutOfRange {
                     field,
-                    range: "a length above 0 and up to 1000 mm",
+                    range,
                     value: value.to_string(),
                 }
             })
         };
         let first = squares("squares_x", self.squares_x)
             .or_else(|| squares("squares_y", self.squares_y))
-            .or_else(|| length("square_mm", self.square_mm))
-            .or_else(|| length("marker_mm", self.marker_mm));
+            .or_else(|| length("square_mm", self.square_mm, "1 to 1000 mm", 1.0))
+            .or_else(|| length("marker_mm", self.marker_mm, "0.5 to 1000 mm", 0.5));
         if let Some(e) = first {
             return Err(e);
         }

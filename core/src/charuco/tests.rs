@@ -115,14 +115,14 @@ fn a_board_that_cannot_be_made_names_its_field() {
                 square_mm: f64::NAN,
                 ..board
             },
-            "square_mm must be",
+            "square_mm must be 1 to 1000 mm; got NaN",
         ),
         (
             CharucoBoard {
                 marker_mm: 0.0,
                 ..board
             },
-            "marker_mm must be",
+            "marker_mm must be 0.5 to 1000 mm; got 0",
         ),
         (
             CharucoBoard {
