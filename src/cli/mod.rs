@@ -57,7 +57,8 @@ pub(crate) enum Command {
     /// frames (SSIM, mean absolute intensity error); or, with --session, rebuild a recorded
     /// session's presses in the twin (SSIM, marker displacement error, hardness agreement).
     Compare(sim2real::compare::CompareArgs),
-    /// The ChArUco calibration board to print (PNG, SVG at true scale) and its description.
+    /// The ChArUco calibration board to print (PNG, SVG at true scale: print it at 100%,
+    /// landscape on A4) and its description; OpenCV 4.6's layout (not the legacy pattern).
     Board(commands::board::BoardArgs),
     /// Marker centroids on a tactile frame, and displacements against a reference frame.
     Markers(commands::markers::MarkersArgs),

@@ -21,10 +21,10 @@ pub struct BoardArgs {
     #[arg(long, default_value = "7x5", value_parser = squares)]
     pub squares: (usize, usize),
     /// A square's side (mm), 1 to 1000.
-    #[arg(long, default_value_t = 30.0, value_parser = above(0.0, 1000.0))]
+    #[arg(long, default_value_t = 30.0, value_parser = within(1.0, 1000.0))]
     pub square_mm: f64,
     /// A marker's side (mm), 0.5 to 1000 and smaller than a square's.
-    #[arg(long, default_value_t = 22.0, value_parser = above(0.0, 1000.0))]
+    #[arg(long, default_value_t = 22.0, value_parser = within(0.5, 1000.0))]
     pub marker_mm: f64,
     /// OpenCV's predefined ArUco dictionary the markers come from.
     #[arg(long, default_value = "DICT_5X5_100", value_parser = choice::<ArucoDictionary>(&DICTIONARY_NAMES))]
@@ -82,7 +82,7 @@ pub fn run(args: &BoardArgs) -> Result<()> {
     let side_px = (w_mm.max(h_mm) + 2.0 * args.margin_mm) * args.px_per_mm;
     if side_px > MAX_SIDE_PX {
         bail!(
-            "--px-per-mm: the image would be {side_px:.0} px a side; at most {MAX_SIDE_PX:.0} (lower --px-per-mm or --margin-mm)"
+            "--px-per-mm: the image would be {side_px:.0} px a side; at most {MAX_SIDE_PX:.0} (lower --px-per-mm or --margin-mm, or make the board smaller: --squares, --square-mm)"
         );
     }
     let cell_px = board.marker_mm / (board.dictionary.marker_bits() + 2) as f64 * args.px_per_mm;
@@ -112,13 +112,15 @@ pub fn run(args: &BoardArgs) -> Result<()> {
     let toml = format!(
         "# ChArUco board written by `tactex board`: print {} at 100% ({} x {} mm without its margin)\n{}",
         file_name(&svg_path),
-        w_mm,
-        h_mm,
+        mm(w_mm),
+        mm(h_mm),
         toml::to_string(&board).context("writing the board's TOML")?
     );
-    write_bytes_atomic(&args.out, png.get_ref())?;
-    write_bytes_atomic(&svg_path, board_svg(&board, args.margin_mm).as_bytes())?;
-    write_bytes_atomic(&toml_path, toml.as_bytes())?;
+    write_all_or_none(&[
+        (&args.out, png.get_ref().as_slice()),
+        (&svg_path, board_svg(&board, args.margin_mm).as_bytes()),
+        (&toml_path, toml.as_bytes()),
+    ])?;
     let report = BoardReport {
         board: &board,
         corners: board.corners().len(),
@@ -139,8 +141,8 @@ pub fn run(args: &BoardArgs) -> Result<()> {
             board.marker_mm,
             board.dictionary,
             report.corners,
-            w_mm,
-            h_mm
+            mm(w_mm),
+            mm(h_mm)
         );
         println!(
             "{} x {} px at {} px/mm; print {} at 100% (no fit to page), and measure a square: it must be {} mm; description in {}",
@@ -155,6 +157,30 @@ pub fn run(args: &BoardArgs) -> Result<()> {
     })
 }
 
+/// Each file written whole, and none left when a later one fails (a PNG without its
+/// true-scale SVG would be printed at the wrong size); files that were there before stay.
+fn write_all_or_none(files: &[(&PathBuf, &[u8])]) -> Result<()> {
+    let mut written = Vec::new();
+    for (path, bytes) in files {
+        let existed = path.exists();
+        if let Err(e) = write_bytes_atomic(path, bytes) {
+            for created in written {
+                let _ = std::fs::remove_file(created);
+            }
+            return Err(e);
+        }
+        if !existed {
+            written.push(*path);
+        }
+    }
+    Ok(())
+}
+
+/// A length in mm as people write it: 233.1, not 233.09999999999997.
+fn mm(v: f64) -> String {
+    tactex_core::printable::short_number((v * 1e6).round() / 1e6)
+}
+
 /// The board's field names as this command's flags.
 fn flag_words(message: &str) -> String {
     message
@@ -162,6 +188,7 @@ fn flag_words(message: &str) -> String {
         .replace("squares_y", "--squares (down)")
         .replace("square_mm", "--square-mm")
         .replace("marker_mm", "--marker-mm")
+        .replace("markers; DICT", "markers (--squares); DICT")
 }
 
 fn file_name(path: &Path) -> String {

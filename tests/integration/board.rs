@@ -73,11 +73,11 @@ fn a_board_that_cannot_be_made_is_refused_by_flag_and_nothing_is_written() {
         ),
         (
             vec!["--square-mm", "0.5", "--marker-mm", "0.4"],
-            "--square-mm must be 1 to 1000 mm; got 0.5",
+            "0.5 is outside [1, 1000]",
         ),
         (
             vec!["--squares", "11x10", "--dictionary", "DICT_4X4_50"],
-            "needs 55 markers; DICT_4X4_50 has 50",
+            "11 x 10 squares need 55 markers (--squares); DICT_4X4_50 has 50",
         ),
     ] {
         let mut all = vec!["board", "--out", png];
@@ -102,4 +102,10 @@ fn a_board_that_cannot_be_made_is_refused_by_flag_and_nothing_is_written() {
         "{stderr}"
     );
     assert!(!dir.path().join("b.png").exists(), "a PNG without its SVG");
+    // The TOML's name too long for the file system: the PNG and SVG written before it go.
+    let long = dir.path().join(format!("{}.png", "a".repeat(251)));
+    let out = tactex(&["board", "--out", long.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(left.len(), 1, "only the folder b.svg stays: {left:?}");
 }

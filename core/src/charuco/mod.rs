@@ -56,7 +56,7 @@ pub enum BoardError {
     )]
     MarkerTooLarge { marker_mm: f64, square_mm: f64 },
     #[error(
-        "a {squares_x} x {squares_y} board needs {needed} markers; {dictionary} has {available}"
+        "{squares_x} x {squares_y} squares need {needed} markers; {dictionary} has {available}"
     )]
     TooFewMarkers {
         squares_x: usize,

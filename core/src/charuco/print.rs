@@ -34,7 +34,9 @@ pub fn board_image(board: &CharucoBoard, px_per_mm: f64, margin_mm: f64) -> Gray
 /// a white margin of `margin_mm`; the board's description in its title.
 pub fn board_svg(board: &CharucoBoard, margin_mm: f64) -> String {
     let (w_mm, h_mm) = board.size_mm();
-    let (w, h) = (w_mm + 2.0 * margin_mm, h_mm + 2.0 * margin_mm);
+    // Rounded to a nanometre: 233.1, not 233.09999999999997.
+    let round = |v: f64| (v * 1e6).round() / 1e6;
+    let (w, h) = (round(w_mm + 2.0 * margin_mm), round(h_mm + 2.0 * margin_mm));
     let mut svg = String::new();
     let _ = writeln!(
         svg,

@@ -138,7 +138,7 @@ fn a_board_that_cannot_be_made_names_its_field() {
                 dictionary: ArucoDictionary::Dict4x4_50,
                 ..board
             },
-            "a 11 x 10 board needs 55 markers; DICT_4X4_50 has 50",
+            "11 x 10 squares need 55 markers; DICT_4X4_50 has 50",
         ),
     ];
     for (b, want) in cases {
