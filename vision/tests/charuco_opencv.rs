@@ -34,6 +34,14 @@ fn score(image: &image::RgbImage, board: &CharucoBoard, pose: &Pose) -> (usize, 
     (sighting.corners.len(), worst)
 }
 
+/// The camera's noise: one draw per pixel, the same on its three channels.
+fn add_noise(image: &mut image::RgbImage, noise: &Normal<f64>, rng: &mut impl rand::Rng) {
+    image.pixels_mut().for_each(|p| {
+        let n = noise.sample(rng);
+        p.0 = p.0.map(|c| (c as f64 + n).round().clamp(0.0, 255.0) as u8);
+    });
+}
+
 fn poses(board: &CharucoBoard) -> Vec<(&'static str, Pose)> {
     vec![
         (
@@ -78,10 +86,7 @@ fn corners_hold_through_camera_noise() {
     let noise = Normal::new(0.0, 3.0).unwrap();
     for (name, pose) in poses(&board) {
         let mut image = board_view(&face, &pose, &k, &SheetLook::default(), [90, 90, 90]);
-        image.pixels_mut().for_each(|p| {
-            let n = noise.sample(&mut rng);
-            p.0 = p.0.map(|c| (c as f64 + n).round().clamp(0.0, 255.0) as u8);
-        });
+        add_noise(&mut image, &noise, &mut rng);
         let (found, worst) = score(&image, &board, &pose);
         assert!(found >= 22, "{name}: {found} corners");
         assert!(worst < 0.5, "{name}: worst corner {worst:.3} px off");
@@ -166,10 +171,7 @@ fn the_camera_is_placed_from_fifteen_rendered_stations() {
             .compose(&seen)
             .compose(&board_in_flange.inverse());
         let mut image = board_view(&face, &seen, &k, &SheetLook::default(), [90, 90, 90]);
-        image.pixels_mut().for_each(|p| {
-            let n = noise.sample(&mut rng);
-            p.0 = p.0.map(|c| (c as f64 + n).round().clamp(0.0, 255.0) as u8);
-        });
+        add_noise(&mut image, &noise, &mut rng);
         let sighting = CharucoDetector.detect(&image, &board).unwrap();
         let on_board = board.corners();
         let corners: Vec<BoardCorner> = sighting

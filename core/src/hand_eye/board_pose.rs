@@ -3,7 +3,7 @@
 //! first, Hartley's conditioning), split into a rotation and a translation (Zhang 2000), then
 //! refined on the corners' reprojection error.
 
-use super::least_squares::{levenberg_marquardt, solve};
+use super::least_squares::{levenberg_marquardt, nudged, solve};
 use super::{BoardCorner, HandEyeError};
 use crate::geometry::{CameraIntrinsics, Pose};
 use glam::{DMat3, DQuat, DVec3};
@@ -36,11 +36,14 @@ pub fn board_pose_from_corners(
         return Err(HandEyeError::BoardCornersNotFinite);
     }
     let start = homography_pose(corners, intrinsics).ok_or(HandEyeError::CornersOnALine)?;
-    let fit =
-        levenberg_marquardt(&|p: &[f64; 6]| reprojection(corners, intrinsics, &moved(&start, p)));
+    let fit = levenberg_marquardt(&|p: &[f64; 6]| {
+        let mut r = Vec::with_capacity(2 * corners.len());
+        push_reprojection(&mut r, corners, intrinsics, &nudged(&start, p));
+        r
+    });
     let rms_px = (fit.residuals.iter().map(|r| r * r).sum::<f64>() / corners.len() as f64).sqrt();
     Ok(BoardPose {
-        board_in_camera: moved(&start, &fit.parameters),
+        board_in_camera: nudged(&start, &fit.parameters),
         rms_px,
     })
 }
@@ -105,24 +108,19 @@ fn homography_pose(corners: &[BoardCorner], k: &CameraIntrinsics) -> Option<Pose
     Some(Pose::new(h3 * s, rotation))
 }
 
-/// `start` turned by p's rotation vector and shifted by its translation (m).
-fn moved(start: &Pose, p: &[f64; 6]) -> Pose {
-    Pose::new(
-        start.position + DVec3::new(p[3], p[4], p[5]),
-        DQuat::from_scaled_axis(DVec3::new(p[0], p[1], p[2])) * start.rotation,
-    )
-}
-
-/// Each corner's projection through `board_in_camera` less where it was seen (u then v); a
-/// corner behind the camera counts as far off.
-fn reprojection(corners: &[BoardCorner], k: &CameraIntrinsics, board_in_camera: &Pose) -> Vec<f64> {
-    corners
-        .iter()
-        .flat_map(|c| {
-            let (u, v) = k
-                .project(board_in_camera.transform_point(c.on_board_m))
-                .unwrap_or((1e6, 1e6));
-            [u - c.seen_px[0], v - c.seen_px[1]]
-        })
-        .collect()
+/// Each corner's projection through `board_in_camera` less where it was seen (u then v),
+/// appended to `out`; a corner behind the camera counts as far off.
+pub(super) fn push_reprojection(
+    out: &mut Vec<f64>,
+    corners: &[BoardCorner],
+    k: &CameraIntrinsics,
+    board_in_camera: &Pose,
+) {
+    for c in corners {
+        let (u, v) = k
+            .project(board_in_camera.transform_point(c.on_board_m))
+            .unwrap_or((1e6, 1e6));
+        out.push(u - c.seen_px[0]);
+        out.push(v - c.seen_px[1]);
+    }
 }

@@ -2,6 +2,18 @@
 //! fixed number of parameters, central-difference Jacobian, steps damped on the diagonal
 //! (Marquardt's scaling), used for the board's pose and for the camera and board together.
 
+use crate::geometry::Pose;
+use glam::{DQuat, DVec3};
+
+/// `pose` turned by the rotation vector `p[0..3]` and shifted by `p[3..6]` (m): the six
+/// increments a fit searches over for each pose it refines.
+pub(crate) fn nudged(pose: &Pose, p: &[f64]) -> Pose {
+    Pose::new(
+        pose.position + DVec3::new(p[3], p[4], p[5]),
+        DQuat::from_scaled_axis(DVec3::new(p[0], p[1], p[2])) * pose.rotation,
+    )
+}
+
 /// Steps tried at most.
 const MAX_ITERATIONS: usize = 100;
 

@@ -5,10 +5,11 @@
 //! every corner by what the image fixes. Levenberg-Marquardt (`least_squares`) over the 12
 //! parameters: a turn and a shift applied to each.
 
-use super::least_squares::levenberg_marquardt;
+use super::board_pose::push_reprojection;
+use super::least_squares::{levenberg_marquardt, nudged};
 use super::{HandEyeError, HandEyeSolution, checked_pose};
 use crate::geometry::{CameraIntrinsics, Pose};
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use serde::Serialize;
 
 /// A station with the board's corners as the camera saw them.
@@ -112,17 +113,10 @@ fn checked_corner_stations(stations: &[CornerStation]) -> Result<Vec<CornerStati
 
 /// X and Z turned by p's rotation vectors and shifted by its translations (m).
 fn moved(base: &(Pose, Pose), p: &[f64; PARAMETERS]) -> (Pose, Pose) {
-    let apply = |pose: &Pose, q: &[f64]| {
-        Pose::new(
-            pose.position + DVec3::new(q[3], q[4], q[5]),
-            DQuat::from_scaled_axis(DVec3::new(q[0], q[1], q[2])) * pose.rotation,
-        )
-    };
-    (apply(&base.0, &p[..6]), apply(&base.1, &p[6..]))
+    (nudged(&base.0, &p[..6]), nudged(&base.1, &p[6..]))
 }
 
-/// Each corner's seen pixel less its projection through X^-1 F_i Z (u then v); a corner
-/// behind the camera counts as far off.
+/// Each corner's projection through X^-1 F_i Z less its seen pixel, station by station.
 fn residuals(
     stations: &[CornerStation],
     intrinsics: &CameraIntrinsics,
@@ -132,13 +126,7 @@ fn residuals(
     let mut out = Vec::new();
     for s in stations {
         let board_in_camera = base_in_camera.compose(&s.flange_in_base.compose(board_in_flange));
-        for corner in &s.corners {
-            let (u, v) = intrinsics
-                .project(board_in_camera.transform_point(corner.on_board_m))
-                .unwrap_or((1e6, 1e6));
-            out.push(u - corner.seen_px[0]);
-            out.push(v - corner.seen_px[1]);
-        }
+        push_reprojection(&mut out, &s.corners, intrinsics, &board_in_camera);
     }
     out
 }
