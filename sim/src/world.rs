@@ -2,9 +2,11 @@
 //! rapier3d), the tool (GelSight pad) pose, and the simulated clock.
 
 use crate::mesh::{self, MeshError, TriMesh};
+use crate::render::board_view::SheetLook;
 use glam::{DQuat, DVec3};
 use rapier3d::prelude::*;
 use std::sync::{Arc, Mutex};
+use tactex_core::charuco::CharucoBoard;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::hardness::scale::Hardness;
 use tactex_core::scene::{ObjectKind, Scene, Table};
@@ -34,6 +36,18 @@ pub struct SimWorld {
     /// Pose of the tactile pad (centre of the gel surface, tool z pointing at the object).
     pub tool: Pose,
     pub time_s: f64,
+    /// A calibration board the arm holds (hand-eye calibration), moving with the tool.
+    pub held_board: Option<HeldBoard>,
+}
+
+/// A ChArUco board fixed to the arm's end, as the scene camera sees it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldBoard {
+    pub board: CharucoBoard,
+    /// The board's frame (OpenCV's: origin at its top-left corner, x along the squares'
+    /// rows, z into the sheet, the printed face looking along -z) in the tool's frame.
+    pub board_in_tool: Pose,
+    pub look: SheetLook,
 }
 
 pub type SharedWorld = Arc<Mutex<SimWorld>>;
@@ -196,6 +210,7 @@ impl SimWorld {
             intrinsics: scene.intrinsics,
             tool: tool_park_pose(&scene.table),
             time_s: 0.0,
+            held_board: None,
         })
     }
 

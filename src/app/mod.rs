@@ -10,6 +10,7 @@ pub mod estimator_choice;
 pub mod explainer_choice;
 pub mod file_input;
 pub mod flag_range;
+pub mod hand_eye;
 pub mod hardware;
 pub mod image_input;
 pub mod llm_chat;

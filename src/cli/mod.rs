@@ -60,6 +60,10 @@ pub(crate) enum Command {
     /// The ChArUco calibration board to print (PNG, SVG at true scale: print it at 100%,
     /// landscape on A4) and its description; OpenCV 4.6's layout (not the legacy pattern).
     Board(commands::board::BoardArgs),
+    /// Where the scene camera stands in the arm's frame (eye-to-hand): the arm holds a
+    /// ChArUco board at planned stations, OpenCV finds its corners, Tsai-Lenz, Park-Martin and
+    /// a refinement on the corners place the camera; writes the calibration (TOML).
+    Handeye(commands::handeye::HandEyeArgs),
     /// Marker centroids on a tactile frame, and displacements against a reference frame.
     Markers(commands::markers::MarkersArgs),
     /// Contact or not against a no-contact frame (the paper's SSIM criterion), and the
@@ -115,6 +119,9 @@ pub(crate) enum BenchCommand {
 pub(crate) enum EvalCommand {
     /// The paper's grounding protocol: detectors' success, IoU and centroid error.
     Grounding(eval::grounding::GroundingEvalArgs),
+    /// Hand-eye calibration on the twin against the number of stations: each solver's
+    /// camera error (mm, degrees) against the twin's truth, plotted.
+    Handeye(eval::handeye::HandEyeEvalArgs),
     /// Hardness estimators on held-out synthetic presses of unseen shapes.
     Hardness(eval::hardness::HardnessEvalArgs),
     /// The paper's Table III: ripeness stages of five fruits told apart by pressing.
@@ -204,6 +211,7 @@ pub(crate) fn run(command: Command) -> Result<()> {
         Command::Sensor { command } => commands::sensor::run(&command),
         Command::Compare(args) => sim2real::compare::run(&args),
         Command::Board(args) => commands::board::run(&args),
+        Command::Handeye(args) => commands::handeye::run(&args),
         Command::Markers(args) => commands::markers::run(&args),
         Command::Contact(args) => commands::contact::run(&args),
         Command::Read(args) => commands::read::run(&args),
@@ -212,6 +220,10 @@ pub(crate) fn run(command: Command) -> Result<()> {
         Command::Eval {
             command: EvalCommand::Grounding(args),
         } => eval::grounding::run(&args),
+        #[cfg(feature = "plots")]
+        Command::Eval {
+            command: EvalCommand::Handeye(args),
+        } => eval::handeye::run(&args),
         #[cfg(feature = "plots")]
         Command::Eval {
             command: EvalCommand::Hardness(args),

@@ -6,6 +6,7 @@ pub mod ask;
 pub mod board;
 pub mod contact;
 pub mod detect;
+pub mod handeye;
 pub mod markers;
 pub mod parse;
 pub mod press;

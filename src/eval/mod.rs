@@ -7,6 +7,7 @@ use rand_chacha::ChaCha8Rng;
 pub mod explanations;
 pub mod fruits;
 pub mod grounding;
+pub mod handeye;
 pub mod hardness;
 pub mod report_matching;
 pub mod ripeness;

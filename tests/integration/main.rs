@@ -10,6 +10,7 @@ mod datagen;
 mod datagen_scenes;
 mod detect;
 mod eval;
+mod handeye;
 mod hw_backend;
 mod input_bounds;
 mod numeric_flags;

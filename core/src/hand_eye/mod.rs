@@ -14,11 +14,17 @@
 
 mod board_pose;
 mod least_squares;
+mod plan;
 mod refine;
 mod rotation_fit;
+mod visit;
 
 pub use board_pose::{BoardPose, MIN_POSE_CORNERS, board_pose_from_corners};
+pub use plan::{MAX_STATIONS, StationRequest, plan_stations};
 pub use refine::{BoardCorner, CornerStation, RefinedHandEye, refine_on_corners};
+pub use visit::{
+    HandEyeRun, StationReport, StationSighting, VisitError, solve_sightings, visit_stations,
+};
 
 use crate::geometry::Pose;
 use glam::{DMat3, DQuat, DVec3};
@@ -85,6 +91,16 @@ pub enum HandEyeError {
     BadStation { station: usize, what: String },
     #[error("the camera's intrinsics: {0}")]
     BadIntrinsics(String),
+    #[error("a station plan holds 3 to {max} stations; asked for {0}", max = plan::MAX_STATIONS)]
+    StationCount(usize),
+    #[error(
+        "only {planned} of {asked} stations could be placed with the whole board in the camera's view and the tool in the arm's reach; check the camera's pose and the board's size"
+    )]
+    StationsOutOfReach { planned: usize, asked: usize },
+    #[error(
+        "the board was seen at {seen} of {stations} stations; the camera's pose needs at least 3 (is the board in view, lit, and the dictionary the printed one?)"
+    )]
+    BoardUnseen { seen: usize, stations: usize },
 }
 
 /// The smallest turn (degrees) a pair of stations must make to count as a rotation: below

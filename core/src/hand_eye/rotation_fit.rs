@@ -73,7 +73,7 @@ fn vector_part(q: DQuat) -> DVec3 {
 }
 
 /// The rotation vector: turn (radians, 0 to pi) times axis.
-fn logarithm(q: DQuat) -> DVec3 {
+pub(super) fn logarithm(q: DQuat) -> DVec3 {
     let q = if q.w < 0.0 { -q } else { q };
     let (axis, angle) = q.to_axis_angle();
     axis * angle

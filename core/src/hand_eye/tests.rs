@@ -446,3 +446,142 @@ fn a_pose_from_too_few_or_collinear_corners_is_refused() {
         Err(HandEyeError::BoardCornersNotFinite)
     );
 }
+
+/// A plan for the default board under a camera looking down from 0.7 m over the table.
+fn plan_request(stations: usize) -> StationRequest {
+    StationRequest {
+        camera_in_base: Pose::camera_looking_at(DVec3::new(0.0, 0.0, 0.7), DVec3::ZERO).unwrap(),
+        intrinsics: CameraIntrinsics::default(),
+        board: crate::charuco::CharucoBoard::default(),
+        margin_mm: 10.0,
+        board_in_tool: true_board(),
+        stations,
+    }
+}
+
+#[test]
+fn planned_stations_show_the_whole_board_and_turn_about_every_axis() {
+    let request = plan_request(15);
+    let tools = plan_stations(&request, |_| true).unwrap();
+    assert_eq!(tools.len(), 15);
+    assert_eq!(
+        tools,
+        plan_stations(&request, |_| true).unwrap(),
+        "deterministic"
+    );
+    let k = request.intrinsics;
+    let (w_mm, h_mm) = request.board.size_mm();
+    let mut stations = Vec::new();
+    for tool in &tools {
+        let board_in_camera = request
+            .camera_in_base
+            .inverse()
+            .compose(&tool.compose(&request.board_in_tool));
+        for (x, y) in [
+            (-10.0, -10.0),
+            (w_mm + 10.0, h_mm + 10.0),
+            (-10.0, h_mm + 10.0),
+        ] {
+            let p = board_in_camera.transform_point(DVec3::new(x, y, 0.0) * 1e-3);
+            let (u, v) = k.project(p).expect("in front of the camera");
+            assert!(u > 0.0 && u < k.width as f64 && v > 0.0 && v < k.height as f64);
+        }
+        // The printed face (-z of the board) looks at the camera.
+        let facing = (board_in_camera.rotation * DVec3::NEG_Z).dot(-board_in_camera.position);
+        assert!(facing > 0.0);
+        stations.push(Station {
+            flange_in_base: *tool,
+            board_in_camera,
+        });
+    }
+    // Exact stations give the camera back: the plan is not degenerate.
+    let found = solve_hand_eye(&stations, HandEyeMethod::ParkMartin).unwrap();
+    let (mm, deg) = errors_against(&request.camera_in_base, &found.camera_in_base);
+    assert!(mm < 1e-6 && deg < 1e-6, "{mm} mm {deg} deg");
+}
+
+#[test]
+fn a_plan_out_of_reach_or_of_the_wrong_size_is_refused() {
+    assert_eq!(
+        plan_stations(&plan_request(15), |_| false),
+        Err(HandEyeError::StationsOutOfReach {
+            planned: 0,
+            asked: 15
+        })
+    );
+    assert_eq!(
+        plan_stations(&plan_request(2), |_| true),
+        Err(HandEyeError::StationCount(2))
+    );
+    assert_eq!(
+        plan_stations(&plan_request(MAX_STATIONS + 1), |_| true),
+        Err(HandEyeError::StationCount(MAX_STATIONS + 1))
+    );
+}
+
+/// A sighting of the planned station `tool`: every corner projected exactly, or none.
+fn sighting(request: &StationRequest, tool: &Pose, seen: bool) -> StationSighting {
+    let board_in_camera = request
+        .camera_in_base
+        .inverse()
+        .compose(&tool.compose(&request.board_in_tool));
+    let corners = match seen {
+        true => request
+            .board
+            .corners()
+            .iter()
+            .map(|p| {
+                let (u, v) = request
+                    .intrinsics
+                    .project(board_in_camera.transform_point(*p))
+                    .unwrap();
+                BoardCorner {
+                    on_board_m: *p,
+                    seen_px: [u, v],
+                }
+            })
+            .collect(),
+        false => Vec::new(),
+    };
+    StationSighting {
+        tool_in_base: *tool,
+        markers: if seen { 17 } else { 0 },
+        corners,
+        image: image::RgbImage::new(1, 1),
+    }
+}
+
+#[test]
+fn stations_without_the_board_are_left_out_and_too_few_seen_is_refused() {
+    let request = plan_request(8);
+    let tools = plan_stations(&request, |_| true).unwrap();
+    let sightings: Vec<_> = tools
+        .iter()
+        .enumerate()
+        .map(|(i, t)| sighting(&request, t, i % 2 == 0))
+        .collect();
+    let run = solve_sightings(&sightings, &request.intrinsics).unwrap();
+    let left_out: Vec<usize> = run
+        .stations
+        .iter()
+        .filter(|s| s.unseen.is_some())
+        .map(|s| s.station)
+        .collect();
+    assert_eq!(left_out, vec![1, 3, 5, 7]);
+    let (mm, deg) = errors_against(&request.camera_in_base, &run.refined.camera_in_base);
+    assert!(mm < 1e-4 && deg < 1e-4, "{mm} mm {deg} deg");
+    assert!(run.stations[0].refined_rms_px.unwrap() < 1e-3);
+
+    let mostly_unseen: Vec<_> = tools
+        .iter()
+        .enumerate()
+        .map(|(i, t)| sighting(&request, t, i < 2))
+        .collect();
+    assert!(matches!(
+        solve_sightings(&mostly_unseen, &request.intrinsics),
+        Err(HandEyeError::BoardUnseen {
+            seen: 2,
+            stations: 8
+        })
+    ));
+}

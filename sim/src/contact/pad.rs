@@ -19,6 +19,9 @@ pub const PRESS_GRID_REACH_MM: f64 = 4.0;
 /// Only the object's surface up to this far above the gel plane can meet the gel within a
 /// press (mm): the rest of the mesh (its top, far sides) is left out of the solve.
 const SURFACE_REACH_MM: f64 = 15.0;
+/// How far the sensor's housing, its mount and the wrist reach behind the gel (mm; the
+/// 24 + 15 + 110 mm of `render::scene::tool_body`).
+const BODY_BEHIND_GEL_MM: f64 = 150.0;
 /// Triangles this far beyond the pad's edge are kept, so that a contact cut by the edge is
 /// seen to be.
 const PAD_MARGIN_MM: f64 = 3.0;
@@ -61,7 +64,9 @@ fn surface_under_pad(mesh: &TriMesh, tool: &Pose, pad: &Rect) -> Option<ObjectSu
     if bhi.x < reach.min.x || blo.x > reach.max.x || bhi.y < reach.min.y || blo.y > reach.max.y {
         return None;
     }
-    if blo.z > SURFACE_REACH_MM {
+    // An object wholly behind the sensor's body (a pad turned up over the table, holding a
+    // calibration board) is not under the pad, however far its surface lies behind the gel.
+    if blo.z > SURFACE_REACH_MM || bhi.z < -BODY_BEHIND_GEL_MM {
         return None;
     }
     let vertices: Vec<DVec3> = mesh

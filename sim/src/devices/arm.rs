@@ -6,6 +6,7 @@ use crate::contact::pad::{deepest_touch, pad_of};
 use crate::world::SharedWorld;
 use tactex_core::devices::{Arm, DeviceError};
 use tactex_core::geometry::Pose;
+use tactex_core::scene::Table;
 use tactex_core::tactile::spec::TactileSpec;
 
 pub struct SimArm {
@@ -38,6 +39,21 @@ impl SimArm {
         }
     }
 
+    /// Whether a move to `target` would be taken: inside the workspace, pressing nothing
+    /// past the crush limit (hand-eye calibration plans its stations with it).
+    pub fn reaches(&self, target: &Pose) -> bool {
+        let world = self.world.lock().expect("world lock");
+        self.in_workspace(&world.table, target.position)
+            && deepest_touch(&world, target, &pad_of(&self.spec))
+                .is_none_or(|c| c.approach_mm <= self.max_approach_mm)
+    }
+
+    /// The workspace box: over the table, from its surface up to `max_z_m`.
+    fn in_workspace(&self, table: &Table, p: glam::DVec3) -> bool {
+        let [hx, hy] = table.size_m.map(|s| s / 2.0);
+        p.x.abs() <= hx && p.y.abs() <= hy && (0.0..=self.max_z_m).contains(&p.z)
+    }
+
     /// Duration of a trapezoidal-profile move of `distance` at cruise `speed`.
     fn move_duration_s(&self, distance: f64, speed: f64) -> f64 {
         let v = speed.min(self.max_speed_m_s);
@@ -67,9 +83,8 @@ impl Arm for SimArm {
             return Err(self.refuse(format!("speed {speed_m_s} m/s must be finite and positive")));
         }
         let mut world = self.world.lock().expect("world lock");
-        let [hx, hy] = world.table.size_m.map(|s| s / 2.0);
         let p = target.position;
-        if p.x.abs() > hx || p.y.abs() > hy || p.z < 0.0 || p.z > self.max_z_m {
+        if !self.in_workspace(&world.table, p) {
             return Err(self.refuse(format!(
                 "target ({:.3}, {:.3}, {:.3}) m is outside the workspace",
                 p.x, p.y, p.z

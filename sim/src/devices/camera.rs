@@ -3,9 +3,10 @@
 //! depth noise model (`depth_noise`).
 
 use crate::devices::depth_noise::{CleanDepth, RealSenseNoise};
+use crate::render::board_view::SheetInCamera;
 use crate::render::device::RenderError;
 use crate::render::scene::{CleanRender, CpuSceneRenderer, SceneGeometry, SceneRenderer};
-use crate::world::SharedWorld;
+use crate::world::{HeldBoard, SharedWorld};
 use image::{Luma, Rgb, RgbImage};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -35,8 +36,9 @@ pub struct SimCamera {
     pose: Pose,
     renderer: Arc<dyn SceneRenderer>,
     /// The objects do not move while they are watched: one clean render serves every frame
-    /// until the arm's pad moves (the arm is in the picture once it enters the view).
-    clean: Option<(Pose, CleanRender)>,
+    /// until the arm's pad moves (the arm is in the picture once it enters the view) or the
+    /// board it holds changes.
+    clean: Option<((Pose, Option<HeldBoard>), CleanRender)>,
     rng: ChaCha8Rng,
     /// Colour noise (grey levels, 1 sigma).
     pub color_noise: f64,
@@ -73,17 +75,40 @@ impl SimCamera {
     /// when the pad has moved since the last render.
     pub fn clean(&mut self) -> Result<&CleanRender, RenderError> {
         let world = self.world.lock().expect("world lock");
-        if self
-            .clean
-            .as_ref()
-            .is_none_or(|(tool, _)| *tool != world.tool)
-        {
+        let key = (world.tool, world.held_board.clone());
+        if self.clean.as_ref().is_none_or(|(seen, _)| *seen != key) {
             let geometry = SceneGeometry::of_world(&world);
-            self.clean = Some((world.tool, self.renderer.render(&geometry)?));
+            let mut render = self.renderer.render(&geometry)?;
+            if let Some(held) = &world.held_board {
+                let (tool, camera) = (world.tool, world.camera_pose);
+                draw_held_board(held, &tool, &camera, &self.intrinsics, &mut render);
+            }
+            self.clean = Some((key, render));
         }
         drop(world);
         Ok(&self.clean.as_ref().expect("rendered").1)
     }
+}
+
+/// The board the arm holds drawn into the scene's render, behind whatever is nearer; it
+/// carries the arm's instance id (0), as the rest of the arm's end does.
+fn draw_held_board(
+    held: &HeldBoard,
+    tool: &Pose,
+    camera: &Pose,
+    intrinsics: &CameraIntrinsics,
+    render: &mut CleanRender,
+) {
+    let face = held.board.face();
+    let board_in_camera = camera.inverse().compose(&tool.compose(&held.board_in_tool));
+    SheetInCamera::new(&face, &board_in_camera, &held.look).over_render(
+        intrinsics,
+        &mut render.color,
+        &mut render.depth_m,
+        &mut render.specular,
+        &mut render.instances,
+        0,
+    );
 }
 
 impl RgbdCamera for SimCamera {

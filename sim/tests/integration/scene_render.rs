@@ -4,7 +4,7 @@
 use glam::DVec3;
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
-use tactex_core::geometry::Pose;
+use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::scene::Scene;
 use tactex_sim::render::device::DeviceChoice;
 use tactex_sim::render::scene::{
@@ -296,4 +296,68 @@ fn gpu_scene_render_is_deterministic() {
     assert_eq!(a.instances.as_raw(), b.instances.as_raw());
     assert_eq!(a.depth_m, b.depth_m);
     assert_eq!(a.color, b.color);
+}
+
+/// A board the arm holds face up at `height_m` under the camera, centred on the table's
+/// middle: the camera's clean render with it.
+fn render_with_board(height_m: f64) -> (CleanRender, CleanRender) {
+    use tactex_core::charuco::CharucoBoard;
+    use tactex_sim::devices::camera::SimCamera;
+    use tactex_sim::render::board_view::SheetLook;
+    use tactex_sim::world::HeldBoard;
+    let shared = sphere_world().shared();
+    let mut camera = SimCamera::new(shared.clone(), 1);
+    let bare = camera.clean().unwrap().clone();
+    let board = CharucoBoard::default();
+    let (w_mm, h_mm) = board.size_mm();
+    {
+        let mut world = shared.lock().unwrap();
+        // The pad pointing up (its housing and the wrist below it); the board over the
+        // pad's face, its frame's origin at a corner, its z (into the sheet) down.
+        world.tool = Pose::new(DVec3::new(0.0, 0.0, height_m), glam::DQuat::IDENTITY);
+        world.held_board = Some(HeldBoard {
+            board,
+            board_in_tool: Pose::new(
+                DVec3::new(-w_mm / 2.0 * 1e-3, h_mm / 2.0 * 1e-3, 0.005),
+                glam::DQuat::from_rotation_x(std::f64::consts::PI),
+            ),
+            look: SheetLook::default(),
+        });
+    }
+    (bare, camera.clean().unwrap().clone())
+}
+
+#[test]
+fn a_held_board_is_seen_at_its_depth_and_hidden_behind_what_is_nearer() {
+    let (_, above) = render_with_board(0.3);
+    let k = CameraIntrinsics::default();
+    // The sheet's middle: 0.7 - 0.305 m from the camera, its white margin or a square.
+    let centre = (k.height / 2) as usize * k.width as usize + (k.width / 2) as usize;
+    assert!(
+        (above.depth_m[centre] - 0.395).abs() < 1e-3,
+        "{}",
+        above.depth_m[centre]
+    );
+    let grey = above.color[centre][0] * 255.0;
+    assert!(
+        (grey - 220.0).abs() < 1.0 || (grey - 25.0).abs() < 1.0,
+        "{grey}"
+    );
+    // Under the table the sheet is hidden: the render is the bare scene's.
+    let (bare, below) = render_with_board(-0.05);
+    let changed: Vec<usize> = (0..bare.color.len())
+        .filter(|i| bare.color[*i] != below.color[*i] || bare.depth_m[*i] != below.depth_m[*i])
+        .collect();
+    assert!(
+        changed.is_empty(),
+        "{} pixels changed, the first at {:?}: {:?} {} -> {:?} {}",
+        changed.len(),
+        changed
+            .first()
+            .map(|i| (i % k.width as usize, i / k.width as usize)),
+        changed.first().map(|i| bare.color[*i]),
+        changed.first().map_or(0.0, |i| bare.depth_m[*i]),
+        changed.first().map(|i| below.color[*i]),
+        changed.first().map_or(0.0, |i| below.depth_m[*i]),
+    );
 }
