@@ -56,4 +56,15 @@ impl SimDevices {
             world: shared,
         })
     }
+
+    /// Stands the scene camera at `truth` (where it renders from) while it reports `believed`
+    /// (where its user thinks it stands): a rig whose camera was placed with an error.
+    pub fn place_camera(
+        &mut self,
+        truth: tactex_core::geometry::Pose,
+        believed: tactex_core::geometry::Pose,
+    ) {
+        self.world.lock().expect("world lock").camera_pose = truth;
+        self.camera.believe_pose(believed);
+    }
 }

@@ -3,14 +3,13 @@
 //! is not told) sees it with its own noise, a detector finds the corners, and every solver
 //! places the camera; the twin knows the truth each is scored against.
 
+use super::camera_placement::CameraPlacement;
 use anyhow::{Context, Result};
 use glam::{DQuat, DVec3};
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, StandardNormal};
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::charuco::{BoardDetector, CharucoBoard};
+use tactex_core::devices::RgbdCamera;
 use tactex_core::geometry::Pose;
 use tactex_core::hand_eye::{
     HandEyeRun, StationRequest, StationSighting, plan_stations, solve_sightings, visit_stations,
@@ -30,10 +29,9 @@ pub struct TwinHandEyeRequest<'a> {
     pub scene: &'a Path,
     pub board: CharucoBoard,
     pub stations: usize,
-    /// The camera's misplacement: how far (mm) and how much turned (degrees) it stands from
-    /// where the scene puts it, in directions drawn from `seed`.
-    pub camera_error_mm: f64,
-    pub camera_error_deg: f64,
+    /// Where the camera really stands against the scene's pose.
+    pub placement: CameraPlacement,
+    /// Seeds the camera's noise.
     pub seed: u64,
 }
 
@@ -61,25 +59,6 @@ pub fn board_in_tool_on_twin(board: &CharucoBoard) -> Pose {
     )
 }
 
-/// The camera's pose moved by `mm` in a direction and turned by `deg` about an axis, both
-/// drawn from `seed`.
-pub fn misplaced(pose: &Pose, mm: f64, deg: f64, seed: u64) -> Pose {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x4a4d_e7e5);
-    let mut unit = || {
-        let v = DVec3::new(
-            StandardNormal.sample(&mut rng),
-            StandardNormal.sample(&mut rng),
-            StandardNormal.sample(&mut rng),
-        );
-        v.normalize_or(DVec3::X)
-    };
-    let (shift, axis) = (unit(), unit());
-    Pose::new(
-        pose.position + shift * mm * 1e-3,
-        (DQuat::from_axis_angle(axis, deg.to_radians()) * pose.rotation).normalize(),
-    )
-}
-
 /// Calibrates the twin's camera by `detector`, telling `progress` after each station.
 pub fn hand_eye_on_twin(
     request: &TwinHandEyeRequest,
@@ -92,25 +71,17 @@ pub fn hand_eye_on_twin(
         .with_context(|| format!("{}: building the twin", request.scene.display()))?;
     let board_in_tool = board_in_tool_on_twin(&request.board);
     let look = SheetLook::default();
-    let (believed, intrinsics) = {
+    request.placement.apply(&mut sim);
+    let believed = sim.camera.pose();
+    let (truth, intrinsics) = {
         let mut world = sim.world.lock().expect("world lock");
-        let believed = world.camera_pose;
-        world.camera_pose = misplaced(
-            &believed,
-            request.camera_error_mm,
-            request.camera_error_deg,
-            request.seed,
-        );
         world.held_board = Some(HeldBoard {
             board: request.board,
             board_in_tool,
             look,
         });
-        (believed, world.intrinsics)
+        (world.camera_pose, world.intrinsics)
     };
-    let truth = sim.world.lock().expect("world lock").camera_pose;
-    // The camera was made before it was moved: made again, it renders from where it stands.
-    sim.camera = tactex_sim::devices::camera::SimCamera::new(sim.world.clone(), request.seed);
     let plan = plan_stations(
         &StationRequest {
             camera_in_base: believed,

@@ -4,6 +4,7 @@
 //! the real devices or from a recorded session.
 
 pub mod ball_presses;
+pub mod camera_placement;
 pub mod detector_choice;
 pub mod error_kind;
 pub mod estimator_choice;

@@ -1,6 +1,7 @@
 //! A question answered on the twin: fresh sim devices of a scene, the pipeline on them, and
 //! the ground truth an evaluation scores the answer against.
 
+use crate::app::camera_placement::CameraPlacement;
 use crate::app::detector_choice::{DetectorChoice, GroundTruth};
 use crate::app::question::{Question, Recording};
 use anyhow::{Context, Result};
@@ -48,6 +49,8 @@ pub struct Twin<'a> {
     pub estimator: &'a dyn HardnessEstimator,
     /// Contact physics of the sim GelSight.
     pub fidelity: Fidelity,
+    /// Where the scene camera really stands against where the pipeline believes it does.
+    pub camera: &'a CameraPlacement,
 }
 
 /// The sim devices of one question and what an evaluation needs from the twin beside them.
@@ -63,6 +66,7 @@ impl<'a> Twin<'a> {
         let mut sim =
             SimDevices::with_sensor(self.scene, self.seed, self.sensor.clone(), self.fidelity)?;
         sim.camera.set_renderer(self.renderer.clone());
+        self.camera.apply(&mut sim);
         let instances = sim.camera.clean()?.instances.clone();
         let labels: Vec<String> = self.scene.objects.iter().map(|o| o.label.clone()).collect();
         // Only the perception-error models look at the ground truth.
@@ -120,7 +124,8 @@ impl<'a> Twin<'a> {
             true_centres_m,
             world: sim.world.clone(),
             intrinsics: sim.camera.intrinsics(),
-            camera_pose: sim.camera.pose(),
+            // Where the instances were rendered from: the truth, not the belief.
+            camera_pose: sim.world.lock().expect("world lock").camera_pose,
             instances,
         })
     }

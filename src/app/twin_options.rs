@@ -2,6 +2,7 @@
 //! estimator, intervals, sensor), shared by `ask`, `serve` and the evaluations, and what
 //! they name once opened.
 
+use crate::app::camera_placement::CameraPlacement;
 use crate::app::detector_choice::DetectorChoice;
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::app::explainer_choice::{ExplainerChoice, explainer};
@@ -53,6 +54,15 @@ pub struct TwinOptions {
     pub intervals: Option<PathBuf>,
     /// Sensor profile the sim GelSight renders with; None: the built-in GelSight Mini.
     pub sensor: Option<PathBuf>,
+    /// How far the twin's scene camera really stands from where the scene puts it (mm).
+    pub camera_error_mm: f64,
+    /// How far it is really turned from the scene's pose (degrees).
+    pub camera_error_deg: f64,
+    /// Draws the directions of the camera's misplacement.
+    pub camera_error_seed: u64,
+    /// A hand-eye calibration (`tactex handeye`'s TOML) whose camera pose the pipeline
+    /// believes instead of the scene's.
+    pub camera_calibration: Option<PathBuf>,
 }
 
 impl Default for TwinOptions {
@@ -69,6 +79,10 @@ impl Default for TwinOptions {
                 .expect("the default estimator is registered"),
             intervals: None,
             sensor: None,
+            camera_error_mm: 0.0,
+            camera_error_deg: 0.0,
+            camera_error_seed: 1,
+            camera_calibration: None,
         }
     }
 }
@@ -87,6 +101,7 @@ pub struct OpenedTwin {
     pub estimator: Box<dyn HardnessEstimator + Send + Sync>,
     pub fidelity: Fidelity,
     pub sensor: SensorProfile,
+    pub camera: CameraPlacement,
 }
 
 impl OpenedTwin {
@@ -138,6 +153,7 @@ impl TwinOptions {
             eprintln!("{note}");
         }
         let (parser, explainer) = self.language()?;
+        let camera = self.camera_placement()?;
         Ok(OpenedTwin {
             detector: DetectorChoice::parse(&self.detector)?,
             renderer: scene_renderer(self.device)?,
@@ -146,6 +162,17 @@ impl TwinOptions {
             estimator,
             fidelity: self.fidelity,
             sensor,
+            camera,
         })
+    }
+
+    /// The scene camera's placement these options describe, its calibration file read.
+    pub fn camera_placement(&self) -> Result<CameraPlacement> {
+        CameraPlacement::checked(
+            self.camera_error_mm,
+            self.camera_error_deg,
+            self.camera_error_seed,
+            self.camera_calibration.as_deref(),
+        )
     }
 }

@@ -121,6 +121,7 @@ pub(crate) fn run(args: &AskBenchArgs) -> Result<()> {
             language: Language::OFFLINE,
             estimator: estimator.as_ref(),
             fidelity,
+            camera: &crate::app::camera_placement::CameraPlacement::default(),
         };
         let mut stages: Vec<(String, Vec<f64>)> = Vec::new();
         let (mut pair, mut whole) = (Vec::new(), Vec::new());

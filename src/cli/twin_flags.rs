@@ -1,9 +1,10 @@
 //! The flags that say how the twin answers (`ask`, `serve`), read into the library's
 //! `TwinOptions`.
 
+use crate::app::camera_placement::{CAMERA_ERROR_DEG_MAX, CAMERA_ERROR_MM_MAX};
 use crate::app::estimator_choice::EstimatorChoice;
 use crate::app::explainer_choice::ExplainerChoice;
-use crate::app::flag_range::choice;
+use crate::app::flag_range::{choice, within};
 use crate::app::parser_choice::ParserChoice;
 use crate::app::twin_options::{DEFAULT_ESTIMATOR, TwinOptions};
 use clap::Args;
@@ -54,6 +55,20 @@ pub struct TwinFlags {
     /// Mini.
     #[arg(long)]
     pub sensor: Option<PathBuf>,
+    /// Twin: how far the scene camera really stands from where the scene puts it (mm, 0 to
+    /// 200), in a direction drawn from --camera-error-seed; the pipeline is not told.
+    #[arg(long, default_value_t = 0.0, value_parser = within(0.0, CAMERA_ERROR_MM_MAX))]
+    pub camera_error_mm: f64,
+    /// Twin: how far it is really turned from the scene's pose (degrees, 0 to 20).
+    #[arg(long, default_value_t = 0.0, value_parser = within(0.0, CAMERA_ERROR_DEG_MAX))]
+    pub camera_error_deg: f64,
+    /// Twin: draws the directions of the camera's misplacement.
+    #[arg(long, default_value_t = 1)]
+    pub camera_error_seed: u64,
+    /// A hand-eye calibration (`tactex handeye --out`'s TOML): the pipeline believes its
+    /// camera pose instead of the scene's.
+    #[arg(long)]
+    pub camera_calibration: Option<PathBuf>,
 }
 
 impl TwinFlags {
@@ -68,6 +83,10 @@ impl TwinFlags {
             estimator: self.estimator.clone(),
             intervals: self.intervals.clone(),
             sensor: self.sensor.clone(),
+            camera_error_mm: self.camera_error_mm,
+            camera_error_deg: self.camera_error_deg,
+            camera_error_seed: self.camera_error_seed,
+            camera_calibration: self.camera_calibration.clone(),
         }
     }
 }

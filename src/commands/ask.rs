@@ -195,6 +195,7 @@ pub fn answer(args: &AskRequest) -> Result<Answer> {
                 language: opened.language(),
                 estimator: opened.estimator.as_ref(),
                 fidelity: opened.fidelity,
+                camera: &opened.camera,
             };
             match &args.record {
                 Some(dir) => twin.answer_recorded(&args.prompt, &config, dir)?,

@@ -3,6 +3,7 @@
 //! by a known error first; every solver's answer is scored against the twin's truth. Writes
 //! the calibration (the camera's pose, each solver's, residuals per station) as TOML.
 
+use crate::app::camera_placement::CameraPlacement;
 use crate::app::flag_range::{count, within};
 use crate::app::hand_eye::{TwinHandEye, TwinHandEyeRequest, hand_eye_on_twin, pose_error};
 use crate::report::output::{OutputDir, write_bytes_atomic, write_png_atomic};
@@ -42,7 +43,11 @@ pub struct HandEyeArgs {
     /// Twin: how far it is turned from the scene's (degrees), 0 to 20.
     #[arg(long, default_value_t = 0.0, value_parser = within(0.0, 20.0))]
     pub camera_error_deg: f64,
-    /// Seeds the camera's noise and the directions of its misplacement.
+    /// Twin: draws the directions the camera is moved and turned in (the same seed, the same
+    /// misplaced rig: give `ask` the same to ask on it).
+    #[arg(long, default_value_t = 1)]
+    pub camera_error_seed: u64,
+    /// Seeds the camera's noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Also write each station's frame with the corners found marked (station-NN.png).
@@ -154,6 +159,7 @@ struct Solver {
 struct TwinTruth {
     scene: String,
     seed: u64,
+    camera_error_seed: u64,
     camera_error_mm: f64,
     camera_error_deg: f64,
     believed: CameraPose,
@@ -226,8 +232,12 @@ pub fn run(args: &HandEyeArgs) -> Result<()> {
         scene: &scene,
         board,
         stations: args.poses,
-        camera_error_mm: args.camera_error_mm,
-        camera_error_deg: args.camera_error_deg,
+        placement: CameraPlacement {
+            error_mm: args.camera_error_mm,
+            error_deg: args.camera_error_deg,
+            error_seed: args.camera_error_seed,
+            calibrated: None,
+        },
         seed: args.seed,
     };
     let frames_dir = match &args.frames {
@@ -283,6 +293,7 @@ pub fn run(args: &HandEyeArgs) -> Result<()> {
         twin: Some(TwinTruth {
             scene: scene.display().to_string(),
             seed: args.seed,
+            camera_error_seed: args.camera_error_seed,
             camera_error_mm: args.camera_error_mm,
             camera_error_deg: args.camera_error_deg,
             believed: CameraPose::of(&believed),

@@ -583,6 +583,7 @@ pub(crate) fn run(args: &FruitEvalArgs) -> Result<()> {
                 language: Language::OFFLINE,
                 estimator: estimator.as_ref(),
                 fidelity: args.fidelity,
+                camera: &crate::app::camera_placement::CameraPlacement::default(),
             }
             .answer(PROMPT, &config, &|_| {})
             .with_context(|| {

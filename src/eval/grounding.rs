@@ -6,6 +6,7 @@
 //! depth and the true mask),
 //! with and without the mask refinement and the 10-frame depth median.
 
+use crate::app::camera_placement::CameraPlacement;
 use crate::app::detector_choice::{DetectorChoice, GroundTruth};
 use crate::eval::PAPER_FRUIT_KINDS;
 use crate::report::output::{OutputDir, write_json_atomic};
@@ -69,6 +70,21 @@ pub struct GroundingEvalArgs {
     /// on the machine), gpu (any Vulkan adapter) or auto (a hardware GPU if there is one).
     #[arg(long, default_value = "cpu")]
     pub device: DeviceChoice,
+    /// How far the scene camera really stands from where the scene puts it (mm, 0 to 200),
+    /// in a direction drawn from --camera-error-seed; the centroids are located with the
+    /// camera's believed pose and scored against the truth.
+    #[arg(long, default_value_t = 0.0)]
+    pub camera_error_mm: f64,
+    /// How far it is really turned (degrees, 0 to 20).
+    #[arg(long, default_value_t = 0.0)]
+    pub camera_error_deg: f64,
+    /// Draws the directions of the camera's misplacement.
+    #[arg(long, default_value_t = 1)]
+    pub camera_error_seed: u64,
+    /// A hand-eye calibration (`tactex handeye --out`'s TOML) whose camera pose is believed
+    /// instead of the scene's.
+    #[arg(long)]
+    pub camera_calibration: Option<PathBuf>,
 }
 
 /// One detector on one instance.
@@ -160,14 +176,19 @@ fn run_instance(
     detectors: &[DetectorChoice],
     catalog: &FruitCatalog,
     renderer: &Arc<dyn SceneRenderer>,
+    placement: &CameraPlacement,
 ) -> Result<Vec<Trial>> {
     let seed = args.seed.wrapping_mul(7919).wrapping_add(i as u64);
     let (fruit, kinds) = instance_kinds(i, args.per_kind, args.seed);
     let scene = random_scene(&kinds, catalog, seed, &Variation::default())?;
     let mut sim = SimDevices::from_scene(&scene, seed)?;
     sim.camera.set_renderer(renderer.clone());
+    placement.apply(&mut sim);
     let clean = sim.camera.clean()?.clone();
+    // The centroids are located from where the camera is believed to stand, and scored
+    // against the truth, seen from where it stands.
     let (k, pose) = (sim.camera.intrinsics(), sim.camera.pose());
+    let true_pose = sim.world.lock().expect("world lock").camera_pose;
     let frames = (0..args.depth_frames)
         .map(|_| sim.camera.capture())
         .collect::<Result<Vec<_>, _>>()?;
@@ -183,7 +204,7 @@ fn run_instance(
     let truth_mask = instance_mask(&clean.instances, 1);
     // The true centroid is the paper's centroid on perfect data: the refined true mask over
     // noise-free depth.
-    let truth_centroid = locate(&truth_mask, true, &clean_depth, &k, &pose)
+    let truth_centroid = locate(&truth_mask, true, &clean_depth, &k, &true_pose)
         .context("the target is not visible")?
         .surface;
     let labels: Vec<String> = scene.objects.iter().map(|o| o.label.clone()).collect();
@@ -197,7 +218,7 @@ fn run_instance(
         intrinsics: &k,
         pose: &pose,
     };
-    let to_cam = pose.inverse();
+    let to_cam = true_pose.inverse();
     let on_target = |p: DVec3| -> bool {
         k.project(to_cam.transform_point(p)).is_some_and(|(u, v)| {
             u >= 0.0
@@ -392,6 +413,12 @@ pub(crate) fn run(args: &GroundingEvalArgs) -> Result<()> {
         args.tolerance_mm
     );
     anyhow::ensure!(!args.detector.is_empty(), "--detector: name at least one");
+    let placement = CameraPlacement::checked(
+        args.camera_error_mm,
+        args.camera_error_deg,
+        args.camera_error_seed,
+        args.camera_calibration.as_deref(),
+    )?;
     let catalog = FruitCatalog::builtin();
     let detectors = args
         .detector
@@ -407,7 +434,7 @@ pub(crate) fn run(args: &GroundingEvalArgs) -> Result<()> {
     let rows: Vec<Vec<Trial>> = (0..n)
         .into_par_iter()
         .map(|i| {
-            let r = run_instance(i, args, &detectors, &catalog, &renderer)
+            let r = run_instance(i, args, &detectors, &catalog, &renderer, &placement)
                 .with_context(|| format!("instance {i}"));
             bar.inc(1);
             r

@@ -4,6 +4,7 @@
 //! twin's truth; the medians over seeds per count are plotted (error-vs-poses.png) and every
 //! run is kept (handeye.csv, summary.json).
 
+use crate::app::camera_placement::CameraPlacement;
 use crate::app::flag_range::{count, within};
 use crate::app::hand_eye::{TwinHandEyeRequest, hand_eye_on_twin, pose_error};
 use crate::report::output::{OutputDir, write_bytes_atomic, write_json_atomic};
@@ -98,8 +99,12 @@ pub fn run(args: &HandEyeEvalArgs) -> Result<()> {
             scene: &scene,
             board: CharucoBoard::default(),
             stations: poses,
-            camera_error_mm: args.camera_error_mm,
-            camera_error_deg: args.camera_error_deg,
+            placement: CameraPlacement {
+                error_mm: args.camera_error_mm,
+                error_deg: args.camera_error_deg,
+                error_seed: seed,
+                calibrated: None,
+            },
             seed,
         };
         match hand_eye_on_twin(&request, detector.as_ref(), |_| {}) {

@@ -572,6 +572,7 @@ pub(crate) fn run(args: &ScenarioEvalArgs) -> Result<()> {
                 language: Language::OFFLINE,
                 estimator: estimator.as_ref(),
                 fidelity: args.fidelity,
+                camera: &crate::app::camera_placement::CameraPlacement::default(),
             }
             .answer(&sc.prompt, &config, &|_| {})
             .with_context(|| format!("tier {} run {}: {}", sc.tier, sc.run, args.detector[d]))?;

@@ -78,6 +78,8 @@ struct Served {
     estimator: Box<dyn HardnessEstimator + Send + Sync>,
     fidelity: Fidelity,
     sensor: SensorProfile,
+    /// Where the scene camera really stands against the pipeline's belief.
+    camera: crate::app::camera_placement::CameraPlacement,
     seed: u64,
     /// The live view's camera: the twin's camera on its own noise stream.
     live: Mutex<SimCamera>,
@@ -110,6 +112,7 @@ pub(crate) fn run(args: &ServeArgs) -> Result<()> {
         estimator,
         fidelity,
         sensor,
+        camera,
     } = args.twin.options().open()?;
     let mut live = SimDevices::from_scene(&scene, args.seed.wrapping_add(1))?.camera;
     live.set_renderer(renderer.clone());
@@ -125,6 +128,7 @@ pub(crate) fn run(args: &ServeArgs) -> Result<()> {
         estimator,
         fidelity,
         sensor,
+        camera,
         seed: args.seed,
         live: Mutex::new(live),
         queries: Mutex::default(),
@@ -397,6 +401,7 @@ fn answer_question(s: &Served, run: &QueryRun, prompt: &str) {
         },
         estimator: s.estimator.as_ref(),
         fidelity: s.fidelity,
+        camera: &s.camera,
     };
     let answered = twin.answer(prompt, &PipelineConfig::default(), &|p| run.progress(&p));
     match answered {

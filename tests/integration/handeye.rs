@@ -79,3 +79,158 @@ fn handeye_refuses_bad_inputs_by_name_and_writes_nothing() {
         assert!(!calib.exists(), "{args:?} wrote {}", calib.display());
     }
 }
+
+/// A calibration file holding the camera's true pose for the default rig (the scene parser's
+/// camera) misplaced by 20 mm and 2 degrees with error seed 1: a perfect calibration.
+fn truth_calibration(dir: &std::path::Path) -> std::path::PathBuf {
+    let scene = tactex_core::scene::Scene::parse(
+        "name = \"rig\"\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n",
+        std::path::Path::new("rig.toml"),
+        &tactex_core::catalog::FruitCatalog::builtin(),
+    )
+    .unwrap();
+    let truth = tactex::app::camera_placement::misplaced(&scene.camera_pose, 20.0, 2.0, 1);
+    let path = dir.join("truth.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "[camera]\nposition_m = {:?}\nrotation_xyzw = {:?}\n",
+            truth.position.to_array(),
+            truth.rotation.to_array()
+        ),
+    )
+    .unwrap();
+    path
+}
+
+/// `eval grounding`'s per-instance centroid errors (mm) for the classical detector.
+fn grounding_errors(extra: &[&str]) -> Vec<f64> {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("g");
+    let mut args = vec![
+        "eval",
+        "grounding",
+        "--detector",
+        "classical",
+        "--per-kind",
+        "1",
+        "--depth-frames",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let run = tactex(&args);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    results["trials"][0][1]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["error_mm"].as_f64().unwrap())
+        .collect()
+}
+
+#[test]
+fn a_misplaced_camera_moves_every_centroid_and_its_true_pose_puts_them_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let truth = truth_calibration(dir.path());
+    let misplaced = grounding_errors(&["--camera-error-mm", "20", "--camera-error-deg", "2"]);
+    let told = grounding_errors(&[
+        "--camera-error-mm",
+        "20",
+        "--camera-error-deg",
+        "2",
+        "--camera-calibration",
+        truth.to_str().unwrap(),
+    ]);
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    // 20 mm and 2 degrees at 0.7 m put the table's points 15-45 mm off.
+    assert!(mean(&misplaced) > 10.0, "{misplaced:?}");
+    assert!(mean(&told) < 3.0, "{told:?}");
+}
+
+#[cfg(feature = "opencv")]
+#[test]
+fn a_hand_eye_calibration_grounds_as_well_as_the_true_pose() {
+    let dir = tempfile::tempdir().unwrap();
+    let calib = dir.path().join("calib.toml");
+    let out = tactex(&[
+        "handeye",
+        "--poses",
+        "10",
+        "--camera-error-mm",
+        "20",
+        "--camera-error-deg",
+        "2",
+        "--out",
+        calib.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let truth = truth_calibration(dir.path());
+    let rig = ["--camera-error-mm", "20", "--camera-error-deg", "2"];
+    let with = |file: &std::path::Path| {
+        let mut args = rig.to_vec();
+        args.extend(["--camera-calibration", file.to_str().unwrap()]);
+        grounding_errors(&args)
+    };
+    let (calibrated, told) = (with(&calib), with(&truth));
+    // The bar: centroids within 0.5 mm of the run that knows the true pose.
+    for (c, t) in calibrated.iter().zip(&told) {
+        assert!((c - t).abs() < 0.5, "{calibrated:?} against {told:?}");
+    }
+}
+
+#[test]
+fn a_bad_camera_calibration_is_refused_by_its_file_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("no-camera.toml", "[fit]\nrms_px = 0.1\n", "camera"),
+        (
+            "not-unit.toml",
+            "[camera]\nposition_m = [0.0, 0.0, 0.7]\nrotation_xyzw = [0.5, 0.0, 0.0, 0.5]\n",
+            "camera.rotation_xyzw",
+        ),
+        (
+            "nan.toml",
+            "[camera]\nposition_m = [0.0, nan, 0.7]\nrotation_xyzw = [1.0, 0.0, 0.0, 0.0]\n",
+            "camera.position_m",
+        ),
+        (
+            "short.toml",
+            "[camera]\nposition_m = [0.0, 0.7]\nrotation_xyzw = [1.0, 0.0, 0.0, 0.0]\n",
+            "short.toml",
+        ),
+    ];
+    for (name, text, says) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = tactex(&[
+            "ask",
+            "Which fruit is the softest?",
+            "--camera-calibration",
+            path.to_str().unwrap(),
+        ]);
+        let stderr = crate::cli::one_line_error(&out);
+        assert!(
+            stderr.contains(says) && stderr.contains(name),
+            "{name}: {stderr}"
+        );
+    }
+    let out = tactex(&[
+        "ask",
+        "Which fruit is the softest?",
+        "--camera-error-deg",
+        "21",
+    ]);
+    assert!(crate::cli::one_line_error(&out).contains("--camera-error-deg"));
+}

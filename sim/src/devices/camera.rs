@@ -30,6 +30,10 @@ pub fn instance_mask(instances: &InstanceImage, id: u16) -> image::GrayImage {
     })
 }
 
+/// What a clean render depends on besides the objects: the tool's pose, the camera's, the
+/// board the arm holds.
+type RenderKey = (Pose, Pose, Option<HeldBoard>);
+
 pub struct SimCamera {
     world: SharedWorld,
     intrinsics: CameraIntrinsics,
@@ -37,8 +41,8 @@ pub struct SimCamera {
     renderer: Arc<dyn SceneRenderer>,
     /// The objects do not move while they are watched: one clean render serves every frame
     /// until the arm's pad moves (the arm is in the picture once it enters the view) or the
-    /// board it holds changes.
-    clean: Option<((Pose, Option<HeldBoard>), CleanRender)>,
+    /// board it holds changes (or the camera is moved).
+    clean: Option<(RenderKey, CleanRender)>,
     rng: ChaCha8Rng,
     /// Colour noise (grey levels, 1 sigma).
     pub color_noise: f64,
@@ -65,6 +69,12 @@ impl SimCamera {
         }
     }
 
+    /// Reports `pose` from now on (what its user measured by hand or calibrated) while it
+    /// renders from where the world has it: a camera misplaced against its belief.
+    pub fn believe_pose(&mut self, pose: Pose) {
+        self.pose = pose;
+    }
+
     /// Renders through `renderer` from now on (the CPU reference by default).
     pub fn set_renderer(&mut self, renderer: Arc<dyn SceneRenderer>) {
         self.renderer = renderer;
@@ -75,7 +85,7 @@ impl SimCamera {
     /// when the pad has moved since the last render.
     pub fn clean(&mut self) -> Result<&CleanRender, RenderError> {
         let world = self.world.lock().expect("world lock");
-        let key = (world.tool, world.held_board.clone());
+        let key = (world.tool, world.camera_pose, world.held_board.clone());
         if self.clean.as_ref().is_none_or(|(seen, _)| *seen != key) {
             let geometry = SceneGeometry::of_world(&world);
             let mut render = self.renderer.render(&geometry)?;
