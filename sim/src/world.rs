@@ -50,6 +50,48 @@ pub struct HeldBoard {
     pub look: SheetLook,
 }
 
+/// How far the held sheet keeps from the table and the objects' boxes (m).
+const SHEET_CLEARANCE_M: f64 = 0.02;
+/// Spacing of the points the sheet is checked at (m): finer than any fruit.
+const SHEET_CHECK_STEP_M: f64 = 0.02;
+
+impl HeldBoard {
+    /// Whether the sheet, the tool at `tool`, stays above the table (its top at z = 0) and
+    /// outside every object's bounding box, each by 2 cm: a station whose board would pass
+    /// through a fruit or the table is one the arm cannot hold.
+    pub fn clears(&self, world: &SimWorld, tool: &Pose) -> bool {
+        let (w_mm, h_mm) = self.board.size_mm();
+        let m = self.look.margin_mm;
+        let (x0, x1) = (-m * 1e-3, (w_mm + m) * 1e-3);
+        let (y0, y1) = (-m * 1e-3, (h_mm + m) * 1e-3);
+        let steps = |span: f64| (span / SHEET_CHECK_STEP_M).ceil().max(1.0) as usize;
+        let (nx, ny) = (steps(x1 - x0), steps(y1 - y0));
+        let boxes: Vec<(DVec3, DVec3)> = world
+            .objects
+            .iter()
+            .map(|o| {
+                let (lo, hi) = o.mesh.bounds();
+                (
+                    lo - DVec3::splat(SHEET_CLEARANCE_M),
+                    hi + DVec3::splat(SHEET_CLEARANCE_M),
+                )
+            })
+            .collect();
+        let sheet = tool.compose(&self.board_in_tool);
+        (0..=nx).all(|i| {
+            (0..=ny).all(|j| {
+                let x = x0 + (x1 - x0) * i as f64 / nx as f64;
+                let y = y0 + (y1 - y0) * j as f64 / ny as f64;
+                let p = sheet.transform_point(DVec3::new(x, y, 0.0));
+                p.z > SHEET_CLEARANCE_M
+                    && !boxes
+                        .iter()
+                        .any(|(lo, hi)| p.cmpge(*lo).all() && p.cmple(*hi).all())
+            })
+        })
+    }
+}
+
 pub type SharedWorld = Arc<Mutex<SimWorld>>;
 
 #[derive(Debug, thiserror::Error)]

@@ -52,9 +52,10 @@ impl CameraPlacement {
                 bail!("{flag}: must be in [0, {hi}]; got {value}");
             }
         }
+        // + 0.0 turns a -0 given on the command line into 0.
         Ok(Self {
-            error_mm,
-            error_deg,
+            error_mm: error_mm + 0.0,
+            error_deg: error_deg + 0.0,
             error_seed,
             calibrated: calibration.map(load_calibrated_camera).transpose()?,
         })

@@ -12,7 +12,8 @@ use tactex_core::charuco::{BoardDetector, CharucoBoard};
 use tactex_core::devices::RgbdCamera;
 use tactex_core::geometry::Pose;
 use tactex_core::hand_eye::{
-    HandEyeRun, StationRequest, StationSighting, plan_stations, solve_sightings, visit_stations,
+    HandEyeRun, StationRequest, StationSighting, Visit, plan_stations, solve_sightings,
+    visit_stations,
 };
 use tactex_sim::SimDevices;
 use tactex_sim::render::board_view::SheetLook;
@@ -33,6 +34,8 @@ pub struct TwinHandEyeRequest<'a> {
     pub placement: CameraPlacement,
     /// Seeds the camera's noise.
     pub seed: u64,
+    /// Keep each station's frame in the answer.
+    pub keep_frames: bool,
 }
 
 /// The run, and the twin's truth beside it.
@@ -43,7 +46,7 @@ pub struct TwinHandEye {
     pub believed: Pose,
     /// Where the twin's camera really stands.
     pub truth: Pose,
-    /// What each station saw: its frame and the corners found in it, in order.
+    /// What each station saw: the corners found (and its frame, if kept), in order.
     pub sightings: Vec<StationSighting>,
 }
 
@@ -73,13 +76,14 @@ pub fn hand_eye_on_twin(
     let look = SheetLook::default();
     request.placement.apply(&mut sim);
     let believed = sim.camera.pose();
+    let held = HeldBoard {
+        board: request.board,
+        board_in_tool,
+        look,
+    };
     let (truth, intrinsics) = {
         let mut world = sim.world.lock().expect("world lock");
-        world.held_board = Some(HeldBoard {
-            board: request.board,
-            board_in_tool,
-            look,
-        });
+        world.held_board = Some(held.clone());
         (world.camera_pose, world.intrinsics)
     };
     let plan = plan_stations(
@@ -91,15 +95,18 @@ pub fn hand_eye_on_twin(
             board_in_tool,
             stations: request.stations,
         },
-        |tool| sim.arm.reaches(tool),
+        |tool| sim.arm.reaches(tool) && held.clears(&sim.world.lock().expect("world lock"), tool),
     )?;
     let sightings = visit_stations(
         &mut sim.arm,
         &mut sim.camera,
         detector,
-        &request.board,
-        &plan,
-        STATION_SPEED_M_S,
+        &Visit {
+            board: &request.board,
+            tool_poses: &plan,
+            speed_m_s: STATION_SPEED_M_S,
+            keep_images: request.keep_frames,
+        },
         progress,
     )?;
     let run = solve_sightings(&sightings, &intrinsics)?;

@@ -6,17 +6,19 @@
 use crate::app::camera_placement::CameraPlacement;
 use crate::app::flag_range::{count, within};
 use crate::app::hand_eye::{TwinHandEye, TwinHandEyeRequest, hand_eye_on_twin, pose_error};
-use crate::report::output::{OutputDir, write_bytes_atomic, write_png_atomic};
+use crate::report::output::{OutputDir, same_file, write_bytes_atomic, write_png_atomic};
 use crate::report::summary::median;
 use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tactex_core::charuco::{BoardDetector, CharucoBoard};
 use tactex_core::geometry::Pose;
-use tactex_core::hand_eye::{BoardCorner, HandEyeSolution, MAX_STATIONS, StationReport};
+use tactex_core::hand_eye::{
+    BoardCorner, HandEyeSolution, MAX_STATIONS, MIN_POSE_CORNERS, StationReport,
+};
 
 #[derive(Args, Debug)]
 pub struct HandEyeArgs {
@@ -97,7 +99,54 @@ fn load_board(path: &Option<PathBuf>) -> Result<CharucoBoard> {
     board
         .check()
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let corners = board.corners().len();
+    if corners < MIN_POSE_CORNERS {
+        bail!(
+            "{}: a {} x {} board has {corners} inner corners; the board's pose needs {MIN_POSE_CORNERS}",
+            path.display(),
+            board.squares_x,
+            board.squares_y
+        );
+    }
     Ok(board)
+}
+
+/// `--out` and `--frames` refused before the run where they cannot be written or would
+/// replace an input.
+fn check_outputs(args: &HandEyeArgs, scene: &Path) -> Result<()> {
+    let out = &args.out;
+    if out.is_dir() {
+        bail!(
+            "--out {}: is a directory; the calibration is a file",
+            out.display()
+        );
+    }
+    let folder = out.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(folder) = folder.filter(|f| !f.is_dir()) {
+        bail!(
+            "--out {}: {} is not a folder",
+            out.display(),
+            folder.display()
+        );
+    }
+    let inputs = std::iter::once(scene).chain(args.board.as_deref());
+    for input in inputs {
+        if same_file(out, input) {
+            bail!(
+                "--out {}: is one of this command's inputs; nothing was written",
+                out.display()
+            );
+        }
+    }
+    if let Some(frames) = &args.frames
+        && (frames == out || same_file(frames, out))
+    {
+        bail!(
+            "--frames {}: is where --out writes the calibration",
+            frames.display()
+        );
+    }
+    Ok(())
 }
 
 /// The calibration file: the camera's pose first, then how it was found.
@@ -214,14 +263,9 @@ fn closed_form(name: &'static str, s: &HandEyeSolution, truth: Option<&Pose>) ->
 
 pub fn run(args: &HandEyeArgs) -> Result<()> {
     let board = load_board(&args.board)?;
-    if args.out.is_dir() {
-        bail!(
-            "--out {}: is a directory; the calibration is a file",
-            args.out.display()
-        );
-    }
     let scene = args.scene.clone().unwrap_or_else(crate::app::default_scene);
     crate::app::file_input::present(&scene, "file: cannot read scene")?;
+    check_outputs(args, &scene)?;
     let detector = detector()?;
     let bar = ProgressBar::new(args.poses as u64).with_style(
         ProgressStyle::with_template("handeye {bar:30} {pos}/{len} stations {elapsed}")
@@ -232,13 +276,14 @@ pub fn run(args: &HandEyeArgs) -> Result<()> {
         scene: &scene,
         board,
         stations: args.poses,
-        placement: CameraPlacement {
-            error_mm: args.camera_error_mm,
-            error_deg: args.camera_error_deg,
-            error_seed: args.camera_error_seed,
-            calibrated: None,
-        },
+        placement: CameraPlacement::checked(
+            args.camera_error_mm,
+            args.camera_error_deg,
+            args.camera_error_seed,
+            None,
+        )?,
         seed: args.seed,
+        keep_frames: args.frames.is_some(),
     };
     let frames_dir = match &args.frames {
         Some(dir) => Some(OutputDir::create("--frames", dir)?),
@@ -251,13 +296,6 @@ pub fn run(args: &HandEyeArgs) -> Result<()> {
         sightings,
     } = hand_eye_on_twin(&request, detector.as_ref(), |n| bar.set_position(n as u64))?;
     bar.finish_and_clear();
-    if let Some(dir) = frames_dir {
-        for (i, s) in sightings.iter().enumerate() {
-            let marked = marked_corners(&s.image, &s.corners);
-            write_png_atomic(&dir.path().join(format!("station-{i:02}.png")), &marked)?;
-        }
-        dir.finish()?;
-    }
     let refined = &run.refined;
     let refined_error = pose_error(&refined.camera_in_base, &truth);
     let method = format!(
@@ -294,8 +332,8 @@ pub fn run(args: &HandEyeArgs) -> Result<()> {
             scene: scene.display().to_string(),
             seed: args.seed,
             camera_error_seed: args.camera_error_seed,
-            camera_error_mm: args.camera_error_mm,
-            camera_error_deg: args.camera_error_deg,
+            camera_error_mm: request.placement.error_mm,
+            camera_error_deg: request.placement.error_deg,
             believed: CameraPose::of(&believed),
             truth: CameraPose::of(&truth),
         }),
@@ -305,7 +343,27 @@ pub fn run(args: &HandEyeArgs) -> Result<()> {
         "# The scene camera's pose in the arm's frame, by `tactex handeye` (eye-to-hand, ChArUco).\n# camera.rotation_xyzw turns OpenCV's camera axes (x right, y down the image, z along the view) into the arm's frame.\n{}",
         toml::to_string(&file).context("writing the calibration's TOML")?
     );
-    write_bytes_atomic(&args.out, text.as_bytes())?;
+    // The calibration first, the frames after: frames are only kept beside a calibration,
+    // and a calibration whose frames could not be written is taken back.
+    let existed = args.out.exists();
+    write_bytes_atomic(&args.out, text.as_bytes()).map_err(|e| e.context("--out"))?;
+    if let Some(dir) = frames_dir {
+        let written = (|| -> Result<()> {
+            for (i, s) in sightings.iter().enumerate() {
+                if let Some(image) = &s.image {
+                    let marked = marked_corners(image, &s.corners);
+                    write_png_atomic(&dir.path().join(format!("station-{i:02}.png")), &marked)?;
+                }
+            }
+            dir.finish()
+        })();
+        if let Err(e) = written {
+            if !existed {
+                let _ = std::fs::remove_file(&args.out);
+            }
+            return Err(e);
+        }
+    }
     print_json_or_text(&file, args.json, || {
         println!(
             "{}: camera at ({:.4}, {:.4}, {:.4}) m, {method}, {:.3} px RMS over {used} of {} stations",

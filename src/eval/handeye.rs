@@ -83,9 +83,13 @@ pub fn run(args: &HandEyeEvalArgs) -> Result<()> {
     let detector = crate::commands::handeye::detector()?;
     let scene = args.scene.clone().unwrap_or_else(crate::app::default_scene);
     crate::app::file_input::present(&scene, "file: cannot read scene")?;
+    // A scene that cannot be loaded fails here, by name, rather than in every run.
+    crate::app::load_scene(&scene, &tactex_core::catalog::FruitCatalog::builtin())?;
+    let mut counts_asked = args.poses.clone();
+    counts_asked.sort_unstable();
+    counts_asked.dedup();
     let out = OutputDir::create("--out", &args.out)?;
-    let runs: Vec<(usize, u64)> = args
-        .poses
+    let runs: Vec<(usize, u64)> = counts_asked
         .iter()
         .flat_map(|&n| (1..=args.seeds).map(move |seed| (n, seed)))
         .collect();
@@ -106,6 +110,7 @@ pub fn run(args: &HandEyeEvalArgs) -> Result<()> {
                 calibrated: None,
             },
             seed,
+            keep_frames: false,
         };
         match hand_eye_on_twin(&request, detector.as_ref(), |_| {}) {
             Ok(twin) => {
@@ -136,8 +141,14 @@ pub fn run(args: &HandEyeEvalArgs) -> Result<()> {
         bar.inc(1);
     }
     bar.finish_and_clear();
+    if rows.is_empty() {
+        anyhow::bail!(
+            "every calibration was refused; the first: {}",
+            refused.first().map_or("", String::as_str)
+        );
+    }
     let mut counts = Vec::new();
-    for &poses in &args.poses {
+    for &poses in &counts_asked {
         for solver in SOLVERS {
             let of: Vec<&Row> = rows
                 .iter()
@@ -212,21 +223,21 @@ pub fn run(args: &HandEyeEvalArgs) -> Result<()> {
     out.finish()?;
     print_json_or_text(&summary, args.json, || {
         println!(
-            "{}: hand-eye on the twin, camera misplaced {} mm / {} deg, median (worst) of {} seeds",
+            "{}: hand-eye on the twin, camera misplaced {} mm / {} deg, median (worst) over the runs at each count",
             args.out.display(),
             args.camera_error_mm,
             args.camera_error_deg,
-            args.seeds
         );
         println!(
-            "{:>6} {:<12} {:>18} {:>20}",
-            "poses", "solver", "error mm", "error deg"
+            "{:>6} {:<12} {:>5} {:>18} {:>20}",
+            "poses", "solver", "runs", "error mm", "error deg"
         );
         for c in &summary.counts {
             println!(
-                "{:>6} {:<12} {:>8.3} ({:>7.3}) {:>9.4} ({:>8.4})",
+                "{:>6} {:<12} {:>5} {:>8.3} ({:>7.3}) {:>9.4} ({:>8.4})",
                 c.poses,
                 c.solver,
+                c.runs,
                 c.median_error_mm,
                 c.worst_error_mm,
                 c.median_error_deg,

@@ -51,7 +51,7 @@ pub(crate) fn levenberg_marquardt<const P: usize>(
                 }
             }
         }
-        let mut improved = false;
+        let (mut improved, mut solvable) = (false, false);
         for _ in 0..10 {
             let mut damped = jtj;
             for (a, row) in damped.iter_mut().enumerate() {
@@ -61,6 +61,7 @@ pub(crate) fn levenberg_marquardt<const P: usize>(
                 damping *= 10.0;
                 continue;
             };
+            solvable = true;
             let trial: [f64; P] = std::array::from_fn(|k| p[k] + step[k]);
             let tr = residuals(&trial);
             let te = cost(&tr);
@@ -74,8 +75,9 @@ pub(crate) fn levenberg_marquardt<const P: usize>(
             damping *= 10.0;
         }
         if !improved {
-            // No step lowers the error, or only by rounding: a minimum.
-            converged = true;
+            // No step lowers the error, or only by rounding: a minimum; but where no damping
+            // made the equations solvable the parameters are not fixed, which is no minimum.
+            converged = solvable;
             break;
         }
     }

@@ -23,7 +23,7 @@ pub use board_pose::{BoardPose, MIN_POSE_CORNERS, board_pose_from_corners};
 pub use plan::{MAX_STATIONS, StationRequest, plan_stations};
 pub use refine::{BoardCorner, CornerStation, RefinedHandEye, refine_on_corners};
 pub use visit::{
-    HandEyeRun, StationReport, StationSighting, VisitError, solve_sightings, visit_stations,
+    HandEyeRun, StationReport, StationSighting, Visit, VisitError, solve_sightings, visit_stations,
 };
 
 use crate::geometry::Pose;
@@ -94,11 +94,19 @@ pub enum HandEyeError {
     #[error("a station plan holds 3 to {max} stations; asked for {0}", max = plan::MAX_STATIONS)]
     StationCount(usize),
     #[error(
-        "only {planned} of {asked} stations could be placed with the whole board in the camera's view and the tool in the arm's reach; check the camera's pose and the board's size"
+        "only {planned} of {asked} stations could be planned: of {tried} places for the board, about {distance_m:.2} m from the camera and half the image wide, {out_of_view} left part of it out of the image, {out_of_reach} put the tool or the board where the arm cannot hold it, {one_axis} added no second axis of turn; check the camera's pose and the board's size"
     )]
-    StationsOutOfReach { planned: usize, asked: usize },
+    StationsOutOfReach {
+        planned: usize,
+        asked: usize,
+        tried: usize,
+        distance_m: f64,
+        out_of_view: usize,
+        out_of_reach: usize,
+        one_axis: usize,
+    },
     #[error(
-        "the board was seen at {seen} of {stations} stations; the camera's pose needs at least 3 (is the board in view, lit, and the dictionary the printed one?)"
+        "the board was seen at {seen} of {stations} stations; the camera's pose needs at least 3 (is the board in view and lit, the dictionary the printed one, and the camera near where it is believed to stand?)"
     )]
     BoardUnseen { seen: usize, stations: usize },
 }

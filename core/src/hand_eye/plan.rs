@@ -64,11 +64,17 @@ pub fn plan_stations(
     .map(|(x, y)| DVec3::new(x, y, 0.0) * 1e-3);
     let mut out = Vec::with_capacity(n);
     let mut candidate = 0usize;
+    let (mut out_of_view, mut out_of_reach, mut one_axis) = (0, 0, 0);
     while out.len() < n {
         if candidate >= TRIES_PER_STATION * n {
             return Err(HandEyeError::StationsOutOfReach {
                 planned: out.len(),
                 asked: n,
+                tried: candidate,
+                distance_m,
+                out_of_view,
+                out_of_reach,
+                one_axis,
             });
         }
         let board_in_camera = candidate_pose(candidate, distance_m, k, centre_on_board);
@@ -83,13 +89,18 @@ pub fn plan_stations(
             }
         });
         if !in_view {
+            out_of_view += 1;
             continue;
         }
         let tool = request
             .camera_in_base
             .compose(&board_in_camera)
             .compose(&request.board_in_tool.inverse());
-        if reachable(&tool) && turns_about_two_axes(&out, &tool) {
+        if !reachable(&tool) {
+            out_of_reach += 1;
+        } else if !turns_about_two_axes(&out, &tool) {
+            one_axis += 1;
+        } else {
             out.push(tool);
         }
     }

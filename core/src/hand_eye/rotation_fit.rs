@@ -9,13 +9,15 @@ use glam::{DMat3, DQuat, DVec3};
 /// linear in P and stacked over the motions. At a half turn of R_X every [a + b]x shares its
 /// axis as null vector (a camera looking straight down is one), so the system is solved for
 /// X' = X R0^-1 (A X' = X' R0 B R0^-1) with R0 the best conditioned of no turn and quarter
-/// turns about x and y.
+/// turns about x, y and z (with z, no R_X is a half turn for all four: a camera turned a half
+/// turn about z is one for the first three).
 pub(super) fn tsai_lenz(motions: &[Motion]) -> Result<DQuat, HandEyeError> {
     use std::f64::consts::FRAC_PI_2;
     let offsets = [
         DQuat::IDENTITY,
         DQuat::from_rotation_x(FRAC_PI_2),
         DQuat::from_rotation_y(FRAC_PI_2),
+        DQuat::from_rotation_z(FRAC_PI_2),
     ];
     let (conditioning, normal, rhs, offset) = offsets
         .into_iter()
@@ -33,7 +35,7 @@ pub(super) fn tsai_lenz(motions: &[Motion]) -> Result<DQuat, HandEyeError> {
             (smallest / largest.max(1e-300), normal, rhs, r0)
         })
         .max_by(|x, y| x.0.total_cmp(&y.0))
-        .expect("three offsets");
+        .expect("four offsets");
     if conditioning <= MIN_SECOND_AXIS_SHARE {
         return Err(HandEyeError::OneAxis);
     }

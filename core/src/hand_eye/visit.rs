@@ -20,8 +20,8 @@ pub struct StationSighting {
     /// Markers decoded.
     pub markers: usize,
     pub corners: Vec<BoardCorner>,
-    /// The frame the corners were found in, for the report's images.
-    pub image: image::RgbImage,
+    /// The frame the corners were found in, when the run was asked to keep it.
+    pub image: Option<image::RgbImage>,
 }
 
 /// A device or the detector failing during the run (not a board unseen).
@@ -36,17 +36,32 @@ pub enum VisitError {
     },
 }
 
-/// Moves through `tool_poses` at `speed_m_s`, capturing and detecting at each; `progress` is
-/// told after each station.
+/// The stations to visit and how.
+#[derive(Clone, Copy, Debug)]
+pub struct Visit<'a> {
+    pub board: &'a CharucoBoard,
+    /// The tool's pose at each station (`plan_stations`).
+    pub tool_poses: &'a [Pose],
+    pub speed_m_s: f64,
+    /// Keep each station's frame in its sighting (a report's images).
+    pub keep_images: bool,
+}
+
+/// Moves through the visit's stations, capturing and detecting at each; `progress` is told
+/// after each station.
 pub fn visit_stations(
     arm: &mut dyn Arm,
     camera: &mut dyn RgbdCamera,
     detector: &dyn BoardDetector,
-    board: &CharucoBoard,
-    tool_poses: &[Pose],
-    speed_m_s: f64,
+    visit: &Visit,
     mut progress: impl FnMut(usize),
 ) -> Result<Vec<StationSighting>, VisitError> {
+    let Visit {
+        board,
+        tool_poses,
+        speed_m_s,
+        keep_images,
+    } = *visit;
     let on_board = board.corners();
     let mut out = Vec::with_capacity(tool_poses.len());
     for (station, pose) in tool_poses.iter().enumerate() {
@@ -71,7 +86,7 @@ pub fn visit_stations(
             tool_in_base,
             markers: sighting.markers,
             corners,
-            image: frame.color,
+            image: keep_images.then_some(frame.color),
         });
         progress(station + 1);
     }

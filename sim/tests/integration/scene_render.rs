@@ -361,3 +361,32 @@ fn a_held_board_is_seen_at_its_depth_and_hidden_behind_what_is_nearer() {
         changed.first().map_or(0.0, |i| below.depth_m[*i]),
     );
 }
+
+#[test]
+fn a_held_board_through_a_fruit_or_the_table_is_not_clear() {
+    use tactex_core::charuco::CharucoBoard;
+    use tactex_sim::render::board_view::SheetLook;
+    use tactex_sim::world::HeldBoard;
+    let world = sphere_world();
+    let board = CharucoBoard::default();
+    let (w_mm, h_mm) = board.size_mm();
+    let held = HeldBoard {
+        board,
+        board_in_tool: Pose::new(
+            DVec3::new(-w_mm / 2.0 * 1e-3, h_mm / 2.0 * 1e-3, 0.005),
+            glam::DQuat::from_rotation_x(std::f64::consts::PI),
+        ),
+        look: SheetLook::default(),
+    };
+    let at = |z: f64| Pose::new(DVec3::new(0.0, 0.0, z), glam::DQuat::IDENTITY);
+    // The sphere (8 cm across) stands under the table's middle: a sheet at 5 cm cuts it.
+    assert!(held.clears(&world, &at(0.3)));
+    assert!(!held.clears(&world, &at(0.05)));
+    // Tilted 60 degrees about x, 8 cm up beside the sphere: the sheet's lower edge (85 mm
+    // from the middle) comes within 7 mm of the table.
+    let tilted = Pose::new(
+        DVec3::new(0.2, 0.0, 0.08),
+        glam::DQuat::from_rotation_x(1.05),
+    );
+    assert!(!held.clears(&world, &tilted));
+}
