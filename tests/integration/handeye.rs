@@ -26,12 +26,7 @@ fn handeye_finds_a_misplaced_twin_camera_from_fifteen_stations() {
         frames.to_str().unwrap(),
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let report = crate::cli::json(&out);
     let solvers = report["solvers"].as_array().unwrap();
     assert_eq!(solvers.len(), 3);
     for s in solvers {
