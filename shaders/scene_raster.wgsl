@@ -1,5 +1,6 @@
 // The RGB-D scene renderer's raster pipeline: pinhole projection at the camera's intrinsics
-// (pixel centres sampled, as in the CPU reference), depth test on camera z, and per fragment
+// (pixel x's centre at u = x, as in OpenCV and the CPU reference: the Rust side adds half a
+// pixel to the principal point), depth test on camera z, and per fragment
 // ambient plus Lambert light with a Blinn-Phong highlight on objects (id > 0). Four outputs:
 // colour with the specular share in alpha, camera-frame depth in metres, and the instance id.
 // `SceneParams` is laid out exactly as the Rust struct of the same name (uniform, 144 bytes).

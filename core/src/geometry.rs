@@ -86,6 +86,8 @@ impl Pose {
 }
 
 /// Pinhole intrinsics (pixels). Defaults are the TactEx paper's RealSense colour stream.
+/// Pixel (x, y)'s centre is at (u, v) = (x, y), as in OpenCV and librealsense, so a real
+/// camera's calibration and the twin's renders mean the same point by the same pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CameraIntrinsics {
     pub width: u32,
@@ -143,6 +145,14 @@ impl CameraIntrinsics {
         (p.z > 1e-9).then(|| (self.fx * p.x / p.z + self.cx, self.fy * p.y / p.z + self.cy))
     }
 
+    /// The pixel whose area holds image point (u, v) (pixel x spans u in [x - 0.5, x + 0.5)),
+    /// or None outside the image.
+    pub fn pixel_at(&self, u: f64, v: f64) -> Option<(u32, u32)> {
+        let (x, y) = ((u + 0.5).floor(), (v + 0.5).floor());
+        (x >= 0.0 && y >= 0.0 && x < self.width as f64 && y < self.height as f64)
+            .then_some((x as u32, y as u32))
+    }
+
     /// The camera-frame point at pixel (u, v) with depth `z` along the optical axis.
     pub fn back_project(&self, u: f64, v: f64, z: f64) -> DVec3 {
         DVec3::new((u - self.cx) * z / self.fx, (v - self.cy) * z / self.fy, z)
@@ -152,6 +162,18 @@ impl CameraIntrinsics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_pixel_holds_the_points_within_half_a_pixel_of_its_centre() {
+        let k = CameraIntrinsics::default();
+        assert_eq!(k.pixel_at(3.0, 4.0), Some((3, 4)));
+        assert_eq!(k.pixel_at(3.49, 4.49), Some((3, 4)));
+        assert_eq!(k.pixel_at(3.5, 3.5), Some((4, 4)));
+        assert_eq!(k.pixel_at(-0.5, -0.5), Some((0, 0)));
+        assert_eq!(k.pixel_at(-0.51, 0.0), None);
+        assert_eq!(k.pixel_at(639.49, 479.49), Some((639, 479)));
+        assert_eq!(k.pixel_at(639.5, 0.0), None);
+    }
 
     #[test]
     fn camera_looking_straight_down_maps_world_x_right_and_y_up_in_image() {

@@ -11,8 +11,8 @@
 //! depth = "/dev/video2"
 //! depth_scale_m = 0.0001
 //! intrinsics = { width = 640, height = 480, fx = 608.5, fy = 606.9, cx = 309.4, cy = 213.83 }
-//! position_m = [0.0, 0.0, 0.70]
-//! look_at_m = [0.0, 0.0, 0.0]
+//! position_m = [0.0, 0.0, 0.70]     # where it stands, as measured by hand; or, instead of
+//! look_at_m = [0.0, 0.0, 0.0]        # these two, calibration = "calib.toml" (`tactex handeye`)
 //!
 //! [tactile]                      # a GelSight Mini on V4L2
 //! device = "GelSight Mini"
@@ -24,6 +24,7 @@ use std::path::{Path, PathBuf};
 use tactex_core::devices::DeviceError;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::glam::DVec3;
+use tactex_core::hand_eye::calibration_file::load_camera_in_base;
 
 #[derive(Debug, thiserror::Error)]
 pub enum DevicesError {
@@ -47,6 +48,10 @@ pub struct DevicesConfig {
     pub arm: ArmConfig,
     pub camera: CameraConfig,
     pub tactile: TactileConfig,
+    /// The camera in the world frame, from `camera.calibration` or `camera.position_m` and
+    /// `camera.look_at_m` (set by `load`).
+    #[serde(skip, default = "unset_pose")]
+    camera_in_world: Pose,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -64,14 +69,22 @@ pub struct CameraConfig {
     pub depth: String,
     pub depth_scale_m: f64,
     pub intrinsics: CameraIntrinsics,
-    pub position_m: [f64; 3],
-    pub look_at_m: [f64; 3],
+    pub position_m: Option<[f64; 3]>,
+    pub look_at_m: Option<[f64; 3]>,
+    /// A hand-eye calibration file (`tactex handeye --out`), relative to devices.toml's
+    /// folder: the camera's pose in the arm's base frame, instead of `position_m` and
+    /// `look_at_m`.
+    pub calibration: Option<PathBuf>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TactileConfig {
     pub device: String,
+}
+
+fn unset_pose() -> Pose {
+    Pose::IDENTITY
 }
 
 impl DevicesConfig {
@@ -81,7 +94,7 @@ impl DevicesConfig {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
-        let config: DevicesConfig = toml::from_str(&text).map_err(|e| DevicesError::File {
+        let mut config: DevicesConfig = toml::from_str(&text).map_err(|e| DevicesError::File {
             path: path.to_path_buf(),
             message: tactex_core::file_failure::toml_failure(&text, &e),
         })?;
@@ -97,26 +110,52 @@ impl DevicesConfig {
         if let Err(why) = k.check() {
             return Err(field("camera.intrinsics", &why));
         }
-        if config.camera_pose().is_none() {
-            return Err(field(
-                "camera.look_at_m",
-                "must differ from camera.position_m",
-            ));
-        }
         if let Some(w) = config.arm.workspace_mm {
             WorkspaceBox::from_bounds_mm(w).map_err(|e| field("arm.workspace_mm", &e))?;
         }
         if config.arm.base_in_world_m.iter().any(|v| !v.is_finite()) {
             return Err(field("arm.base_in_world_m", "must be finite"));
         }
+        let c = &config.camera;
+        config.camera_in_world = match (&c.calibration, c.position_m, c.look_at_m) {
+            (Some(file), None, None) => {
+                let folder = path.parent().unwrap_or(Path::new(""));
+                let in_base = load_camera_in_base(&folder.join(file))
+                    .map_err(|e| field("camera.calibration", &e.to_string()))?;
+                // The arm's base frame has the world's axes (see `base_in_world_m`).
+                Pose::new(
+                    in_base.position + DVec3::from_array(config.arm.base_in_world_m),
+                    in_base.rotation,
+                )
+            }
+            (Some(_), _, _) => {
+                return Err(field(
+                    "camera.calibration",
+                    "places the camera: leave out camera.position_m and camera.look_at_m",
+                ));
+            }
+            (None, Some(at), Some(look_at)) => {
+                if !at.iter().chain(&look_at).all(|v| v.is_finite()) {
+                    return Err(field("camera.position_m", "must be finite"));
+                }
+                Pose::camera_looking_at(DVec3::from_array(at), DVec3::from_array(look_at))
+                    .ok_or_else(|| {
+                        field("camera.look_at_m", "must differ from camera.position_m")
+                    })?
+            }
+            (None, _, _) => {
+                return Err(field(
+                    "camera",
+                    "needs position_m and look_at_m, or calibration = \"calib.toml\" (tactex handeye)",
+                ));
+            }
+        };
         Ok(config)
     }
 
-    pub fn camera_pose(&self) -> Option<Pose> {
-        Pose::camera_looking_at(
-            DVec3::from_array(self.camera.position_m),
-            DVec3::from_array(self.camera.look_at_m),
-        )
+    /// Where the camera stands in the world frame (OpenCV's camera axes).
+    pub fn camera_pose(&self) -> Pose {
+        self.camera_in_world
     }
 
     /// Connects to the arm and makes it ready to move (enable, position mode, start).
@@ -136,7 +175,7 @@ impl DevicesConfig {
     #[cfg(all(target_os = "linux", feature = "v4l2"))]
     pub fn open_camera(&self) -> Result<crate::realsense::RealSense, DevicesError> {
         let c = &self.camera;
-        let pose = self.camera_pose().expect("checked in load");
+        let pose = self.camera_pose();
         Ok(crate::realsense::RealSense::open(
             &c.color,
             &c.depth,

@@ -3,19 +3,15 @@
 //! belief taken from the scene or from a hand-eye calibration file (`tactex handeye`'s
 //! `calib.toml`). `ask`, `serve`, the evaluations and `handeye` itself share it.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use glam::{DQuat, DVec3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use serde::Deserialize;
 use std::path::Path;
 use tactex_core::geometry::Pose;
+use tactex_core::hand_eye::calibration_file;
 use tactex_sim::SimDevices;
-
-/// How far a quaternion's length may be off 1 in a calibration file (rounding) before it is
-/// taken for a mistake.
-const UNIT_TOLERANCE: f64 = 1e-3;
 
 /// The camera's misplacement and what its user believes.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -101,43 +97,10 @@ pub fn misplaced(pose: &Pose, mm: f64, deg: f64, seed: u64) -> Pose {
     )
 }
 
-#[derive(Deserialize)]
-struct CalibrationFile {
-    camera: CameraSection,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CameraSection {
-    position_m: [f64; 3],
-    rotation_xyzw: [f64; 4],
-}
-
 /// The camera's pose from a hand-eye calibration file (`[camera] position_m` and
-/// `rotation_xyzw`); the rest of the file (how it was found) is not read.
+/// `rotation_xyzw`, in the arm's base frame, which is the twin's world); the rest of the file
+/// (how it was found) is not read.
 pub fn load_calibrated_camera(path: &Path) -> Result<Pose> {
     super::file_input::present(path, "file: cannot read calibration")?;
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read calibration", path.display()))?;
-    let file: CalibrationFile = toml::from_str(&text).map_err(|e| {
-        anyhow::anyhow!(
-            "{}: {}",
-            path.display(),
-            e.message().lines().next().unwrap_or("not a calibration")
-        )
-    })?;
-    let [x, y, z] = file.camera.position_m;
-    let [qx, qy, qz, qw] = file.camera.rotation_xyzw;
-    if ![x, y, z].iter().all(|v| v.is_finite()) {
-        bail!("{}: camera.position_m must be finite", path.display());
-    }
-    let q = DQuat::from_xyzw(qx, qy, qz, qw);
-    let length = q.length();
-    if !length.is_finite() || (length - 1.0).abs() > UNIT_TOLERANCE {
-        bail!(
-            "{}: camera.rotation_xyzw has length {length:.4}; a rotation's quaternion has length 1",
-            path.display()
-        );
-    }
-    Ok(Pose::new(DVec3::new(x, y, z), q / length))
+    Ok(calibration_file::load_camera_in_base(path)?)
 }

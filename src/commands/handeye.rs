@@ -16,6 +16,7 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tactex_core::charuco::{BoardDetector, CharucoBoard};
 use tactex_core::geometry::Pose;
+use tactex_core::hand_eye::calibration_file::CameraInBase;
 use tactex_core::hand_eye::{
     BoardCorner, HandEyeSolution, MAX_STATIONS, MIN_POSE_CORNERS, StationReport,
 };
@@ -152,33 +153,13 @@ fn check_outputs(args: &HandEyeArgs, scene: &Path) -> Result<()> {
 /// The calibration file: the camera's pose first, then how it was found.
 #[derive(Serialize)]
 struct CalibrationFile {
-    camera: CameraPose,
+    camera: CameraInBase,
     fit: Fit,
     board: CharucoBoard,
     solvers: Vec<Solver>,
     #[serde(skip_serializing_if = "Option::is_none")]
     twin: Option<TwinTruth>,
     stations: Vec<Station>,
-}
-
-#[derive(Serialize)]
-struct CameraPose {
-    position_m: [f64; 3],
-    rotation_xyzw: [f64; 4],
-}
-
-impl CameraPose {
-    fn of(pose: &Pose) -> Self {
-        Self {
-            position_m: pose.position.to_array().map(round9),
-            rotation_xyzw: pose.rotation.to_array().map(round9),
-        }
-    }
-}
-
-/// Nine decimals: a nanometre, and a rotation to 1e-9; the file reads as a person wrote it.
-fn round9(v: f64) -> f64 {
-    (v * 1e9).round() / 1e9
 }
 
 #[derive(Serialize)]
@@ -193,7 +174,7 @@ struct Fit {
 #[derive(Serialize)]
 struct Solver {
     method: &'static str,
-    camera: CameraPose,
+    camera: CameraInBase,
     #[serde(skip_serializing_if = "Option::is_none")]
     median_residual_mm: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -211,8 +192,8 @@ struct TwinTruth {
     camera_error_seed: u64,
     camera_error_mm: f64,
     camera_error_deg: f64,
-    believed: CameraPose,
-    truth: CameraPose,
+    believed: CameraInBase,
+    truth: CameraInBase,
 }
 
 #[derive(Serialize)]
@@ -249,7 +230,7 @@ fn closed_form(name: &'static str, s: &HandEyeSolution, truth: Option<&Pose>) ->
     let error = truth.map(|t| pose_error(&s.camera_in_base, t));
     Solver {
         method: name,
-        camera: CameraPose::of(&s.camera_in_base),
+        camera: CameraInBase::of(&s.camera_in_base),
         median_residual_mm: Some(round6(median(
             s.residuals.iter().map(|r| r.translation_mm).collect(),
         ))),
@@ -307,7 +288,7 @@ pub fn run(args: &HandEyeArgs) -> Result<()> {
     );
     let used = run.stations.iter().filter(|s| s.unseen.is_none()).count();
     let file = CalibrationFile {
-        camera: CameraPose::of(&refined.camera_in_base),
+        camera: CameraInBase::of(&refined.camera_in_base),
         fit: Fit {
             method: method.clone(),
             rms_px: round6(refined.rms_px),
@@ -321,7 +302,7 @@ pub fn run(args: &HandEyeArgs) -> Result<()> {
             closed_form("Park-Martin", &run.park_martin, Some(&truth)),
             Solver {
                 method: "refined",
-                camera: CameraPose::of(&refined.camera_in_base),
+                camera: CameraInBase::of(&refined.camera_in_base),
                 median_residual_mm: None,
                 median_residual_deg: None,
                 error_mm: Some(round6(refined_error.0)),
@@ -334,8 +315,8 @@ pub fn run(args: &HandEyeArgs) -> Result<()> {
             camera_error_seed: args.camera_error_seed,
             camera_error_mm: request.placement.error_mm,
             camera_error_deg: request.placement.error_deg,
-            believed: CameraPose::of(&believed),
-            truth: CameraPose::of(&truth),
+            believed: CameraInBase::of(&believed),
+            truth: CameraInBase::of(&truth),
         }),
         stations: run.stations.iter().map(Station::from).collect(),
     };

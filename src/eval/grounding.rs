@@ -220,13 +220,9 @@ fn run_instance(
     };
     let to_cam = true_pose.inverse();
     let on_target = |p: DVec3| -> bool {
-        k.project(to_cam.transform_point(p)).is_some_and(|(u, v)| {
-            u >= 0.0
-                && v >= 0.0
-                && (u as u32) < k.width
-                && (v as u32) < k.height
-                && clean.instances.get_pixel(u as u32, v as u32)[0] == 1
-        })
+        k.project(to_cam.transform_point(p))
+            .and_then(|(u, v)| k.pixel_at(u, v))
+            .is_some_and(|(x, y)| clean.instances.get_pixel(x, y)[0] == 1)
     };
     let error_mm = |mask: &GrayImage, refine: bool, depth: &DepthImage| {
         locate(mask, refine, depth, &k, &pose).map(|at| horizontal_mm(at.surface, truth_centroid))

@@ -11,8 +11,8 @@ pub fn match_reports(answer: &Answer, kinds: &[String], twin: &TwinAnswer) -> Ve
     let (k, to_camera) = (twin.intrinsics, twin.camera_pose.inverse());
     let id_under = |p: [f64; 3]| -> Option<usize> {
         let (u, v) = k.project(to_camera.transform_point(glam::DVec3::from_array(p)))?;
-        let inside = u >= 0.0 && v >= 0.0 && (u as u32) < k.width && (v as u32) < k.height;
-        let id = inside.then(|| twin.instances.get_pixel(u as u32, v as u32)[0])?;
+        let (x, y) = k.pixel_at(u, v)?;
+        let id = twin.instances.get_pixel(x, y)[0];
         (id > 0).then(|| id as usize - 1)
     };
     let mut of_object: Vec<Option<usize>> = vec![None; kinds.len()];

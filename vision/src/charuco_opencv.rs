@@ -1,6 +1,7 @@
 //! `BoardDetector` by OpenCV 4.6's `cv::aruco`: `detectMarkers` with the board's predefined
 //! dictionary, then `interpolateCornersCharuco` (the inner corners between two found
-//! markers, refined by `cornerSubPix`).
+//! markers, refined by `cornerSubPix`; OpenCV 4.6 leaves them half a pixel off, so they are
+//! refined again in a window inside the gap to the markers).
 
 use opencv::core::{Mat, Point2f, Vector};
 use opencv::prelude::*;
@@ -16,6 +17,9 @@ pub struct CharucoDetector;
 /// A corner counts when at least this many markers next to it were found (OpenCV's own
 /// default for `interpolateCornersCharuco` is 2: both neighbours).
 const MIN_MARKERS: i32 = 2;
+
+/// Samples a side of each marker cell when its bits are read (OpenCV's default is 4).
+const PIXELS_PER_CELL: i32 = 8;
 
 fn failed(e: opencv::Error) -> DetectError {
     DetectError(e.to_string())
@@ -66,7 +70,10 @@ impl BoardDetector for CharucoDetector {
             &dict,
         )
         .map_err(failed)?;
-        let params = aruco::DetectorParameters::create().map_err(failed)?;
+        let mut params = aruco::DetectorParameters::create().map_err(failed)?;
+        // Each marker cell read from 8 x 8 samples instead of OpenCV's 4 x 4: a marker of
+        // 3 px cells tilted 35 degrees was lost or kept as the board moved by half a pixel.
+        params.set_perspective_remove_pixel_per_cell(PIXELS_PER_CELL);
         let mut marker_corners = Vector::<Mat>::new();
         let mut marker_ids = Mat::default();
         let mut rejected = Vector::<Mat>::new();
@@ -104,12 +111,11 @@ impl BoardDetector for CharucoDetector {
             named.push((id as usize, p));
         }
         let named = refined(&grey, board, named).map_err(failed)?;
-        // OpenCV puts pixel x's centre at x; the twin at x + 0.5.
         let mut seen: Vec<SeenCorner> = named
             .into_iter()
             .map(|(id, p)| SeenCorner {
                 id,
-                px: [p.x as f64 + 0.5, p.y as f64 + 0.5],
+                px: [p.x as f64, p.y as f64],
             })
             .collect();
         seen.sort_by_key(|c| c.id);

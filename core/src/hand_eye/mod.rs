@@ -13,6 +13,7 @@
 //! refines X and Z together on the board corners' reprojection error.
 
 mod board_pose;
+pub mod calibration_file;
 mod least_squares;
 mod plan;
 mod refine;

@@ -52,7 +52,7 @@ fn the_example_devices_file_is_valid() {
     let config = tactex_hw::devices_toml::DevicesConfig::load(&example).unwrap();
     assert_eq!(config.arm.addr, "192.168.1.185:502");
     assert_eq!(config.camera.intrinsics, CameraIntrinsics::default());
-    let pose = config.camera_pose().unwrap();
+    let pose = config.camera_pose();
     // Looking straight down from 0.7 m.
     assert!((pose.position.z - 0.7).abs() < 1e-12);
 }

@@ -105,8 +105,8 @@ impl<'a> SheetInCamera<'a> {
         let mut hits = 0;
         for j in 0..RAYS {
             for i in 0..RAYS {
-                let u = x as f64 + (i as f64 + 0.5) / RAYS as f64;
-                let v = y as f64 + (j as f64 + 0.5) / RAYS as f64;
+                let u = x as f64 - 0.5 + (i as f64 + 0.5) / RAYS as f64;
+                let v = y as f64 - 0.5 + (j as f64 + 0.5) / RAYS as f64;
                 match self.hit(k, u, v).filter(|(_, z)| in_front(*z)) {
                     Some((g, _)) => {
                         hits += 1;
@@ -117,7 +117,7 @@ impl<'a> SheetInCamera<'a> {
             }
         }
         let centre = self
-            .hit(k, x as f64 + 0.5, y as f64 + 0.5)
+            .hit(k, x as f64, y as f64)
             .map(|(_, z)| z)
             .filter(|z| in_front(*z));
         (hits > 0).then(|| (sum.map(|s| s / (RAYS * RAYS) as f64), centre))
@@ -145,8 +145,8 @@ impl<'a> SheetInCamera<'a> {
             let (x, y) = (i as u32 % w, i as u32 / w);
             // Rays that miss every part of the pixel's 3 px box round the sheet skip the
             // supersampling: most of the frame.
-            if self.hit(k, x as f64 + 0.5, y as f64 + 0.5).is_none()
-                && [(-1.0, -1.0), (2.0, -1.0), (-1.0, 2.0), (2.0, 2.0)]
+            if self.hit(k, x as f64, y as f64).is_none()
+                && [(-1.5, -1.5), (1.5, -1.5), (-1.5, 1.5), (1.5, 1.5)]
                     .iter()
                     .all(|(du, dv)| self.hit(k, x as f64 + du, y as f64 + dv).is_none())
             {

@@ -41,11 +41,7 @@ fn demo_world() -> SimWorld {
 /// Camera z of the first hit of pixel (x, y)'s ray on a sphere (camera frame), if any.
 fn ray_sphere_z(world: &SimWorld, x: u32, y: u32, centre: DVec3) -> Option<f64> {
     let k = world.intrinsics;
-    let d = DVec3::new(
-        (x as f64 + 0.5 - k.cx) / k.fx,
-        (y as f64 + 0.5 - k.cy) / k.fy,
-        1.0,
-    );
+    let d = DVec3::new((x as f64 - k.cx) / k.fx, (y as f64 - k.cy) / k.fy, 1.0);
     let c = world.camera_pose.inverse().transform_point(centre);
     let (a, b, q) = (
         d.length_squared(),
@@ -75,7 +71,7 @@ fn depth_of_a_sphere_matches_the_ray_sphere_intersection() {
     let mut checked = 0;
     for y in 0..k.height {
         for x in 0..k.width {
-            let r = ((x as f64 + 0.5 - cx).powi(2) + (y as f64 + 0.5 - cy).powi(2)).sqrt();
+            let r = ((x as f64 - cx).powi(2) + (y as f64 - cy).powi(2)).sqrt();
             // Inside 80% of the silhouette the facets (up to 0.043 mm inside the sphere at a
             // quad's middle) are seen at a slant of at most 53 degrees: within 0.075 mm.
             if r > 0.8 * silhouette_px {
@@ -120,6 +116,67 @@ fn sphere_silhouette_covers_the_projected_disc() {
     );
     // The table is seen everywhere else within the image (the camera looks down at it).
     assert!(render.depth_m.iter().all(|z| *z > 0.0));
+}
+
+/// The sphere's silhouette (instance 1) is centred on the principal point: its mean pixel
+/// within 0.2 px. The facets and whole-pixel sampling move the middle by up to 0.1 px; the
+/// old half-pixel shift moved it 0.4-0.6 px.
+fn assert_centred_on_the_principal_point(render: &CleanRender, k: &CameraIntrinsics) {
+    let (mut x, mut y, mut n) = (0.0, 0.0, 0.0);
+    for (px, py, id) in render.instances.enumerate_pixels() {
+        if id[0] == 1 {
+            (x, y, n) = (x + px as f64, y + py as f64, n + 1.0);
+        }
+    }
+    let (x, y) = (x / n, y / n);
+    assert!(
+        (x - k.cx).abs() < 0.2 && (y - k.cy).abs() < 0.2,
+        "silhouette centred at ({x:.3}, {y:.3}), principal point ({}, {})",
+        k.cx,
+        k.cy
+    );
+}
+
+/// Pixel x's centre is at u = x, as a real camera's OpenCV or librealsense intrinsics mean
+/// it: a sphere on the optical axis is seen centred on the principal point, not half a pixel
+/// off it (which put every twin centroid 0.6 mm from where a real camera's would be).
+#[test]
+fn a_sphere_on_the_optical_axis_is_seen_centred_on_the_principal_point() {
+    let world = sphere_world();
+    let render = CpuSceneRenderer
+        .render(&SceneGeometry::of_world(&world))
+        .unwrap();
+    assert_centred_on_the_principal_point(&render, &world.intrinsics);
+}
+
+/// The sphere's pixels back-projected as the pipeline does (pixel x at u = x, at its
+/// rendered depth) land on the sphere round its own axis: the mean of the visible cap lies
+/// over its centre. Half a pixel of disagreement between renderer and back-projection put
+/// it 0.54 mm off in x and y.
+#[test]
+fn a_sphere_back_projected_from_its_render_stands_where_it_is() {
+    let world = sphere_world();
+    let render = CpuSceneRenderer
+        .render(&SceneGeometry::of_world(&world))
+        .unwrap();
+    let (k, w) = (world.intrinsics, world.intrinsics.width);
+    let (mut sum, mut n) = (DVec3::ZERO, 0.0);
+    for (x, y, id) in render.instances.enumerate_pixels() {
+        let z = render.depth_m[(y * w + x) as usize];
+        if id[0] == 1 && z > 0.0 {
+            sum += world
+                .camera_pose
+                .transform_point(k.back_project(x as f64, y as f64, z));
+            n += 1.0;
+        }
+    }
+    let off_mm = (sum / n - world.objects[0].centre).truncate() * 1e3;
+    assert!(
+        off_mm.length() < 0.1,
+        "the cap's middle is {:.3} mm, {:.3} mm from the sphere's axis",
+        off_mm.x,
+        off_mm.y
+    );
 }
 
 /// Every scene shipped in scenes/ (fruits.toml is the catalog), as its world.
@@ -167,8 +224,8 @@ fn the_arm_over_the_table_hides_it_at_the_wrists_depth() {
         .unwrap();
     let to_camera = world.camera_pose.inverse();
     let top = to_camera.transform_point(pad + DVec3::Z * (0.024 + 0.015 + 0.110));
-    let (x, y) = world.intrinsics.project(top).unwrap();
-    let (x, y) = (x as u32, y as u32);
+    let (u, v) = world.intrinsics.project(top).unwrap();
+    let (x, y) = world.intrinsics.pixel_at(u, v).unwrap();
     let i = (y * world.intrinsics.width + x) as usize;
     assert!(
         (render.depth_m[i] - top.z).abs() < 1e-4,
@@ -219,6 +276,17 @@ fn at_an_edge(a: &CleanRender, b: &CleanRender, x: u32, y: u32) -> bool {
             let (nx, ny) = (nx as u32, ny as u32);
             a.instances.get_pixel(nx, ny)[0] != id || b.instances.get_pixel(nx, ny)[0] != id
         })
+}
+
+#[test]
+#[cfg_attr(
+    not(ci),
+    ignore = "needs a Vulkan adapter (lavapipe: mesa-vulkan-drivers, as .ci/run installs)"
+)]
+fn the_gpu_raster_centres_pixels_as_the_intrinsics_do() {
+    let world = sphere_world();
+    let render = gpu().render(&SceneGeometry::of_world(&world)).unwrap();
+    assert_centred_on_the_principal_point(&render, &world.intrinsics);
 }
 
 #[test]

@@ -42,7 +42,7 @@ impl SceneRenderer for CpuSceneRenderer {
             }
             for y in lo.y as usize..=hi.y as usize {
                 for x in lo.x as usize..=hi.x as usize {
-                    let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                    let p = DVec2::new(x as f64, y as f64);
                     let b = [
                         (s[2] - s[1]).perp_dot(p - s[1]) / area,
                         (s[0] - s[2]).perp_dot(p - s[2]) / area,

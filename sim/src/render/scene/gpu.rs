@@ -38,7 +38,8 @@ impl SceneParams {
         let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
         Self {
             world_to_camera: m.to_cols_array_2d().map(|c| c.map(|x| x as f32)),
-            focal_centre: [k.fx, k.fy, k.cx, k.cy].map(|x| x as f32),
+            // The raster samples pixel x at x + 0.5; the intrinsics put its centre at x.
+            focal_centre: [k.fx, k.fy, k.cx + 0.5, k.cy + 0.5].map(|x| x as f32),
             viewport: [
                 k.width as f32,
                 k.height as f32,
