@@ -819,6 +819,10 @@ def ask(
     parser: Optional[str] = None,
     llm_config: Optional[PathLike] = None,
     gel_modulus_mpa: Optional[float] = None,
+    camera_error_mm: Optional[float] = None,
+    camera_error_deg: Optional[float] = None,
+    camera_error_seed: Optional[int] = None,
+    camera_calibration: Optional[PathLike] = None,
     reproducible: bool = True,
 ) -> Dict[str, Any]:
     """Asks the twin ``prompt`` ("Which fruit is the softest?") on ``scene`` (default the
@@ -827,6 +831,10 @@ def ask(
     With ``reproducible`` (the default) wall-clock times are left out, so that the same
     arguments give the same result, equal to ``ask --json --reproducible``. ``parser="llm"``
     has the endpoint ``explainer="llm"`` uses read the question (``tactex ask --parser``).
+    ``camera_error_mm`` (0-200) and ``camera_error_deg`` (0-20) stand the scene camera off
+    the scene's pose, in directions drawn from ``camera_error_seed``, without telling the
+    pipeline; ``camera_calibration`` (``tactex handeye``'s TOML) has the pipeline believe
+    the calibrated pose instead (``tactex ask --camera-error-mm`` and the rest).
     """
     twin = _request(
         fidelity=_text("fidelity", fidelity),
@@ -838,6 +846,14 @@ def ask(
         explainer=explainer,
         parser=parser,
         llm_config=llm_config,
+        camera_error_mm=_number("camera_error_mm", camera_error_mm),
+        camera_error_deg=_number("camera_error_deg", camera_error_deg),
+        camera_error_seed=(
+            None
+            if camera_error_seed is None
+            else _whole("camera_error_seed", camera_error_seed, 2**64)
+        ),
+        camera_calibration=camera_calibration,
     )
     request = _request(
         prompt=_text("prompt", prompt),

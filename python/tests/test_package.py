@@ -200,6 +200,23 @@ def test_ask_returns_what_ask_json_reproducible_prints(cli):
     assert printed["objects"], "the demo's fruit are touched"
 
 
+def test_ask_takes_the_cameras_misplacement_and_calibration_as_the_cli_does(cli, tmp_path):
+    # A calibration that believes the camera 5 mm off the scene's pose, turned a little.
+    calib = tmp_path / "calib.toml"
+    calib.write_text("[camera]\nposition_m = [0.005, 0.0, 0.7]\n"
+                     "rotation_xyzw = [0.99999, 0.0044, 0.0, 0.0]\n")
+    prompt = "How hard is the lime?"
+    flags = ["--camera-error-mm", "20", "--camera-error-deg", "2", "--camera-error-seed", "3",
+             "--camera-calibration", str(calib)]
+    printed = json.loads(cli("ask", "--json", "--reproducible", *flags, prompt).stdout)
+    got = tactex.ask(prompt, camera_error_mm=20, camera_error_deg=2, camera_error_seed=3,
+                     camera_calibration=calib)
+    assert got == printed
+    plain = tactex.ask(prompt)
+    moved = [abs(a - b) for a, b in zip(got["objects"][0]["position_m"], plain["objects"][0]["position_m"])]
+    assert max(moved[:2]) > 0.005, f"the misplaced, miscalibrated camera places the lime elsewhere: {moved}"
+
+
 FOTS = ROOT / "tests/fixtures/fots"
 FOTS_SCALE = dict(ball_radius_mm=2.35, mm_per_px=0.051072522982635343)
 
@@ -335,6 +352,11 @@ def test_compare_rebuilds_a_recorded_session_as_the_cli_does(cli, tmp_path):
         (lambda: list(tactex.generate(2, shard="0/1")), ValueError, "shard"),
         (lambda: tactex.Sensor().press_sequence(hardness="40A", phase_mm=None), ValueError, "phase_mm"),
         (lambda: tactex.ask("Which fruit is the softest?", reproducible="no"), ValueError, "reproducible"),
+        (lambda: tactex.ask("Which fruit is the softest?", camera_error_mm=500), ValueError, "camera_error_mm"),
+        (lambda: tactex.ask("Which fruit is the softest?", camera_error_deg="2"), ValueError, "camera_error_deg"),
+        (lambda: tactex.ask("Which fruit is the softest?", camera_error_seed=-1), ValueError, "camera_error_seed"),
+        (lambda: tactex.ask("Which fruit is the softest?", camera_calibration="no/such/calib.toml"),
+         FileNotFoundError, "calib.toml"),
         (lambda: tactex.read(ROOT / "tests"), ValueError, "tests"),
         (lambda: tactex.read(None), ValueError, "image"),
     ],
