@@ -18,6 +18,14 @@ pub fn array<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(
     exact(Vec::<T>::deserialize(d)?)
 }
 
+/// `Option<[T; N]>` from a list of exactly N, when the field is there (give the field
+/// `#[serde(default)]` too, so that it may be left out).
+pub fn optional_array<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(
+    d: D,
+) -> Result<Option<[T; N]>, D::Error> {
+    array(d).map(Some)
+}
+
 /// `[[T; N]; M]` from a list of exactly M lists of exactly N.
 pub fn matrix<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize, const M: usize>(
     d: D,

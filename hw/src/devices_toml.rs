@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 use tactex_core::devices::DeviceError;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::glam::DVec3;
-use tactex_core::hand_eye::calibration_file::load_camera_in_base;
+use tactex_core::hand_eye::calibration_file::{CAMERA_REACH_M, load_camera_in_base};
 
 #[derive(Debug, thiserror::Error)]
 pub enum DevicesError {
@@ -58,7 +58,9 @@ pub struct DevicesConfig {
 #[serde(deny_unknown_fields)]
 pub struct ArmConfig {
     pub addr: String,
+    #[serde(deserialize_with = "tactex_core::serde_exact::array")]
     pub base_in_world_m: [f64; 3],
+    #[serde(default, deserialize_with = "tactex_core::serde_exact::optional_array")]
     pub workspace_mm: Option<[f64; 6]>,
 }
 
@@ -69,7 +71,9 @@ pub struct CameraConfig {
     pub depth: String,
     pub depth_scale_m: f64,
     pub intrinsics: CameraIntrinsics,
+    #[serde(default, deserialize_with = "tactex_core::serde_exact::optional_array")]
     pub position_m: Option<[f64; 3]>,
+    #[serde(default, deserialize_with = "tactex_core::serde_exact::optional_array")]
     pub look_at_m: Option<[f64; 3]>,
     /// A hand-eye calibration file (`tactex handeye --out`), relative to devices.toml's
     /// folder: the camera's pose in the arm's base frame, instead of `position_m` and
@@ -116,9 +120,26 @@ impl DevicesConfig {
         if config.arm.base_in_world_m.iter().any(|v| !v.is_finite()) {
             return Err(field("arm.base_in_world_m", "must be finite"));
         }
+        if config
+            .arm
+            .base_in_world_m
+            .iter()
+            .any(|v| v.abs() > CAMERA_REACH_M)
+        {
+            return Err(field(
+                "arm.base_in_world_m",
+                &format!("must be within {CAMERA_REACH_M} m of the world's origin on each axis"),
+            ));
+        }
         let c = &config.camera;
         config.camera_in_world = match (&c.calibration, c.position_m, c.look_at_m) {
             (Some(file), None, None) => {
+                if file.as_os_str().is_empty() {
+                    return Err(field(
+                        "camera.calibration",
+                        "is empty: give the calibration file's path",
+                    ));
+                }
                 let folder = path.parent().unwrap_or(Path::new(""));
                 let in_base = load_camera_in_base(&folder.join(file))
                     .map_err(|e| field("camera.calibration", &e.to_string()))?;
@@ -137,6 +158,14 @@ impl DevicesConfig {
             (None, Some(at), Some(look_at)) => {
                 if !at.iter().chain(&look_at).all(|v| v.is_finite()) {
                     return Err(field("camera.position_m", "must be finite"));
+                }
+                if at.iter().chain(&look_at).any(|v| v.abs() > CAMERA_REACH_M) {
+                    return Err(field(
+                        "camera.position_m",
+                        &format!(
+                            "and camera.look_at_m must be within {CAMERA_REACH_M} m of the world's origin on each axis"
+                        ),
+                    ));
                 }
                 Pose::camera_looking_at(DVec3::from_array(at), DVec3::from_array(look_at))
                     .ok_or_else(|| {

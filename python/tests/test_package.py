@@ -357,6 +357,8 @@ def test_compare_rebuilds_a_recorded_session_as_the_cli_does(cli, tmp_path):
         (lambda: tactex.ask("Which fruit is the softest?", camera_error_seed=-1), ValueError, "camera_error_seed"),
         (lambda: tactex.ask("Which fruit is the softest?", camera_calibration="no/such/calib.toml"),
          FileNotFoundError, "calib.toml"),
+        (lambda: tactex.ask("Which fruit is the softest?", camera_calibration=ROOT / "devices.example.toml"),
+         ValueError, "devices.example.toml"),
         (lambda: tactex.read(ROOT / "tests"), ValueError, "tests"),
         (lambda: tactex.read(None), ValueError, "image"),
     ],

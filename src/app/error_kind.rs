@@ -4,6 +4,7 @@
 
 use crate::app::flag_range::FieldError;
 use tactex_core::catalog::CatalogError;
+use tactex_core::hand_eye::calibration_file::CalibrationFileError;
 use tactex_core::hardness::interval_calibration::CalibrationError;
 use tactex_core::hardness::scale::HardnessError;
 use tactex_core::query::QueryError;
@@ -67,6 +68,7 @@ fn is_bad_input(cause: &(dyn std::error::Error + 'static)) -> bool {
         || cause.is::<HardnessError>()
         || cause.is::<AnnotationError>()
         || cause.is::<CalibrationError>()
+        || cause.is::<CalibrationFileError>()
         || cause.is::<DevicesError>()
         || cause.is::<SessionError>()
         || cause.is::<OnnxError>()

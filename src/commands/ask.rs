@@ -155,6 +155,22 @@ pub fn answer(args: &AskRequest) -> Result<Answer> {
     if args.gel_modulus_mpa.is_some() && args.backend != Backend::Sim {
         bail!("--gel-modulus-mpa: only with --backend sim (a real gel is what it is)");
     }
+    if args.backend != Backend::Sim {
+        // The twin's camera rig: a real camera stands where it stands, and a recorded one
+        // stood where it did.
+        let rig = &args.twin;
+        if rig.camera_calibration.is_some() {
+            bail!(
+                "--camera-calibration: only with --backend sim (on --backend hw give it in devices.toml: [camera] calibration = \"FILE\")"
+            );
+        }
+        if rig.camera_error_mm != 0.0 {
+            bail!("--camera-error-mm: only with --backend sim (the twin's camera rig)");
+        }
+        if rig.camera_error_deg != 0.0 {
+            bail!("--camera-error-deg: only with --backend sim (the twin's camera rig)");
+        }
+    }
     let answer = match args.backend {
         Backend::Hw => {
             let Some(file) = &args.devices else {

@@ -103,6 +103,19 @@ fn a_bad_devices_file_names_the_file_and_field() {
     assert!(stderr.contains("--devices"), "{stderr}");
     let stderr = one_line_error(&ask(&["--devices", path]));
     assert!(stderr.contains("only with --backend hw"), "{stderr}");
+    // The twin's camera rig is refused on real devices: their camera is placed in the file.
+    std::fs::write(&file, devices_toml("127.0.0.1:502", "")).unwrap();
+    for (flag, value) in [
+        ("--camera-calibration", "calib.toml"),
+        ("--camera-error-mm", "20"),
+        ("--camera-error-deg", "2"),
+    ] {
+        let stderr = one_line_error(&ask(&["--backend", "hw", "--devices", path, flag, value]));
+        assert!(
+            stderr.contains(&format!("{flag}: only with --backend sim")),
+            "{stderr}"
+        );
+    }
     let stderr = one_line_error(&ask(&[
         "--backend",
         "hw",

@@ -17,9 +17,15 @@ const UNIT_TOLERANCE: f64 = 1e-3;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraInBase {
+    #[serde(deserialize_with = "crate::serde_exact::array")]
     pub position_m: [f64; 3],
+    #[serde(deserialize_with = "crate::serde_exact::array")]
     pub rotation_xyzw: [f64; 4],
 }
+
+/// How far from the arm's base a calibrated camera may stand (m): a table-top robot's camera
+/// is within a metre or two; past this a number is a mistake (or overflows the world pose).
+pub const CAMERA_REACH_M: f64 = 10.0;
 
 impl CameraInBase {
     /// The section for `pose`, to nine decimals (a nanometre; a rotation to 1e-9), so the file
@@ -37,6 +43,12 @@ impl CameraInBase {
         if !self.position_m.iter().all(|v| v.is_finite()) {
             return Err(("camera.position_m", "must be finite".into()));
         }
+        if self.position_m.iter().any(|v| v.abs() > CAMERA_REACH_M) {
+            return Err((
+                "camera.position_m",
+                format!("must be within {CAMERA_REACH_M} m of the arm's base on each axis"),
+            ));
+        }
         let q = DQuat::from_array(self.rotation_xyzw);
         let length = q.length();
         if !length.is_finite() || (length - 1.0).abs() > UNIT_TOLERANCE {
@@ -53,8 +65,11 @@ impl CameraInBase {
 /// is wrong.
 #[derive(Debug, thiserror::Error)]
 pub enum CalibrationFileError {
-    #[error("{}: cannot read calibration: {message}", path.display())]
-    Read { path: PathBuf, message: String },
+    #[error("{}: cannot read calibration: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{}: {message}", path.display())]
     Format { path: PathBuf, message: String },
     #[error("{}: {field} {message}", path.display())]
@@ -72,9 +87,9 @@ struct Sections {
 
 /// The camera's pose in the arm's base frame from a calibration file.
 pub fn load_camera_in_base(path: &Path) -> Result<Pose, CalibrationFileError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CalibrationFileError::Read {
+    let text = std::fs::read_to_string(path).map_err(|source| CalibrationFileError::Read {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        source,
     })?;
     camera_in_base_of_text(&text, path)
 }
@@ -136,5 +151,23 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("camera"), "{e}");
+        // A list longer than the field is refused, not cut; a far-off number is a mistake.
+        for text in [
+            "[camera]\nposition_m = [0.0, 0.0, 0.7, 5.0]\nrotation_xyzw = [1.0, 0.0, 0.0, 0.0]\n",
+            "[camera]\nposition_m = [0.0, 0.0, 0.7]\nrotation_xyzw = [1.0, 0.0, 0.0, 0.0, 0.0]\n",
+        ] {
+            let e = camera_in_base_of_text(text, at).unwrap_err().to_string();
+            assert!(e.contains("exactly"), "{e}");
+        }
+        let e = camera_in_base_of_text(
+            "[camera]\nposition_m = [1e308, 0.0, 0.7]\nrotation_xyzw = [1.0, 0.0, 0.0, 0.0]\n",
+            at,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("calib.toml: camera.position_m must be within 10 m"),
+            "{e}"
+        );
     }
 }

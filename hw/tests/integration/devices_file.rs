@@ -73,6 +73,14 @@ fn a_camera_placed_twice_or_not_at_all_is_refused_naming_the_field() {
     );
     let half = load(dir.path(), "position_m = [0.0, 0.0, 0.7]\n", CALIB).unwrap_err();
     assert!(half.contains("camera: needs"), "{half}");
+    // Hand-measured numbers are read exactly: a fourth is refused, not dropped.
+    let long = load(
+        dir.path(),
+        "position_m = [0.0, 0.0, 0.7, 9.0]\nlook_at_m = [0.0, 0.0, 0.0]\n",
+        CALIB,
+    )
+    .unwrap_err();
+    assert!(long.contains("exactly 3"), "{long}");
 }
 
 #[test]
@@ -95,7 +103,26 @@ fn a_bad_calibration_file_is_named_through_the_field_that_names_it() {
         missing.contains("nowhere.toml: cannot read calibration"),
         "{missing}"
     );
-    for e in [skewed, missing] {
+    let long = load(
+        dir.path(),
+        lines,
+        "[camera]\nposition_m = [0.0, 0.0, 0.7]\nrotation_xyzw = [1.0, 0.0, 0.0, 0.0, 0.0]\n",
+    )
+    .unwrap_err();
+    assert!(long.contains("exactly 4"), "{long}");
+    let far = load(
+        dir.path(),
+        lines,
+        "[camera]\nposition_m = [1e308, 0.0, 0.7]\nrotation_xyzw = [1.0, 0.0, 0.0, 0.0]\n",
+    )
+    .unwrap_err();
+    assert!(
+        far.contains("camera.position_m must be within 10 m"),
+        "{far}"
+    );
+    let empty = load(dir.path(), "calibration = \"\"\n", CALIB).unwrap_err();
+    assert!(empty.contains("camera.calibration: is empty"), "{empty}");
+    for e in [skewed, missing, long, far, empty] {
         assert!(!e.contains('\n'), "{e}");
     }
 }
