@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 use tactex_core::devices::DeviceError;
 use tactex_core::geometry::{CameraIntrinsics, Pose};
 use tactex_core::glam::DVec3;
-use tactex_core::hand_eye::calibration_file::{CAMERA_REACH_M, load_camera_in_base};
+use tactex_core::hand_eye::calibration_file::{PLACEMENT_LIMIT_M, load_camera_in_base};
 
 #[derive(Debug, thiserror::Error)]
 pub enum DevicesError {
@@ -117,20 +117,22 @@ impl DevicesConfig {
         if let Some(w) = config.arm.workspace_mm {
             WorkspaceBox::from_bounds_mm(w).map_err(|e| field("arm.workspace_mm", &e))?;
         }
-        if config.arm.base_in_world_m.iter().any(|v| !v.is_finite()) {
-            return Err(field("arm.base_in_world_m", "must be finite"));
-        }
-        if config
-            .arm
-            .base_in_world_m
-            .iter()
-            .any(|v| v.abs() > CAMERA_REACH_M)
-        {
-            return Err(field(
-                "arm.base_in_world_m",
-                &format!("must be within {CAMERA_REACH_M} m of the world's origin on each axis"),
-            ));
-        }
+        // A place in the world: finite and within the limit a table-top rig stands in.
+        let placed = |name: &str, at: &[f64; 3]| {
+            if !at.iter().all(|v| v.is_finite()) {
+                return Err(field(name, "must be finite"));
+            }
+            if at.iter().any(|v| v.abs() > PLACEMENT_LIMIT_M) {
+                return Err(field(
+                    name,
+                    &format!(
+                        "must be within {PLACEMENT_LIMIT_M} m of the world's origin on each axis"
+                    ),
+                ));
+            }
+            Ok(())
+        };
+        placed("arm.base_in_world_m", &config.arm.base_in_world_m)?;
         let c = &config.camera;
         config.camera_in_world = match (&c.calibration, c.position_m, c.look_at_m) {
             (Some(file), None, None) => {
@@ -156,17 +158,8 @@ impl DevicesConfig {
                 ));
             }
             (None, Some(at), Some(look_at)) => {
-                if !at.iter().chain(&look_at).all(|v| v.is_finite()) {
-                    return Err(field("camera.position_m", "must be finite"));
-                }
-                if at.iter().chain(&look_at).any(|v| v.abs() > CAMERA_REACH_M) {
-                    return Err(field(
-                        "camera.position_m",
-                        &format!(
-                            "and camera.look_at_m must be within {CAMERA_REACH_M} m of the world's origin on each axis"
-                        ),
-                    ));
-                }
+                placed("camera.position_m", &at)?;
+                placed("camera.look_at_m", &look_at)?;
                 Pose::camera_looking_at(DVec3::from_array(at), DVec3::from_array(look_at))
                     .ok_or_else(|| {
                         field("camera.look_at_m", "must differ from camera.position_m")

@@ -164,11 +164,13 @@ pub fn answer(args: &AskRequest) -> Result<Answer> {
                 "--camera-calibration: only with --backend sim (on --backend hw give it in devices.toml: [camera] calibration = \"FILE\")"
             );
         }
-        if rig.camera_error_mm != 0.0 {
-            bail!("--camera-error-mm: only with --backend sim (the twin's camera rig)");
-        }
-        if rig.camera_error_deg != 0.0 {
-            bail!("--camera-error-deg: only with --backend sim (the twin's camera rig)");
+        for (flag, error) in [
+            ("--camera-error-mm", rig.camera_error_mm),
+            ("--camera-error-deg", rig.camera_error_deg),
+        ] {
+            if error != 0.0 {
+                bail!("{flag}: only with --backend sim (the twin's camera rig)");
+            }
         }
     }
     let answer = match args.backend {

@@ -23,9 +23,10 @@ pub struct CameraInBase {
     pub rotation_xyzw: [f64; 4],
 }
 
-/// How far from the arm's base a calibrated camera may stand (m): a table-top robot's camera
-/// is within a metre or two; past this a number is a mistake (or overflows the world pose).
-pub const CAMERA_REACH_M: f64 = 10.0;
+/// How far a table-top rig's camera may stand from the arm's base, or the base from the
+/// world's origin, on each axis (m): a metre or two in practice; past this a number is a
+/// mistake (or overflows the world pose).
+pub const PLACEMENT_LIMIT_M: f64 = 10.0;
 
 impl CameraInBase {
     /// The section for `pose`, to nine decimals (a nanometre; a rotation to 1e-9), so the file
@@ -43,10 +44,10 @@ impl CameraInBase {
         if !self.position_m.iter().all(|v| v.is_finite()) {
             return Err(("camera.position_m", "must be finite".into()));
         }
-        if self.position_m.iter().any(|v| v.abs() > CAMERA_REACH_M) {
+        if self.position_m.iter().any(|v| v.abs() > PLACEMENT_LIMIT_M) {
             return Err((
                 "camera.position_m",
-                format!("must be within {CAMERA_REACH_M} m of the arm's base on each axis"),
+                format!("must be within {PLACEMENT_LIMIT_M} m of the arm's base on each axis"),
             ));
         }
         let q = DQuat::from_array(self.rotation_xyzw);
