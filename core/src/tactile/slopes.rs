@@ -160,7 +160,8 @@ pub fn recover_slopes(
 /// drift removed; a first reading at half the resolution (the glow's linear part inverted,
 /// the table read backwards, integrated) places the imprint, so the drift is measured again
 /// away from it, and gives the indentation the glow's other terms are computed from; those
-/// terms subtracted, the change is read at full resolution.
+/// terms subtracted, the change is read at full resolution, with what the glow's linear part
+/// leaves undetermined taken from the first reading's change.
 fn read_through_glow(
     table: &ShadingTable,
     glow: &GelGlow,
@@ -200,13 +201,19 @@ fn read_through_glow(
             .collect(),
         None => observed,
     };
-    read_table(table, &inverse.solve(&linear), field);
+    read_table(
+        table,
+        &inverse.solve_toward(&linear, &first_reading.change),
+        field,
+    );
 }
 
-/// The reading's first pass, on every pixel of the frame: its indentation (mm) and the
-/// glow's terms beyond the linear ones (None when the glow has none).
+/// The reading's first pass, on every pixel of the frame: its indentation (mm), the table's
+/// change of its slopes (the prior of what the glow leaves undetermined), and the glow's
+/// terms beyond the linear ones (None when the glow has none).
 struct FirstReading {
     indentation_mm: Vec<f32>,
+    change: Vec<[f32; 3]>,
     rest: Option<Vec<[f32; 3]>>,
 }
 
@@ -231,16 +238,20 @@ impl FirstReading {
             .into_iter()
             .map(|d| d as f32)
             .collect();
-        let rest = inverse.has_rest().then(|| {
-            let rest = inverse.rest(&modelled_change(table, &field), &depth);
+        let up = |image: &[[f32; 3]]| -> Vec<[f32; 3]> {
             let channels: [Vec<f64>; 3] =
-                std::array::from_fn(|c| half.up(&rest.iter().map(|r| r[c]).collect::<Vec<_>>()));
+                std::array::from_fn(|c| half.up(&image.iter().map(|r| r[c]).collect::<Vec<_>>()));
             (0..half.width * half.height)
                 .map(|i| std::array::from_fn(|c| channels[c][i] as f32))
                 .collect()
-        });
+        };
+        let change = modelled_change(table, &field);
+        let rest = inverse
+            .has_rest()
+            .then(|| up(&inverse.rest(&change, &depth)));
         Self {
             indentation_mm: half.up(&depth).into_iter().map(|d| d as f32).collect(),
+            change: up(&change),
             rest,
         }
     }
@@ -257,11 +268,11 @@ impl FirstReading {
             .into_iter()
             .map(|d| d as f32)
             .collect();
-        let rest = inverse
-            .has_rest()
-            .then(|| inverse.rest(&modelled_change(table, field), &depth));
+        let change = modelled_change(table, field);
+        let rest = inverse.has_rest().then(|| inverse.rest(&change, &depth));
         Self {
             indentation_mm: depth,
+            change,
             rest,
         }
     }
