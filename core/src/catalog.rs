@@ -116,7 +116,7 @@ impl FruitCatalog {
 
     pub fn load(path: &Path) -> Result<Self, CatalogError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| CatalogError::Read {
+        let text = crate::text_file::read_to_string(path).map_err(|e| CatalogError::Read {
             path: shown.clone(),
             message: e.to_string(),
         })?;

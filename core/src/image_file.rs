@@ -31,6 +31,7 @@ fn say(e: image::ImageError) -> String {
 /// The image at `path`, its format from its contents. The error is the reason alone; the
 /// caller names the file and what it was for.
 pub fn open(path: &Path) -> Result<DynamicImage, String> {
+    crate::text_file::regular(path).map_err(|e| e.to_string())?;
     let mut reader = ImageReader::open(path)
         .map_err(|e| e.to_string())?
         .with_guessed_format()

@@ -37,6 +37,7 @@ pub mod serde_exact;
 pub mod spectral;
 pub mod stats;
 pub mod tactile;
+pub mod text_file;
 
 pub use glam;
 pub use image;

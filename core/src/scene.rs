@@ -209,7 +209,7 @@ impl Scene {
 
     pub fn load(path: &Path, catalog: &FruitCatalog) -> Result<Scene, SceneError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        let text = crate::text_file::read_to_string(path).map_err(|e| SceneError {
             path: shown.clone(),
             field: "file".into(),
             message: format!("cannot read scene: {e}"),

@@ -94,10 +94,11 @@ fn unset_pose() -> Pose {
 impl DevicesConfig {
     /// Reads and checks the file; every problem names the file and the field.
     pub fn load(path: &Path) -> Result<DevicesConfig, DevicesError> {
-        let text = std::fs::read_to_string(path).map_err(|e| DevicesError::File {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        let text =
+            tactex_core::text_file::read_to_string(path).map_err(|e| DevicesError::File {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })?;
         let mut config: DevicesConfig = toml::from_str(&text).map_err(|e| DevicesError::File {
             path: path.to_path_buf(),
             message: tactex_core::file_failure::toml_failure(&text, &e),

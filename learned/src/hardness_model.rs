@@ -98,17 +98,20 @@ impl OnnxEstimator {
     /// The model at `path` with its card beside it (`card_path`).
     pub fn load(path: &Path) -> Result<Self, OnnxError> {
         let card_file = card_path(path);
-        let card = std::fs::read_to_string(&card_file).map_err(|e| OnnxError::Model {
-            path: card_file.display().to_string(),
-            reason: format!(
-                "cannot read the model card that must sit beside {}: {e}",
-                path.display()
-            ),
-        })?;
-        let bytes = std::fs::read(path).map_err(|e| OnnxError::Model {
-            path: path.display().to_string(),
-            reason: format!("cannot read: {e}"),
-        })?;
+        let card =
+            tactex_core::text_file::read_to_string(&card_file).map_err(|e| OnnxError::Model {
+                path: card_file.display().to_string(),
+                reason: format!(
+                    "cannot read the model card that must sit beside {}: {e}",
+                    path.display()
+                ),
+            })?;
+        let bytes =
+            tactex_core::text_file::read_bytes(path, tactex_core::text_file::MAX_MODEL_BYTES)
+                .map_err(|e| OnnxError::Model {
+                    path: path.display().to_string(),
+                    reason: format!("cannot read: {e}"),
+                })?;
         Self::from_bytes(
             &path.display().to_string(),
             &bytes,

@@ -33,7 +33,8 @@ impl DetectorChoice {
             }
             let path = std::path::Path::new(file);
             // A model that is not there is missing, not a model that cannot be read.
-            crate::app::file_input::present(path, "no such model file").context("--detector")?;
+            crate::app::file_input::present(path, "cannot read model file")
+                .context("--detector")?;
             return Ok(Self::Yolo(Box::new(YoloSegDetector::load(path)?)));
         }
         if spec == "classical" {

@@ -161,10 +161,10 @@ impl EstimatorChoice {
             Self::Named(e) => (e.open)()?,
             Self::Model(path) => {
                 // A model that is not there is missing, not a model that cannot be read.
-                crate::app::file_input::present(path, "no such model file")
+                crate::app::file_input::present(path, "cannot read model file")
                     .with_context(|| flag.to_string())?;
                 if !path.is_file() {
-                    bail!("{flag} {}: no such model file", path.display());
+                    bail!("{flag} {}: not a model file (a folder)", path.display());
                 }
                 Box::new(tactex_learned::builtin::from_file(flag, path)?)
             }
@@ -218,7 +218,7 @@ impl EstimatorChoice {
         estimator: &str,
         sensor: &ProfileId,
     ) -> Result<IntervalCalibration> {
-        let text = std::fs::read_to_string(path)
+        let text = tactex_core::text_file::read_to_string(path)
             .with_context(|| format!("{what} {}: cannot read", path.display()))?;
         let c = IntervalCalibration::parse(&text, &format!("{what} {}", path.display()))?;
         if c.estimator != estimator {

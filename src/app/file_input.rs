@@ -5,11 +5,12 @@
 use anyhow::Result;
 use std::path::Path;
 
-/// Ok when `path` can be looked up; else its I/O error under "PATH: READING" (READING may
+/// Ok when `path` can be looked up and is a file or folder (not a FIFO or device, which
+/// would block or never end); else its I/O error under "PATH: READING" (READING may
 /// be empty), as in "scene.toml: file: cannot read scene: No such file or directory".
 pub fn present(path: &Path, reading: &str) -> Result<()> {
-    match std::fs::metadata(path) {
-        Ok(_) => Ok(()),
+    match tactex_core::text_file::regular(path) {
+        Ok(()) => Ok(()),
         Err(e) if reading.is_empty() => {
             Err(anyhow::Error::new(e).context(path.display().to_string()))
         }

@@ -155,9 +155,10 @@ impl<'a> Twin<'a> {
             fidelity: Some(self.fidelity),
             sensor: Some(self.sensor.id()),
         };
-        let scene_toml = std::fs::read_to_string(&self.scene.path).with_context(|| {
-            format!("{}: cannot read the scene again", self.scene.path.display())
-        })?;
+        let scene_toml =
+            tactex_core::text_file::read_to_string(&self.scene.path).with_context(|| {
+                format!("{}: cannot read the scene again", self.scene.path.display())
+            })?;
         let scene_path = std::path::absolute(&self.scene.path).unwrap_or(self.scene.path.clone());
         question.ask(
             devices,

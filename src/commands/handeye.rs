@@ -85,7 +85,7 @@ fn load_board(path: &Option<PathBuf>) -> Result<CharucoBoard> {
         return Ok(CharucoBoard::default());
     };
     crate::app::file_input::present(path, "file: cannot read board")?;
-    let text = std::fs::read_to_string(path)
+    let text = tactex_core::text_file::read_to_string(path)
         .with_context(|| format!("{}: cannot read board", path.display()))?;
     let board: CharucoBoard = toml::from_str(&text).map_err(|e| {
         anyhow::anyhow!(

@@ -58,7 +58,7 @@ struct Miss {
 const MAX_MARKERS: usize = 10_000;
 
 fn read_marker_annotations(path: &std::path::Path) -> Result<Vec<(f64, f64)>> {
-    let text = std::fs::read_to_string(path)
+    let text = tactex_core::text_file::read_to_string(path)
         .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
     let mut out = Vec::new();
     // Where each marker was first listed (its coordinates' bits -> file line).

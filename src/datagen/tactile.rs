@@ -225,7 +225,7 @@ fn prepare_dir(dir: &Path, info: &DatasetInfo) -> Result<()> {
         .with_context(|| format!("--out {}: cannot create", dir.display()))?;
     let path = dir.join("dataset.json");
     if path.exists() {
-        let text = std::fs::read_to_string(&path)
+        let text = tactex_core::text_file::read_to_string(&path)
             .with_context(|| format!("{}: cannot read", path.display()))?;
         let old: serde_json::Value = serde_json::from_str(&text)
             .with_context(|| format!("{}: not valid JSON", path.display()))?;

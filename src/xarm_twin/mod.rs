@@ -144,7 +144,7 @@ pub(crate) fn run(args: &TwinArgs) -> Result<()> {
                 (w.tool, w.time_s)
             };
             recorder.start_arm("twin-xarm-850", pad, Some(time_s));
-            let scene_toml = std::fs::read_to_string(&path)
+            let scene_toml = tactex_core::text_file::read_to_string(&path)
                 .with_context(|| format!("{}: cannot read the scene again", path.display()))?;
             recorder.twin(TwinRecord {
                 scene_toml,

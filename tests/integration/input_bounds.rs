@@ -231,3 +231,34 @@ fn an_object_far_smaller_than_a_pixel_is_pressed_with_its_fields_pooled_not_out_
         assert!(out_dir.join("tactile.png").exists());
     }
 }
+
+#[test]
+fn a_fifo_or_device_given_as_an_input_file_is_refused_not_waited_on() {
+    // A FIFO blocks its reader until a writer comes, and /dev/zero never ends: each was a
+    // hang (or all the memory) where a file was expected.
+    let tmp = tempfile::tempdir().unwrap();
+    let fifo = tmp.path().join("scene.toml");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let fifo = fifo.to_str().unwrap();
+    let ask = |flag: &str, path: &str| {
+        one_line_error(&tactex(&["ask", "Which fruit is the softest?", flag, path]))
+    };
+    for (flag, path) in [
+        ("--scene", fifo),
+        ("--scene", "/dev/zero"),
+        ("--sensor", "/dev/zero"),
+        ("--camera-calibration", fifo),
+    ] {
+        let err = ask(flag, path);
+        assert!(
+            err.contains(path) && err.contains("not a regular file"),
+            "{flag} {path}: {err}"
+        );
+    }
+    let err = one_line_error(&tactex(&["read", "/dev/zero"]));
+    assert!(err.contains("not a regular file"), "{err}");
+}

@@ -88,10 +88,11 @@ struct Sections {
 
 /// The camera's pose in the arm's base frame from a calibration file.
 pub fn load_camera_in_base(path: &Path) -> Result<Pose, CalibrationFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CalibrationFileError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text =
+        crate::text_file::read_to_string(path).map_err(|source| CalibrationFileError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
     camera_in_base_of_text(&text, path)
 }
 

@@ -39,7 +39,7 @@ pub const MAX_PRESSES: usize = 1000;
 
 pub fn read_annotations(path: &Path) -> Result<Vec<BallPress>, AnnotationError> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| AnnotationError::Read {
+    let text = crate::text_file::read_to_string(path).map_err(|e| AnnotationError::Read {
         path: shown.clone(),
         message: e.to_string(),
     })?;

@@ -215,7 +215,7 @@ impl SensorProfile {
     /// and the field.
     pub fn load(path: &Path) -> Result<Self, ProfileError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ProfileError {
+        let text = crate::text_file::read_to_string(path).map_err(|e| ProfileError {
             file: file.clone(),
             field: "file".into(),
             message: format!("cannot read: {e}"),

@@ -34,7 +34,8 @@ pub fn open_session(
         });
     }
     let path = dir.join(MANIFEST);
-    let text = std::fs::read_to_string(&path).map_err(|e| SessionError::file(&path, e))?;
+    let text =
+        tactex_core::text_file::read_to_string(&path).map_err(|e| SessionError::file(&path, e))?;
     let manifest: Manifest = serde_json::from_str(&text).map_err(|e| {
         SessionError::file(&path, tactex_core::file_failure::json_failure(&text, &e))
     })?;
