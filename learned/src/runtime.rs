@@ -34,6 +34,16 @@ pub enum OnnxError {
     Model { path: String, reason: String },
 }
 
+/// The bytes of the ONNX file at `path`: a regular file within `MAX_MODEL_BYTES`.
+pub fn read_model_file(path: &Path) -> Result<Vec<u8>, OnnxError> {
+    tactex_core::text_file::read_bytes(path, tactex_core::text_file::MAX_MODEL_BYTES).map_err(|e| {
+        OnnxError::Model {
+            path: path.display().to_string(),
+            reason: format!("cannot read: {e}"),
+        }
+    })
+}
+
 struct Runtime {
     backend: OnnxBackend,
     environment: ort::environment::Environment,

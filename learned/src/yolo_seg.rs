@@ -260,12 +260,7 @@ pub struct YoloSegDetector {
 impl YoloSegDetector {
     /// An Ultralytics YOLOv8-seg ONNX export; class names from its `names` metadata.
     pub fn load(path: &Path) -> Result<Self, OnnxError> {
-        let bytes =
-            tactex_core::text_file::read_bytes(path, tactex_core::text_file::MAX_MODEL_BYTES)
-                .map_err(|e| OnnxError::Model {
-                    path: path.display().to_string(),
-                    reason: format!("cannot read: {e}"),
-                })?;
+        let bytes = crate::runtime::read_model_file(path)?;
         Self::from_bytes(&path.display().to_string(), &bytes)
     }
 
