@@ -484,11 +484,14 @@ impl Scene {
                                 format!("'{}' is a directory, not a mesh file", path.display()),
                             ));
                         }
-                        if !path.is_file() {
+                        if !path.exists() {
                             return Err(err(
                                 &field("mesh"),
                                 format!("mesh file '{}' not found", path.display()),
                             ));
+                        }
+                        if let Err(e) = crate::text_file::regular(&path) {
+                            return Err(err(&field("mesh"), format!("'{}': {e}", path.display())));
                         }
                         ObjectKind::Mesh {
                             path,

@@ -4,6 +4,7 @@ use glam::{DQuat, DVec3};
 use std::f64::consts::PI;
 use std::path::Path;
 use tactex_core::catalog::FruitShape;
+use tactex_core::text_file;
 
 #[derive(Clone, Debug, Default)]
 pub struct TriMesh {
@@ -405,25 +406,88 @@ pub fn blob(size: DVec3, lobes: &[Lobe], detail: usize) -> TriMesh {
 pub const MAX_MESH_BYTES: u64 = 256 << 20;
 pub const MAX_TRIANGLES: usize = 2_000_000;
 
-/// Why a glTF did not import, naming the buffer file when that is what is missing (the
-/// importer's own message names neither).
-fn gltf_failure(path: &Path, e: gltf::Error) -> String {
-    if let Ok(doc) = gltf::Gltf::open(path) {
-        let dir = path.parent().unwrap_or(Path::new("."));
-        for buffer in doc.buffers() {
-            if let gltf::buffer::Source::Uri(uri) = buffer.source()
-                && !uri.starts_with("data:")
-                && !dir.join(uri).is_file()
-            {
-                return format!(
-                    "buffer {} file '{}' not found",
-                    buffer.index(),
-                    dir.join(uri).display()
-                );
+/// The path a glTF buffer URI names: relative to the glTF's folder (percent-encoded, as the
+/// glTF spec writes it) or `file:`; other schemes are refused.
+fn gltf_buffer_path(dir: &Path, uri: &str) -> Result<std::path::PathBuf, String> {
+    if uri.contains(':') {
+        let rest = uri
+            .strip_prefix("file://")
+            .or_else(|| uri.strip_prefix("file:"))
+            .ok_or_else(|| format!("buffer URI '{uri}' has a scheme other than file: or data:"))?;
+        return Ok(std::path::PathBuf::from(rest));
+    }
+    let raw = uri.as_bytes();
+    let mut bytes = Vec::with_capacity(raw.len());
+    let mut i = 0;
+    while i < raw.len() {
+        let hex = raw
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
+        match (raw[i], hex) {
+            (b'%', Some(b)) => {
+                bytes.push(b);
+                i += 3;
+            }
+            (c, _) => {
+                bytes.push(c);
+                i += 1;
             }
         }
     }
-    e.to_string()
+    let decoded = String::from_utf8(bytes)
+        .map_err(|_| format!("buffer URI '{uri}' is not UTF-8 once percent-decoded"))?;
+    Ok(dir.join(decoded))
+}
+
+/// The data of every buffer of a glTF, its external files read with the same bound as the
+/// mesh file itself (the importer's own reader would wait on a FIFO and read a device whole).
+fn gltf_buffers(
+    doc: &gltf::Document,
+    dir: &Path,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<gltf::buffer::Data>, String> {
+    let mut buffers = Vec::new();
+    for buffer in doc.buffers() {
+        let mut data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                format!(
+                    "buffer {} is the GLB chunk, which is missing",
+                    buffer.index()
+                )
+            })?,
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                gltf::buffer::Data::from_source(buffer.source(), None)
+                    .map_err(|e| format!("buffer {}: {e}", buffer.index()))?
+                    .0
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                let file = gltf_buffer_path(dir, uri)?;
+                text_file::read_bytes(&file, MAX_MESH_BYTES).map_err(|e| match e.kind() {
+                    std::io::ErrorKind::NotFound => {
+                        format!(
+                            "buffer {} file '{}' not found",
+                            buffer.index(),
+                            file.display()
+                        )
+                    }
+                    _ => format!("buffer {} file '{}': {e}", buffer.index(), file.display()),
+                })?
+            }
+        };
+        if data.len() < buffer.length() {
+            return Err(format!(
+                "buffer {} has {} bytes, the glTF says {}",
+                buffer.index(),
+                data.len(),
+                buffer.length()
+            ));
+        }
+        // Accessors read whole 4-byte words.
+        data.resize(data.len().next_multiple_of(4), 0);
+        buffers.push(gltf::buffer::Data(data));
+    }
+    Ok(buffers)
 }
 
 pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
@@ -437,19 +501,21 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
         path: shown.clone(),
         message,
     };
-    let bytes = std::fs::metadata(path)
-        .map_err(|source| MeshError::Io {
-            path: shown.clone(),
-            source,
-        })?
-        .len();
-    if bytes > MAX_MESH_BYTES {
-        return Err(read_err(format!(
-            "{} MB, over the {} MB a mesh file may have",
-            bytes >> 20,
-            MAX_MESH_BYTES >> 20
-        )));
+    if !matches!(ext.as_str(), "obj" | "gltf" | "glb") {
+        return Err(MeshError::Format { path: shown });
     }
+    // One bounded read: a FIFO or a device is refused, an oversize file is not read whole.
+    let bytes =
+        text_file::read_bytes(path, MAX_MESH_BYTES).map_err(|source| match source.kind() {
+            std::io::ErrorKind::InvalidData => read_err(format!(
+                "over the {} MB a mesh file may have",
+                MAX_MESH_BYTES >> 20
+            )),
+            _ => MeshError::Io {
+                path: shown.clone(),
+                source,
+            },
+        })?;
     let mesh = match ext.as_str() {
         "obj" => {
             let opts = tobj::LoadOptions {
@@ -457,7 +523,11 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
                 single_index: true,
                 ..Default::default()
             };
-            let (models, _) = tobj::load_obj(path, &opts).map_err(|e| read_err(e.to_string()))?;
+            // Materials are not simulated: an `mtllib` is never opened.
+            let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &opts, |_| {
+                Err(tobj::LoadError::OpenFileFailed)
+            })
+            .map_err(|e| read_err(e.to_string()))?;
             let mut m = TriMesh::default();
             for model in models {
                 let base = m.vertices.len() as u32;
@@ -479,8 +549,12 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
             m
         }
         "gltf" | "glb" => {
-            let (doc, buffers, _) =
-                gltf::import(path).map_err(|e| read_err(gltf_failure(path, e)))?;
+            let gltf::Gltf {
+                document: doc,
+                blob,
+            } = gltf::Gltf::from_slice(&bytes).map_err(|e| read_err(e.to_string()))?;
+            let dir = path.parent().unwrap_or(Path::new("."));
+            let buffers = gltf_buffers(&doc, dir, blob).map_err(read_err)?;
             let mut m = TriMesh::default();
             let scene = doc
                 .default_scene()
@@ -631,5 +705,70 @@ mod tests {
         let closed = dir.path().join("closed.obj");
         std::fs::write(&closed, format!("{cube}f 5 6 8\nf 5 8 7\n")).unwrap();
         assert!(load(&closed).is_ok());
+    }
+
+    /// A closed tetrahedron, 5 cm across, as a glTF naming its one buffer by `uri`.
+    fn tetra_gltf(uri: &str) -> (String, Vec<u8>) {
+        let v: [[f32; 3]; 4] = [
+            [0.0; 3],
+            [0.05, 0.0, 0.0],
+            [0.0, 0.05, 0.0],
+            [0.0, 0.0, 0.05],
+        ];
+        let idx: [u16; 12] = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
+        let mut bin: Vec<u8> = v.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+        bin.extend(idx.iter().flat_map(|i| i.to_le_bytes()));
+        let json = format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+"buffers":[{{"byteLength":72,"uri":"{uri}"}}],
+"bufferViews":[{{"buffer":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":24}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","max":[0.05,0.05,0.05],"min":[0,0,0]}},
+{{"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}}]}}"#
+        );
+        (json, bin)
+    }
+
+    #[test]
+    fn a_mesh_or_the_files_it_names_being_a_device_is_refused_not_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path();
+        // A mesh that is a device: refused before it is read (it would never end).
+        let zero = p.join("zero.obj");
+        std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+        let e = load(&zero).unwrap_err().to_string();
+        assert!(
+            e.contains("zero.obj") && e.contains("not a regular file"),
+            "{e}"
+        );
+        // An OBJ's material library is never opened: a device there does not block the mesh.
+        let tet =
+            "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nv 0 0 0.05\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+        let with_mtl = p.join("with-mtl.obj");
+        std::fs::write(&with_mtl, format!("mtllib /dev/zero\n{tet}")).unwrap();
+        assert_eq!(load(&with_mtl).unwrap().triangles.len(), 4);
+        // A glTF's buffer: percent-encoded names are read, a device behind file: is refused.
+        let (json, bin) = tetra_gltf("tetra%20mesh.bin");
+        std::fs::write(p.join("tetra mesh.bin"), &bin).unwrap();
+        std::fs::write(p.join("t.gltf"), json).unwrap();
+        assert_eq!(load(&p.join("t.gltf")).unwrap().triangles.len(), 4);
+        let (json, _) = tetra_gltf("file:///dev/zero");
+        std::fs::write(p.join("z.gltf"), json).unwrap();
+        let e = load(&p.join("z.gltf")).unwrap_err().to_string();
+        assert!(
+            e.contains("z.gltf") && e.contains("/dev/zero") && e.contains("not a regular file"),
+            "{e}"
+        );
+        // A name that is not UTF-8 once decoded is an error, not a panic.
+        let (json, _) = tetra_gltf("%FF.bin");
+        std::fs::write(p.join("bad-uri.gltf"), json).unwrap();
+        let e = load(&p.join("bad-uri.gltf")).unwrap_err().to_string();
+        assert!(e.contains("not UTF-8"), "{e}");
+        // A buffer shorter than the glTF says is named for it.
+        let (json, _) = tetra_gltf("short.bin");
+        std::fs::write(p.join("short.bin"), &bin[..40]).unwrap();
+        std::fs::write(p.join("short.gltf"), json).unwrap();
+        let e = load(&p.join("short.gltf")).unwrap_err().to_string();
+        assert!(e.contains("buffer 0 has 40 bytes, the glTF says 72"), "{e}");
     }
 }

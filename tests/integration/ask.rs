@@ -1055,6 +1055,7 @@ fn a_mesh_that_cannot_be_simulated_is_refused_for_what_is_wrong_with_it() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path();
     std::fs::create_dir(p.join("meshdir")).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", p.join("zero.obj")).unwrap();
     std::fs::write(
         p.join("tri.obj"),
         "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nf 1 2 3\n",
@@ -1071,6 +1072,7 @@ fn a_mesh_that_cannot_be_simulated_is_refused_for_what_is_wrong_with_it() {
     .unwrap();
     for (mesh, says) in [
         ("meshdir", "is a directory, not a mesh file"),
+        ("zero.obj", "not a regular file (a FIFO, device or socket)"),
         ("tri.obj", "1 triangles on 3 vertices"),
         ("m.gltf", "buffer 0 file"),
     ] {

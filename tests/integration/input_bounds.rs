@@ -261,4 +261,29 @@ fn a_fifo_or_device_given_as_an_input_file_is_refused_not_waited_on() {
     }
     let err = one_line_error(&tactex(&["read", "/dev/zero"]));
     assert!(err.contains("not a regular file"), "{err}");
+    // A mesh given straight to `press`: refused as a FIFO, not opened (which would block).
+    let mesh = tmp.path().join("fruit.obj");
+    assert!(
+        std::process::Command::new("mkfifo")
+            .arg(&mesh)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let mesh = mesh.to_str().unwrap();
+    let err = one_line_error(&tactex(&[
+        "press",
+        "--shape",
+        "mesh",
+        "--mesh",
+        mesh,
+        "--hardness",
+        "30A",
+        "--depth-mm",
+        "1",
+    ]));
+    assert!(
+        err.contains(mesh) && err.contains("not a regular file"),
+        "{err}"
+    );
 }
