@@ -28,6 +28,18 @@ fn say(e: image::ImageError) -> String {
     }
 }
 
+/// The width and height the image at `path` declares, read from its header alone (a file
+/// that is not an image in a known format fails here, before anything waits on it).
+pub fn dimensions(path: &Path) -> Result<(u32, u32), String> {
+    crate::text_file::regular(path).map_err(|e| e.to_string())?;
+    ImageReader::open(path)
+        .map_err(|e| e.to_string())?
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?
+        .into_dimensions()
+        .map_err(say)
+}
+
 /// The image at `path`, its format from its contents. The error is the reason alone; the
 /// caller names the file and what it was for.
 pub fn open(path: &Path) -> Result<DynamicImage, String> {

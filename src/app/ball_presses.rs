@@ -67,7 +67,6 @@ pub fn load(
             annotations.display()
         );
     }
-    super::file_input::present(images, "")?;
     if !images.is_dir() {
         bail!(
             "--images {}: not a directory; give the folder the annotations' images are in",

@@ -151,6 +151,25 @@ fn broken_or_missing_sessions_and_misused_flags_are_one_line_errors() {
     let stderr = one_line_error(&replay(&dir, p));
     assert!(stderr.contains("tactile/0003.png"), "{stderr}");
     assert!(stderr.contains("missing"), "{stderr}");
+    // A frame that is not an image, or not the sensor's size, is named before the replay
+    // starts (found halfway, it showed as the arm diverging from the recording).
+    std::fs::write(dir.join("tactile/0003.png"), "not a png").unwrap();
+    let stderr = one_line_error(&replay(&dir, p));
+    assert!(
+        stderr.contains("tactile/0003.png: not a readable frame") && !stderr.contains("diverged"),
+        "{stderr}"
+    );
+    image::RgbImage::new(8, 6)
+        .save(dir.join("tactile/0003.png"))
+        .unwrap();
+    let stderr = one_line_error(&replay(&dir, p));
+    assert!(
+        stderr.contains("tactile/0003.png: 8x6 px, the sensor gives"),
+        "{stderr}"
+    );
+    // A file given where the session folder belongs says so.
+    let stderr = one_line_error(&replay(&manifest, p));
+    assert!(stderr.contains("not a folder"), "{stderr}");
 
     let out = tactex(&["ask", "--backend", "replay", p]);
     assert!(one_line_error(&out).contains("--session"));

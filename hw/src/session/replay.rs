@@ -25,6 +25,8 @@ pub fn open_session(
     if !dir.is_dir() {
         let why = if partial_dir(dir).is_dir() {
             "no such session (a .partial recording beside it did not finish)"
+        } else if dir.exists() {
+            "not a folder; a session is the folder `ask --record` wrote"
         } else {
             "no such session directory"
         };
@@ -61,13 +63,23 @@ pub fn open_session(
             "must be a positive number".into(),
         ));
     }
+    let k = &manifest.camera.intrinsics;
+    let spec = &manifest.tactile.spec;
+    // Every frame with the size its device gives: (file, size, what says so).
     let files = manifest
         .camera
         .frames
         .iter()
         .flat_map(|f| [&f.color, &f.depth])
-        .chain(manifest.tactile.frames.iter().map(|f| &f.image));
-    for file in files {
+        .map(|file| (file, (k.width, k.height), "the intrinsics say"))
+        .chain(manifest.tactile.frames.iter().map(|f| {
+            (
+                &f.image,
+                (spec.width_px, spec.height_px),
+                "the sensor gives",
+            )
+        }));
+    for (file, size, says) in files {
         let p = dir.join(file);
         let outside = Path::new(file).is_absolute()
             || Path::new(file)
@@ -85,8 +97,25 @@ pub fn open_session(
                 ),
             });
         }
-        if !p.is_file() {
+        if !p.exists() {
             return Err(SessionError::file(&p, "listed in the manifest but missing"));
+        }
+        tactex_core::text_file::regular(&p).map_err(|e| SessionError::file(&p, e))?;
+        if p.is_dir() {
+            return Err(SessionError::file(
+                &p,
+                "a folder, where the manifest lists a frame",
+            ));
+        }
+        // Checked before the replay starts: a frame found bad halfway would end that press
+        // and show as the arm diverging from the recording, not as the frame it is.
+        let found = tactex_core::image_file::dimensions(&p)
+            .map_err(|e| SessionError::file(&p, format!("not a readable frame: {e}")))?;
+        if found != size {
+            return Err(SessionError::file(
+                &p,
+                format!("{}x{} px, {says} {}x{}", found.0, found.1, size.0, size.1),
+            ));
         }
     }
     let name = |device: &str| format!("replay {device} ({})", dir.display());
@@ -189,23 +218,9 @@ impl RgbdCamera for ReplayCamera {
             tactex_core::image_file::open(&path)
                 .map_err(|e| failure(&self.name, format!("{}: {e}", path.display())))
         };
+        // Their sizes were checked against the intrinsics when the session was opened.
         let color = read(&f.color)?.to_rgb8();
         let depth = read(&f.depth)?.to_luma16();
-        let k = &self.record.intrinsics;
-        for (file, size) in [
-            (&f.color, color.dimensions()),
-            (&f.depth, depth.dimensions()),
-        ] {
-            if size != (k.width, k.height) {
-                return Err(failure(
-                    &self.name,
-                    format!(
-                        "{file}: {}x{} px, the intrinsics say {}x{}",
-                        size.0, size.1, k.width, k.height
-                    ),
-                ));
-            }
-        }
         self.clock.set(Some(f.timestamp_s));
         Ok(RgbdFrame {
             color,
@@ -243,20 +258,7 @@ impl TactileSensor for ReplayTactile {
         let image = tactex_core::image_file::open(&path)
             .map_err(|e| failure(&self.name, format!("{}: {e}", path.display())))?
             .to_rgb8();
-        let spec = &self.record.spec;
-        if image.dimensions() != (spec.width_px, spec.height_px) {
-            return Err(failure(
-                &self.name,
-                format!(
-                    "{}: {}x{} px, the sensor gives {}x{}",
-                    f.image,
-                    image.width(),
-                    image.height(),
-                    spec.width_px,
-                    spec.height_px
-                ),
-            ));
-        }
+        // Its size was checked against the sensor when the session was opened.
         self.clock.set(Some(f.timestamp_s));
         Ok(TactileFrame {
             image,
