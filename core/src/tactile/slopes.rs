@@ -206,6 +206,49 @@ fn read_through_glow(
         &inverse.solve_toward(&linear, &first_reading.change),
         field,
     );
+    take_out_tilt(field, depth, peak);
+}
+
+/// The drift is measured over gel the contact's glow and rise still reach, so round a wide
+/// contact it is off by a few grey levels, which the table reads as a tilt of the whole gel:
+/// a mango-like press through R1.5 read 4x deep. The gel's true ends are level along a row
+/// (column) whose two ends the first reading calls untouched, whatever the contact does in
+/// between, so the median of those lines' mean slope is that tilt, taken out; a contact
+/// that runs off a side leaves its lines out. Fewer than a quarter of the lines: none taken.
+fn take_out_tilt(field: &mut SlopeField, first_mm: &[f32], peak_mm: f32) {
+    let (w, h) = (field.width, field.height);
+    let untouched = |i: usize| first_mm[i] < UNTOUCHED_SHARE * peak_mm;
+    let valid = &field.valid;
+    let line_mean = |g: &[f32], line: &mut dyn Iterator<Item = usize>| {
+        let (mut sum, mut n) = (0.0f64, 0usize);
+        for i in line.filter(|i| valid[*i]) {
+            sum += g[i] as f64;
+            n += 1;
+        }
+        (n > 0).then(|| sum / n as f64)
+    };
+    let tilt = |mut means: Vec<f64>, lines: usize| -> f32 {
+        if means.len() * 4 < lines {
+            return 0.0;
+        }
+        let k = means.len() / 2;
+        *means.select_nth_unstable_by(k, f64::total_cmp).1 as f32
+    };
+    let rows: Vec<f64> = (0..h)
+        .filter(|y| untouched(y * w) && untouched(y * w + w - 1))
+        .filter_map(|y| line_mean(&field.gx, &mut (y * w..(y + 1) * w)))
+        .collect();
+    let cols: Vec<f64> = (0..w)
+        .filter(|x| untouched(*x) && untouched((h - 1) * w + x))
+        .filter_map(|x| line_mean(&field.gy, &mut (0..h).map(|y| y * w + x)))
+        .collect();
+    let (tx, ty) = (tilt(rows, h), tilt(cols, w));
+    for i in 0..w * h {
+        if field.valid[i] {
+            field.gx[i] -= tx;
+            field.gy[i] -= ty;
+        }
+    }
 }
 
 /// The reading's first pass, on every pixel of the frame: its indentation (mm), the table's
@@ -552,5 +595,57 @@ mod tests {
             (peak / depth - 1.0).abs() < 0.1,
             "peak {peak} mm for {depth}"
         );
+    }
+
+    /// A dome's slopes (peak 1 mm, radius `r` px, centre `cx`) with `tilt` added to every gx.
+    fn dome(w: usize, h: usize, cx: f64, r: f64, tilt: f32) -> (SlopeField, Vec<f32>) {
+        let mut field = SlopeField {
+            width: w,
+            height: h,
+            mm_per_px: 0.1,
+            gx: vec![tilt; w * h],
+            gy: vec![0.0; w * h],
+            valid: vec![true; w * h],
+        };
+        let mut depth = vec![0.0f32; w * h];
+        let cy = h as f64 / 2.0;
+        for y in 0..h {
+            for x in 0..w {
+                let (dx, dy) = (x as f64 - cx, y as f64 - cy);
+                let q = 1.0 - (dx * dx + dy * dy) / (r * r);
+                if q > 0.0 {
+                    let i = y * w + x;
+                    depth[i] = q as f32;
+                    // d/dx of 1 - (dx^2 + dy^2) / r^2, per mm.
+                    field.gx[i] += (-2.0 * dx / (r * r) / 0.1) as f32;
+                    field.gy[i] = (-2.0 * dy / (r * r) / 0.1) as f32;
+                }
+            }
+        }
+        (field, depth)
+    }
+
+    #[test]
+    fn a_tilt_of_the_whole_gel_is_taken_out_and_a_contact_off_the_side_is_left_as_it_is() {
+        // A contact inside the frame, the whole gel tilted by 0.05: the tilt goes, the
+        // contact's own slopes stay.
+        let (mut field, depth) = dome(64, 48, 32.0, 18.0, 0.05);
+        let (before_x, before_y) = (field.gx.clone(), field.gy.clone());
+        take_out_tilt(&mut field, &depth, 1.0);
+        for i in 0..64 * 48 {
+            assert!((field.gx[i] - (before_x[i] - 0.05)).abs() < 2e-3, "{i}");
+            assert!((field.gy[i] - before_y[i]).abs() < 2e-3, "{i}");
+        }
+        // A contact running off the right side, the gel level: its rows are left out, the
+        // rows above and below it are level, so nothing is taken out.
+        let (mut field, depth) = dome(64, 48, 58.0, 14.0, 0.0);
+        let before = field.gx.clone();
+        take_out_tilt(&mut field, &depth, 1.0);
+        assert_eq!(field.gx, before);
+        // Lines with untouched ends too few to measure on: nothing is taken out.
+        let (mut field, depth) = dome(64, 48, 32.0, 60.0, 0.05);
+        let before = field.gx.clone();
+        take_out_tilt(&mut field, &depth, 1.0);
+        assert_eq!(field.gx, before);
     }
 }
