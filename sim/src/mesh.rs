@@ -562,9 +562,7 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
                 .ok_or_else(|| MeshError::Empty {
                     path: shown.clone(),
                 })?;
-            for node in scene.nodes() {
-                gltf_node(&node, glam::DMat4::IDENTITY, &buffers, &mut m);
-            }
+            gltf_nodes(&doc, scene.nodes(), &buffers, &mut m).map_err(read_err)?;
             m
         }
         _ => return Err(MeshError::Format { path: shown }),
@@ -573,45 +571,95 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
     Ok(mesh)
 }
 
-fn gltf_node(
-    node: &gltf::Node,
-    parent: glam::DMat4,
+/// The triangles of every node under `roots`, walked without recursion: a node reached
+/// twice (a cycle, or a child shared by two parents, which glTF forbids) is refused, as is
+/// an accessor whose stride is shorter than its element or whose count alone passes the
+/// triangle limit, before anything is read from it.
+fn gltf_nodes<'a>(
+    doc: &gltf::Document,
+    roots: impl Iterator<Item = gltf::Node<'a>>,
     buffers: &[gltf::buffer::Data],
     out: &mut TriMesh,
-) {
-    let local = glam::Mat4::from_cols_array_2d(&node.transform().matrix()).as_dmat4();
-    let world = parent * local;
-    if let Some(mesh) = node.mesh() {
-        for prim in mesh.primitives() {
-            if prim.mode() != gltf::mesh::Mode::Triangles {
-                continue;
-            }
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            let Some(positions) = reader.read_positions() else {
-                continue;
-            };
-            let base = out.vertices.len() as u32;
-            out.vertices.extend(positions.map(|p| {
-                world.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
-            }));
-            let count = out.vertices.len() as u32 - base;
-            match reader.read_indices() {
-                Some(idx) => {
-                    let idx: Vec<u32> = idx.into_u32().collect();
-                    out.triangles.extend(
-                        idx.chunks_exact(3)
-                            .map(|t| [base + t[0], base + t[1], base + t[2]]),
-                    );
+) -> Result<(), String> {
+    let mut reached = vec![false; doc.nodes().len()];
+    let mut stack: Vec<(gltf::Node, glam::DMat4)> =
+        roots.map(|n| (n, glam::DMat4::IDENTITY)).collect();
+    let readable = |a: &gltf::Accessor| -> Result<(), String> {
+        if a.count() > 3 * MAX_TRIANGLES {
+            return Err(format!(
+                "accessor {} has {} elements, more than {MAX_TRIANGLES} triangles need",
+                a.index(),
+                a.count()
+            ));
+        }
+        if let Some(view) = a.view()
+            && let Some(stride) = view.stride()
+            && stride < a.size()
+        {
+            return Err(format!(
+                "accessor {}: byteStride {stride} is less than its {}-byte element",
+                a.index(),
+                a.size()
+            ));
+        }
+        Ok(())
+    };
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut reached[node.index()], true) {
+            return Err(format!(
+                "node {} is reached twice (a cycle, or a child of two parents)",
+                node.index()
+            ));
+        }
+        let local = glam::Mat4::from_cols_array_2d(&node.transform().matrix()).as_dmat4();
+        let world = parent * local;
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                if prim.mode() != gltf::mesh::Mode::Triangles {
+                    continue;
                 }
-                None => out.triangles.extend(
-                    (0..count / 3).map(|i| [base + 3 * i, base + 3 * i + 1, base + 3 * i + 2]),
-                ),
+                for accessor in prim
+                    .get(&gltf::Semantic::Positions)
+                    .into_iter()
+                    .chain(prim.indices())
+                {
+                    readable(&accessor)?;
+                }
+                let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+                let Some(positions) = reader.read_positions() else {
+                    continue;
+                };
+                let base = out.vertices.len() as u32;
+                out.vertices.extend(positions.map(|p| {
+                    world.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                }));
+                let count = out.vertices.len() as u32 - base;
+                match reader.read_indices() {
+                    Some(idx) => {
+                        let idx: Vec<u32> = idx.into_u32().collect();
+                        if let Some(bad) = idx.iter().find(|i| **i >= count) {
+                            return Err(format!(
+                                "mesh {} index {bad} is past its {count} vertices",
+                                mesh.index()
+                            ));
+                        }
+                        out.triangles.extend(
+                            idx.chunks_exact(3)
+                                .map(|t| [base + t[0], base + t[1], base + t[2]]),
+                        );
+                    }
+                    None => out.triangles.extend(
+                        (0..count / 3).map(|i| [base + 3 * i, base + 3 * i + 1, base + 3 * i + 2]),
+                    ),
+                }
+                if out.triangles.len() > MAX_TRIANGLES {
+                    return Err(format!("more than {MAX_TRIANGLES} triangles"));
+                }
             }
         }
+        stack.extend(node.children().map(|child| (child, world)));
     }
-    for child in node.children() {
-        gltf_node(&child, world, buffers, out);
-    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -764,6 +812,28 @@ mod tests {
         std::fs::write(p.join("bad-uri.gltf"), json).unwrap();
         let e = load(&p.join("bad-uri.gltf")).unwrap_err().to_string();
         assert!(e.contains("not UTF-8"), "{e}");
+        // A node that is its own child, and a stride shorter than a vertex: refused, not a
+        // stack overflow or the importer's assertion.
+        let (json, _) = tetra_gltf("tetra%20mesh.bin");
+        let cycle = json.replace(
+            r#""nodes":[{"mesh":0}]"#,
+            r#""nodes":[{"mesh":0,"children":[0]}]"#,
+        );
+        assert_ne!(cycle, json);
+        std::fs::write(p.join("cycle.gltf"), cycle).unwrap();
+        let e = load(&p.join("cycle.gltf")).unwrap_err().to_string();
+        assert!(e.contains("node 0 is reached twice"), "{e}");
+        let stride = json.replace(
+            r#"{"buffer":0,"byteLength":48}"#,
+            r#"{"buffer":0,"byteLength":48,"byteStride":4}"#,
+        );
+        assert_ne!(stride, json);
+        std::fs::write(p.join("stride.gltf"), stride).unwrap();
+        let e = load(&p.join("stride.gltf")).unwrap_err().to_string();
+        assert!(
+            e.contains("byteStride 4 is less than its 12-byte element"),
+            "{e}"
+        );
         // A buffer shorter than the glTF says is named for it.
         let (json, _) = tetra_gltf("short.bin");
         std::fs::write(p.join("short.bin"), &bin[..40]).unwrap();
