@@ -448,6 +448,7 @@ fn gltf_buffers(
     mut blob: Option<Vec<u8>>,
 ) -> Result<Vec<gltf::buffer::Data>, String> {
     let mut buffers = Vec::new();
+    let mut total = 0u64;
     for buffer in doc.buffers() {
         let mut data = match buffer.source() {
             gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
@@ -485,6 +486,14 @@ fn gltf_buffers(
         }
         // Accessors read whole 4-byte words.
         data.resize(data.len().next_multiple_of(4), 0);
+        // Many buffers naming one large file would each read it whole.
+        total += data.len() as u64;
+        if total > MAX_MESH_BYTES {
+            return Err(format!(
+                "its buffers hold over the {} MB a mesh may have",
+                MAX_MESH_BYTES >> 20
+            ));
+        }
         buffers.push(gltf::buffer::Data(data));
     }
     Ok(buffers)
