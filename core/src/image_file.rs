@@ -31,23 +31,22 @@ fn say(e: image::ImageError) -> String {
 /// The width and height the image at `path` declares, read from its header alone (a file
 /// that is not an image in a known format fails here, before anything waits on it).
 pub fn dimensions(path: &Path) -> Result<(u32, u32), String> {
+    reader(path)?.into_dimensions().map_err(say)
+}
+
+/// A reader of the regular file at `path`, its format guessed from its first bytes.
+fn reader(path: &Path) -> Result<ImageReader<std::io::BufReader<std::fs::File>>, String> {
     crate::text_file::regular(path).map_err(|e| e.to_string())?;
     ImageReader::open(path)
         .map_err(|e| e.to_string())?
         .with_guessed_format()
-        .map_err(|e| e.to_string())?
-        .into_dimensions()
-        .map_err(say)
+        .map_err(|e| e.to_string())
 }
 
 /// The image at `path`, its format from its contents. The error is the reason alone; the
 /// caller names the file and what it was for.
 pub fn open(path: &Path) -> Result<DynamicImage, String> {
-    crate::text_file::regular(path).map_err(|e| e.to_string())?;
-    let mut reader = ImageReader::open(path)
-        .map_err(|e| e.to_string())?
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
+    let mut reader = reader(path)?;
     reader.limits(limits());
     reader.decode().map_err(say)
 }

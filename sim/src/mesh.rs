@@ -416,28 +416,10 @@ fn gltf_buffer_path(dir: &Path, uri: &str) -> Result<std::path::PathBuf, String>
             .ok_or_else(|| format!("buffer URI '{uri}' has a scheme other than file: or data:"))?;
         return Ok(std::path::PathBuf::from(rest));
     }
-    let raw = uri.as_bytes();
-    let mut bytes = Vec::with_capacity(raw.len());
-    let mut i = 0;
-    while i < raw.len() {
-        let hex = raw
-            .get(i + 1..i + 3)
-            .and_then(|h| std::str::from_utf8(h).ok())
-            .and_then(|h| u8::from_str_radix(h, 16).ok());
-        match (raw[i], hex) {
-            (b'%', Some(b)) => {
-                bytes.push(b);
-                i += 3;
-            }
-            (c, _) => {
-                bytes.push(c);
-                i += 1;
-            }
-        }
-    }
-    let decoded = String::from_utf8(bytes)
+    let decoded = percent_encoding::percent_decode_str(uri)
+        .decode_utf8()
         .map_err(|_| format!("buffer URI '{uri}' is not UTF-8 once percent-decoded"))?;
-    Ok(dir.join(decoded))
+    Ok(dir.join(&*decoded))
 }
 
 /// The data of every buffer of a glTF, its external files read with the same bound as the
@@ -510,9 +492,12 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
         path: shown.clone(),
         message,
     };
-    if !matches!(ext.as_str(), "obj" | "gltf" | "glb") {
-        return Err(MeshError::Format { path: shown });
-    }
+    // The format is known before the file is read.
+    let is_obj = match ext.as_str() {
+        "obj" => true,
+        "gltf" | "glb" => false,
+        _ => return Err(MeshError::Format { path: shown }),
+    };
     // One bounded read: a FIFO or a device is refused, an oversize file is not read whole.
     let bytes =
         text_file::read_bytes(path, MAX_MESH_BYTES).map_err(|source| match source.kind() {
@@ -525,8 +510,8 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
                 source,
             },
         })?;
-    let mesh = match ext.as_str() {
-        "obj" => {
+    let mesh = match is_obj {
+        true => {
             let opts = tobj::LoadOptions {
                 triangulate: true,
                 single_index: true,
@@ -557,7 +542,7 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
             }
             m
         }
-        "gltf" | "glb" => {
+        false => {
             let gltf::Gltf {
                 document: doc,
                 blob,
@@ -574,7 +559,6 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
             gltf_nodes(&doc, scene.nodes(), &buffers, &mut m).map_err(read_err)?;
             m
         }
-        _ => return Err(MeshError::Format { path: shown }),
     };
     mesh.validate(&shown)?;
     Ok(mesh)
@@ -805,49 +789,45 @@ mod tests {
         std::fs::write(&with_mtl, format!("mtllib /dev/zero\n{tet}")).unwrap();
         assert_eq!(load(&with_mtl).unwrap().triangles.len(), 4);
         // A glTF's buffer: percent-encoded names are read, a device behind file: is refused.
+        // The glTF written as `name`, and why it was refused.
+        let refused = |name: &str, json: String| {
+            std::fs::write(p.join(name), json).unwrap();
+            load(&p.join(name)).unwrap_err().to_string()
+        };
         let (json, bin) = tetra_gltf("tetra%20mesh.bin");
         std::fs::write(p.join("tetra mesh.bin"), &bin).unwrap();
-        std::fs::write(p.join("t.gltf"), json).unwrap();
+        std::fs::write(p.join("t.gltf"), &json).unwrap();
         assert_eq!(load(&p.join("t.gltf")).unwrap().triangles.len(), 4);
-        let (json, _) = tetra_gltf("file:///dev/zero");
-        std::fs::write(p.join("z.gltf"), json).unwrap();
-        let e = load(&p.join("z.gltf")).unwrap_err().to_string();
+        let e = refused("z.gltf", tetra_gltf("file:///dev/zero").0);
         assert!(
             e.contains("z.gltf") && e.contains("/dev/zero") && e.contains("not a regular file"),
             "{e}"
         );
         // A name that is not UTF-8 once decoded is an error, not a panic.
-        let (json, _) = tetra_gltf("%FF.bin");
-        std::fs::write(p.join("bad-uri.gltf"), json).unwrap();
-        let e = load(&p.join("bad-uri.gltf")).unwrap_err().to_string();
+        let e = refused("bad-uri.gltf", tetra_gltf("%FF.bin").0);
         assert!(e.contains("not UTF-8"), "{e}");
         // A node that is its own child, and a stride shorter than a vertex: refused, not a
         // stack overflow or the importer's assertion.
-        let (json, _) = tetra_gltf("tetra%20mesh.bin");
         let cycle = json.replace(
             r#""nodes":[{"mesh":0}]"#,
             r#""nodes":[{"mesh":0,"children":[0]}]"#,
         );
         assert_ne!(cycle, json);
-        std::fs::write(p.join("cycle.gltf"), cycle).unwrap();
-        let e = load(&p.join("cycle.gltf")).unwrap_err().to_string();
+        let e = refused("cycle.gltf", cycle);
         assert!(e.contains("node 0 is reached twice"), "{e}");
         let stride = json.replace(
             r#"{"buffer":0,"byteLength":48}"#,
             r#"{"buffer":0,"byteLength":48,"byteStride":4}"#,
         );
         assert_ne!(stride, json);
-        std::fs::write(p.join("stride.gltf"), stride).unwrap();
-        let e = load(&p.join("stride.gltf")).unwrap_err().to_string();
+        let e = refused("stride.gltf", stride);
         assert!(
             e.contains("byteStride 4 is less than its 12-byte element"),
             "{e}"
         );
         // A buffer shorter than the glTF says is named for it.
-        let (json, _) = tetra_gltf("short.bin");
         std::fs::write(p.join("short.bin"), &bin[..40]).unwrap();
-        std::fs::write(p.join("short.gltf"), json).unwrap();
-        let e = load(&p.join("short.gltf")).unwrap_err().to_string();
+        let e = refused("short.gltf", tetra_gltf("short.bin").0);
         assert!(e.contains("buffer 0 has 40 bytes, the glTF says 72"), "{e}");
     }
 }
