@@ -24,6 +24,22 @@ impl Pose {
         Self { position, rotation }
     }
 
+    /// What makes this pose unusable, if anything: a position or rotation not finite, or a
+    /// rotation that is not a unit quaternion (a zero one turns every point to the origin).
+    pub fn check(&self) -> Result<(), String> {
+        if !self.position.is_finite() {
+            return Err(format!("position {} is not finite", self.position));
+        }
+        let norm = self.rotation.length();
+        if !(norm.is_finite() && (norm - 1.0).abs() < 1e-6) {
+            return Err(format!(
+                "rotation {} has length {norm}, expected a unit quaternion",
+                self.rotation
+            ));
+        }
+        Ok(())
+    }
+
     /// A camera at `eye` whose optical axis points at `target`; image "down" is world -z
     /// projected into the image plane, or world -y when looking straight down or up.
     pub fn camera_looking_at(eye: DVec3, target: DVec3) -> Option<Self> {

@@ -3,12 +3,13 @@
 use crate::app::detector_choice::DetectorChoice;
 use crate::app::question::Question;
 use crate::app::twin_options::OpenedTwin;
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
 use tactex_core::ground::detect::Detector;
 use tactex_core::pipeline::{Answer, Devices, PipelineConfig};
-use tactex_hw::session::open_session;
+use tactex_hw::session::{MANIFEST, open_session};
+use tactex_sim::contact::Fidelity;
 
 /// Answers `prompt` from the recorded session in `dir`: its frames in the order they were
 /// taken, its moves checked against the pipeline's.
@@ -21,6 +22,17 @@ pub fn answer_on_replay(
     let choice = &opened.detector;
     let catalog = FruitCatalog::builtin();
     let (manifest, mut camera, mut tactile, mut arm) = open_session(dir).context("--session")?;
+    // A session recorded on the twin says at which fidelity, and the answer repeats it.
+    let fidelity = match manifest.twin.as_ref().and_then(|t| t.fidelity.as_deref()) {
+        Some(f) => Some(f.parse::<Fidelity>().map_err(|e| {
+            anyhow!(
+                "--session: {}: twin.fidelity: {}",
+                dir.join(MANIFEST).display(),
+                tactex_core::printable::printable(&e.chars().take(200).collect::<String>())
+            )
+        })?),
+        None => None,
+    };
     let detector = detector_without_truth(choice, &catalog)?;
     let question = Question {
         prompt,
@@ -42,7 +54,7 @@ pub fn answer_on_replay(
     )?;
     // A session recorded on the twin replays the twin's frames: it says at which fidelity.
     if let Some(twin) = manifest.twin {
-        answer.fidelity = twin.fidelity;
+        answer.fidelity = fidelity.map(|f| f.name().into());
         answer.sensor = twin.sensor;
     }
     Ok(answer)

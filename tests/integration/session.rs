@@ -132,6 +132,24 @@ fn broken_or_missing_sessions_and_misused_flags_are_one_line_errors() {
         stderr.contains("manifest.json: camera.intrinsics") && stderr.contains("fx -600"),
         "{stderr}"
     );
+    // A recorded sensor no device has, and a fidelity the twin does not know, are named
+    // before anything is replayed (a scale of 0 sized the glow's blur in gigabytes).
+    let mut m: Value = serde_json::from_str(&text).unwrap();
+    m["tactile"]["spec"]["mm_per_px"] = 0.0.into();
+    std::fs::write(&manifest, serde_json::to_vec(&m).unwrap()).unwrap();
+    let stderr = one_line_error(&replay(&dir, p));
+    assert!(
+        stderr.contains("manifest.json: tactile.spec.mm_per_px: 0, expected"),
+        "{stderr}"
+    );
+    let mut m: Value = serde_json::from_str(&text).unwrap();
+    m["twin"]["fidelity"] = "warp".into();
+    std::fs::write(&manifest, serde_json::to_vec(&m).unwrap()).unwrap();
+    let stderr = one_line_error(&replay(&dir, p));
+    assert!(
+        stderr.contains("manifest.json: twin.fidelity: unknown fidelity \"warp\""),
+        "{stderr}"
+    );
     // A session's own scene text with a mistake is the session's error, not the demo's.
     let mut m: Value = serde_json::from_str(&text).unwrap();
     let toml = m["twin"]["scene_toml"]

@@ -447,12 +447,13 @@ impl GelGlow {
         }
     }
 
-    /// Checks every term; Err is the field (under `optics.glow`) and what is wrong with it.
+    /// Checks every term; Err is the field (`glow`, `glow.colour[0].sigma_px`) and what is
+    /// wrong with it.
     pub fn validate(&self) -> Result<(), (String, String)> {
         let count = self.terms().len();
         if count == 0 || count > MAX_TERMS {
             return Err((
-                "optics.glow".into(),
+                "glow".into(),
                 format!("{count} terms, expected 1..={MAX_TERMS}"),
             ));
         }
@@ -461,13 +462,13 @@ impl GelGlow {
         let check = |list: &str, i: usize, sigma: f32, weights: &[f32], what: &str| {
             if !sigma_ok(sigma) {
                 return Err((
-                    format!("optics.glow.{list}[{i}].sigma_px"),
+                    format!("glow.{list}[{i}].sigma_px"),
                     format!("{sigma}, expected 0..={MAX_SIGMA_PX} px"),
                 ));
             }
             if !weights.iter().all(weight_ok) {
                 return Err((
-                    format!("optics.glow.{list}[{i}].{what}"),
+                    format!("glow.{list}[{i}].{what}"),
                     "weights must be finite and within +-100".into(),
                 ));
             }
@@ -815,24 +816,18 @@ mod tests {
         };
         assert!(g.validate().is_ok());
         g.colour[0].sigma_px = f32::NAN;
-        assert_eq!(
-            g.validate().unwrap_err().0,
-            "optics.glow.colour[0].sigma_px"
-        );
+        assert_eq!(g.validate().unwrap_err().0, "glow.colour[0].sigma_px");
         g.colour[0].sigma_px = 1.0;
         g.colour[0].mix[1][2] = f32::INFINITY;
-        assert_eq!(g.validate().unwrap_err().0, "optics.glow.colour[0].mix");
+        assert_eq!(g.validate().unwrap_err().0, "glow.colour[0].mix");
         g.colour[0].mix[1][2] = 0.0;
         g.indentation.push(ScalarGlow {
             sigma_px: 0.0,
             colour: [-300.0, 0.0, 0.0],
         });
-        assert_eq!(
-            g.validate().unwrap_err().0,
-            "optics.glow.indentation[0].colour"
-        );
+        assert_eq!(g.validate().unwrap_err().0, "glow.indentation[0].colour");
         g.indentation.clear();
         g.colour.clear();
-        assert_eq!(g.validate().unwrap_err().0, "optics.glow");
+        assert_eq!(g.validate().unwrap_err().0, "glow");
     }
 }

@@ -8,7 +8,6 @@
 //! contents (the canonical TOML, without the background's file name, then the background's
 //! pixels), so two profiles that render alike hash alike wherever their files live.
 
-use crate::printable::short_number;
 use crate::tactile::gel_glow::GelGlow;
 use crate::tactile::photometric::PhotometricModel;
 use crate::tactile::shading_table::ShadingTable;
@@ -19,17 +18,9 @@ use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 pub const PROFILE_FORMAT: &str = "tactex-sensor-profile/1";
-use crate::printable::check_name;
 /// Its `source` note, free text of a few paragraphs at most.
 pub const MAX_SOURCE_CHARS: usize = 10_000;
-/// The thinnest gel a profile or `--gel-thickness-mm` may give: vision-based tactile gels are
-/// 0.5-5 mm, and a layer far thinner than its contact makes the layer solve stall (1e-9 mm
-/// ran past a minute).
-pub const MIN_GEL_THICKNESS_MM: f64 = 0.5;
-/// The finest pixel a profile may have: a micrometre on the gel (GelSight sensors: 0.02-0.1 mm).
-pub const MIN_MM_PER_PX: f64 = 0.001;
-/// The largest ambient and light gain an analytic profile may give, relative to the flat gel.
-pub const MAX_LIGHT_GAIN: f64 = 10.0;
+pub use crate::tactile::spec::{MAX_LIGHT_GAIN, MIN_GEL_THICKNESS_MM, MIN_MM_PER_PX};
 
 /// How gel surface slopes become colour.
 #[derive(Clone, Debug, PartialEq)]
@@ -81,6 +72,23 @@ pub struct SensorProfile {
 pub struct ProfileId {
     pub name: String,
     pub sha256: String,
+}
+
+impl ProfileId {
+    /// Err names the field: the name one line of plain text, the hash 64 hexadecimal digits.
+    pub fn check(&self) -> Result<(), (String, String)> {
+        crate::printable::check_name(&self.name).map_err(|m| ("name".to_string(), m))?;
+        if !(self.sha256.len() == 64 && self.sha256.chars().all(|c| c.is_ascii_hexdigit())) {
+            return Err((
+                "sha256".into(),
+                format!(
+                    "'{}', expected 64 hexadecimal digits",
+                    crate::printable::printable(&self.sha256.chars().take(70).collect::<String>())
+                ),
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl std::fmt::Display for ProfileId {
@@ -328,16 +336,13 @@ impl SensorProfile {
         Ok(profile)
     }
 
-    /// Checks every field's range and that the parts agree; Err names the field.
+    /// Checks every field's range and that the parts agree; Err names the field as the
+    /// profile file does.
     pub fn validate(&self) -> Result<(), (String, String)> {
         let bad = |field: &str, message: String| Err((field.to_string(), message));
         let positive = |v: f64| v.is_finite() && v > 0.0;
         if self.name().trim().is_empty() {
             return bad("name", "must not be empty".into());
-        }
-        // Both are printed in every report and answer: a line of plain text, and a note.
-        if let Err(message) = check_name(self.name()) {
-            return bad("name", message);
         }
         if self.source.chars().count() > MAX_SOURCE_CHARS
             || self
@@ -354,28 +359,9 @@ impl SensorProfile {
             );
         }
         let s = &self.spec;
-        for (field, v) in [
-            ("camera.width_px", s.width_px),
-            ("camera.height_px", s.height_px),
-        ] {
-            if !(8..=4096).contains(&v) {
-                return bad(field, format!("{v} px, expected 8..=4096"));
-            }
-        }
-        if !(s.mm_per_px.is_finite() && (MIN_MM_PER_PX..=1.0).contains(&s.mm_per_px)) {
-            return bad(
-                "camera.mm_per_px",
-                format!(
-                    "{}, expected a scale in [{MIN_MM_PER_PX}, 1] mm per pixel",
-                    crate::printable::short_number(s.mm_per_px)
-                ),
-            );
-        }
-        if !(positive(s.frame_rate_hz) && s.frame_rate_hz <= 10_000.0) {
-            return bad(
-                "camera.frame_rate_hz",
-                format!("{}, expected a rate in (0, 10000] Hz", s.frame_rate_hz),
-            );
+        // The name as well: printed in every report and answer, a line of plain text.
+        if let Err((field, message)) = s.check() {
+            return bad(&profile_field(&field), message);
         }
         if !(self.noise_sigma_grey.is_finite() && (0.0..=64.0).contains(&self.noise_sigma_grey)) {
             return bad(
@@ -407,84 +393,6 @@ impl SensorProfile {
                 ),
             );
         }
-        let g = &s.gel;
-        if !(positive(g.modulus_mpa) && g.modulus_mpa <= 1000.0) {
-            return bad(
-                "gel.modulus_mpa",
-                format!("{}, expected (0, 1000] MPa", g.modulus_mpa),
-            );
-        }
-        if !(g.poisson.is_finite() && (0.0..=0.5).contains(&g.poisson)) {
-            return bad("gel.poisson", format!("{}, expected 0..=0.5", g.poisson));
-        }
-        if !(g.thickness_mm.is_finite() && (MIN_GEL_THICKNESS_MM..=50.0).contains(&g.thickness_mm))
-        {
-            return bad(
-                "gel.thickness_mm",
-                format!(
-                    "{}, expected {MIN_GEL_THICKNESS_MM} to 50 mm",
-                    crate::printable::short_number(g.thickness_mm)
-                ),
-            );
-        }
-        match &s.table {
-            None => {
-                let l = &s.photometric;
-                if !l
-                    .lights
-                    .iter()
-                    .all(|d| d.is_finite() && (d.length() - 1.0).abs() < 1e-3)
-                {
-                    return bad("optics.lights.directions", "must be unit vectors".into());
-                }
-                // Both relative to the flat gel's light: beyond ten times it the shading
-                // overflows the frame's range long before the camera's, and 1e300 overflows
-                // the renderer's arithmetic.
-                if !(l.ambient.is_finite() && (0.0..=MAX_LIGHT_GAIN).contains(&l.ambient)) {
-                    return bad(
-                        "optics.lights.ambient",
-                        format!(
-                            "{}, expected 0 to {MAX_LIGHT_GAIN}",
-                            short_number(l.ambient)
-                        ),
-                    );
-                }
-                if !(positive(l.gain) && l.gain <= MAX_LIGHT_GAIN) {
-                    return bad(
-                        "optics.lights.gain",
-                        format!(
-                            "{}, expected above 0 up to {MAX_LIGHT_GAIN}",
-                            short_number(l.gain)
-                        ),
-                    );
-                }
-                if !l.lights.iter().all(|d| d.z > 0.0) {
-                    return bad(
-                        "optics.lights.directions",
-                        "every light must shine on the flat gel (z > 0)".into(),
-                    );
-                }
-                let det =
-                    glam::DMat3::from_cols(l.lights[0], l.lights[1], l.lights[2]).determinant();
-                if det.abs() < 1e-3 {
-                    return bad(
-                        "optics.lights.directions",
-                        "the three lights must not lie in one plane (slopes could not be read back)"
-                            .into(),
-                    );
-                }
-            }
-            Some(t) => {
-                if let Err(e) = t.validate() {
-                    return bad("optics.table", e.to_string());
-                }
-            }
-        }
-        if let Some(glow) = &s.glow
-            && let Err((field, message)) = glow.validate()
-        {
-            return bad(&field, message);
-        }
         if let Some(bg) = &self.background
             && bg.dimensions() != (s.width_px, s.height_px)
         {
@@ -496,34 +404,6 @@ impl SensorProfile {
                     bg.height(),
                     s.width_px,
                     s.height_px
-                ),
-            );
-        }
-        let m = &s.markers;
-        if u64::from(m.cols) * u64::from(m.rows) > 10_000 {
-            return bad(
-                "markers",
-                format!("{} x {} markers, at most 10000", m.cols, m.rows),
-            );
-        }
-        if (m.cols == 0) != (m.rows == 0) {
-            return bad(
-                "markers",
-                format!(
-                    "cols = {}, rows = {}: a grid has both, or both are 0 for none",
-                    m.cols, m.rows
-                ),
-            );
-        }
-        if !(positive(m.pitch_mm)) {
-            return bad("markers.pitch_mm", format!("{}, expected > 0", m.pitch_mm));
-        }
-        if !(m.radius_mm.is_finite() && m.radius_mm >= 0.0 && m.radius_mm < m.pitch_mm / 2.0) {
-            return bad(
-                "markers.radius_mm",
-                format!(
-                    "{}, expected 0 or more and under half the pitch ({} mm)",
-                    m.radius_mm, m.pitch_mm
                 ),
             );
         }
@@ -658,6 +538,22 @@ impl SensorProfile {
             Some(t) => Shading::Table(t.clone()),
             None => Shading::Lights(self.spec.photometric),
         }
+    }
+}
+
+/// A spec field (`TactileSpec::check`'s name) as the profile file names it: the camera's
+/// numbers under `camera`, the shading under `optics`.
+fn profile_field(spec_field: &str) -> String {
+    match spec_field {
+        "model" => "name".into(),
+        "width_px" | "height_px" | "mm_per_px" | "frame_rate_hz" => format!("camera.{spec_field}"),
+        "photometric.lights" => "optics.lights.directions".into(),
+        "table" => "optics.table".into(),
+        _ => match spec_field.split_once('.') {
+            Some(("photometric", rest)) => format!("optics.lights.{rest}"),
+            _ if spec_field.starts_with("glow") => format!("optics.{spec_field}"),
+            _ => spec_field.into(),
+        },
     }
 }
 

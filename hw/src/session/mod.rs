@@ -22,6 +22,6 @@ pub mod presses;
 pub mod record;
 pub mod replay;
 
-pub use format::{Manifest, SessionError, TwinRecord};
+pub use format::{MANIFEST, Manifest, SessionError, TwinRecord};
 pub use record::{RecordingArm, RecordingCamera, RecordingTactile, SessionRecorder};
 pub use replay::{ReplayArm, ReplayCamera, ReplayTactile, open_session};

@@ -63,23 +63,38 @@ pub fn open_session(
             "must be a positive number".into(),
         ));
     }
+    // The sensor as recorded is what the replay reads the frames through: a scale of zero
+    // or a dot of 1e308 mm would size its blurs in gigabytes.
+    manifest
+        .tactile
+        .spec
+        .check()
+        .map_err(|(f, m)| field(&format!("tactile.spec.{f}"), m))?;
+    check_poses(&manifest).map_err(|(f, m)| field(&f, m))?;
+    if let Some(sensor) = manifest.twin.as_ref().and_then(|t| t.sensor.as_ref()) {
+        sensor
+            .check()
+            .map_err(|(f, m)| field(&format!("twin.sensor.{f}"), m))?;
+    }
     let k = &manifest.camera.intrinsics;
     let spec = &manifest.tactile.spec;
-    // Every frame with the size its device gives: (file, size, what says so).
+    // Every frame with the size and kind its device gives: (file, size, what says so, kind).
     let files = manifest
         .camera
         .frames
         .iter()
-        .flat_map(|f| [&f.color, &f.depth])
-        .map(|file| (file, (k.width, k.height), "the intrinsics say"))
+        .flat_map(|f| [(&f.color, FrameKind::Colour), (&f.depth, FrameKind::Depth)])
+        .map(|(file, kind)| (file, (k.width, k.height), "the intrinsics say", kind))
         .chain(manifest.tactile.frames.iter().map(|f| {
             (
                 &f.image,
                 (spec.width_px, spec.height_px),
                 "the sensor gives",
+                FrameKind::Colour,
             )
         }));
-    for (file, size, says) in files {
+    let inside = dir.canonicalize().map_err(|e| SessionError::file(dir, e))?;
+    for (file, size, says, kind) in files {
         let p = dir.join(file);
         let outside = Path::new(file).is_absolute()
             || Path::new(file)
@@ -107,15 +122,26 @@ pub fn open_session(
                 "a folder, where the manifest lists a frame",
             ));
         }
-        // Checked before the replay starts: a frame found bad halfway would end that press
+        // A link inside the folder can still lead out of it.
+        if !p.canonicalize().is_ok_and(|c| c.starts_with(&inside)) {
+            return Err(SessionError::file(
+                &p,
+                "a link leading out of the session folder; a session's frames lie in it",
+            ));
+        }
+        // Decoded before the replay starts: a frame found bad halfway would end that press
         // and show as the arm diverging from the recording, not as the frame it is.
-        let found = tactex_core::image_file::dimensions(&p)
+        let image = tactex_core::image_file::open(&p)
             .map_err(|e| SessionError::file(&p, format!("not a readable frame: {e}")))?;
+        let found = (image.width(), image.height());
         if found != size {
             return Err(SessionError::file(
                 &p,
                 format!("{}x{} px, {says} {}x{}", found.0, found.1, size.0, size.1),
             ));
+        }
+        if let Some(why) = kind.fault(&image) {
+            return Err(SessionError::file(&p, why));
         }
     }
     let name = |device: &str| format!("replay {device} ({})", dir.display());
@@ -147,6 +173,61 @@ pub fn open_session(
             clock,
         },
     ))
+}
+
+/// What a recorded frame file holds: the recorder writes colour as 8-bit RGB and depth as
+/// one 16-bit channel.
+#[derive(Clone, Copy)]
+enum FrameKind {
+    Colour,
+    Depth,
+}
+
+impl FrameKind {
+    /// Why `image` cannot be a frame of this kind, if it cannot: replayed, a greyscale image
+    /// would be read as colour and a colour image as depth, without a word.
+    fn fault(self, image: &tactex_core::image::DynamicImage) -> Option<String> {
+        let colour = image.color();
+        match self {
+            FrameKind::Colour if !colour.has_color() => {
+                Some("a greyscale image, where the recording holds a colour frame".into())
+            }
+            FrameKind::Depth if colour.has_color() || colour.bytes_per_pixel() != 2 => {
+                Some(format!(
+                    "a {colour:?} image, where the recording holds a depth frame: one 16-bit channel"
+                ))
+            }
+            _ => None,
+        }
+    }
+}
+
+/// Every pose in the recording (the camera, the arm's start, each move and frame) finite with
+/// a unit rotation; Err names the first that is not.
+fn check_poses(manifest: &Manifest) -> Result<(), (String, String)> {
+    let poses = [
+        ("camera.pose".to_string(), &manifest.camera.pose),
+        ("arm.start_pose".to_string(), &manifest.arm.start_pose),
+    ]
+    .into_iter()
+    .chain(manifest.arm.moves.iter().enumerate().flat_map(|(i, m)| {
+        [
+            (format!("arm.moves[{i}].target"), &m.target),
+            (format!("arm.moves[{i}].reached"), &m.reached),
+        ]
+    }))
+    .chain(
+        manifest
+            .tactile
+            .frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (format!("tactile.frames[{i}].arm_pose"), &f.arm_pose)),
+    );
+    for (field, pose) in poses {
+        pose.check().map_err(|m| (field, m))?;
+    }
+    Ok(())
 }
 
 /// The recorded robot clock, where the recorded backend had one of its own (the twin's

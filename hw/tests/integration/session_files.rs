@@ -192,3 +192,125 @@ fn a_manifest_pointing_out_of_its_session_is_refused_for_that() {
         "{err}"
     );
 }
+
+/// A recorded session whose sensor, poses or frames no device gives is refused when it is
+/// opened, naming the field or file: a scale of 0 or a dot of 1e308 mm sized the glow's blur
+/// in gigabytes, a zero quaternion turned every pose to the origin, and a greyscale or
+/// truncated frame showed halfway through as the arm diverging from the recording.
+#[test]
+fn a_session_no_device_could_have_recorded_is_refused_when_opened() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let (mut cam, mut tac, mut arm) = devices();
+    let recorder = SessionRecorder::create(&dir).unwrap();
+    {
+        recorder.camera(&mut cam).capture().unwrap();
+        recorder.tactile(&mut tac).capture().unwrap();
+        recorder.arm(&mut arm).unwrap();
+    }
+    recorder.finish("test", "How hard is it?", None).unwrap();
+    assert!(open_session(&dir).is_ok());
+    let manifest = dir.join("manifest.json");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    let refused = |edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut m: serde_json::Value = serde_json::from_str(&text).unwrap();
+        edit(&mut m);
+        std::fs::write(&manifest, m.to_string()).unwrap();
+        let err = open_session(&dir).err().expect("refused").to_string();
+        std::fs::write(&manifest, &text).unwrap();
+        err
+    };
+    for (path, value, says) in [
+        (
+            "mm_per_px",
+            serde_json::json!(0.0),
+            "tactile.spec.mm_per_px",
+        ),
+        ("frame_rate_hz", 0.0.into(), "tactile.spec.frame_rate_hz"),
+        (
+            "gel/modulus_mpa",
+            (-5.0).into(),
+            "tactile.spec.gel.modulus_mpa",
+        ),
+        (
+            "gel/thickness_mm",
+            0.0.into(),
+            "tactile.spec.gel.thickness_mm",
+        ),
+        (
+            "markers/cols",
+            4_000_000_000u32.into(),
+            "tactile.spec.markers",
+        ),
+        (
+            "markers/radius_mm",
+            1e308.into(),
+            "tactile.spec.markers.radius_mm",
+        ),
+        (
+            "markers/pitch_mm",
+            1.5e308.into(),
+            "tactile.spec.markers.pitch_mm",
+        ),
+        ("model", "a\u{1b}[2Jb".into(), "tactile.spec.model"),
+    ] {
+        let err = refused(&|m| {
+            *m.pointer_mut(&format!("/tactile/spec/{path}")).unwrap() = value.clone();
+        });
+        assert!(
+            err.contains(&format!("manifest.json: {says}:")),
+            "{path}: {err}"
+        );
+    }
+    let err = refused(&|m| m["arm"]["start_pose"]["rotation"] = serde_json::json!([0, 0, 0, 0]));
+    assert!(err.contains("arm.start_pose: rotation"), "{err}");
+    let err = refused(&|m| m["camera"]["pose"]["rotation"] = serde_json::json!([0, 0, 0, 2]));
+    assert!(err.contains("camera.pose: rotation"), "{err}");
+    let err = refused(&|m| {
+        m["twin"] = serde_json::json!({"scene_toml": "", "scene_path": "x", "seed": 1,
+            "sensor": {"name": "GelSight Mini", "sha256": "ééééééééé"}})
+    });
+    assert!(err.contains("twin.sensor.sha256"), "{err}");
+
+    // Frames: each replaced by one no recorder writes, then put back.
+    let frame = |file: &str, bytes: &[u8]| {
+        let p = dir.join(file);
+        let good = std::fs::read(&p).unwrap();
+        std::fs::write(&p, bytes).unwrap();
+        let err = open_session(&dir).err().expect("refused").to_string();
+        std::fs::write(&p, good).unwrap();
+        assert!(err.contains(file), "{err}");
+        err
+    };
+    let png = |image: tactex_core::image::DynamicImage| {
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        image
+            .write_to(&mut bytes, tactex_core::image::ImageFormat::Png)
+            .unwrap();
+        bytes.into_inner()
+    };
+    let tactile = std::fs::read(dir.join("tactile/0000.png")).unwrap();
+    let err = frame("tactile/0000.png", &tactile[..tactile.len() / 2]);
+    assert!(err.contains("not a readable frame"), "{err}");
+    let grey = tactex_core::image::GrayImage::new(320, 240);
+    let err = frame("tactile/0000.png", &png(grey.into()));
+    assert!(err.contains("greyscale"), "{err}");
+    let colour = RgbImage::new(64, 48);
+    let err = frame("camera/depth-0000.png", &png(colour.into()));
+    assert!(err.contains("depth frame"), "{err}");
+    let depth = tactex_core::image::ImageBuffer::<Luma<u16>, Vec<u16>>::new(64, 48);
+    let err = frame("camera/color-0000.png", &png(depth.into()));
+    assert!(err.contains("greyscale"), "{err}");
+    assert!(open_session(&dir).is_ok());
+
+    // A link in the folder that leads out of it.
+    #[cfg(unix)]
+    {
+        let outside = tmp.path().join("elsewhere.png");
+        std::fs::copy(dir.join("tactile/0000.png"), &outside).unwrap();
+        std::fs::remove_file(dir.join("tactile/0000.png")).unwrap();
+        std::os::unix::fs::symlink(&outside, dir.join("tactile/0000.png")).unwrap();
+        let err = open_session(&dir).err().expect("refused").to_string();
+        assert!(err.contains("out of the session folder"), "{err}");
+    }
+}
