@@ -521,7 +521,7 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
             let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &opts, |_| {
                 Err(tobj::LoadError::OpenFileFailed)
             })
-            .map_err(|e| read_err(e.to_string()))?;
+            .map_err(|e| read_err(obj_failure(&bytes, e)))?;
             let mut m = TriMesh::default();
             for model in models {
                 let base = m.vertices.len() as u32;
@@ -562,6 +562,45 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
     };
     mesh.validate(&shown)?;
     Ok(mesh)
+}
+
+/// Why an OBJ could not be read, in words a user can act on: tobj says only "read error"
+/// for a file that is not text.
+fn obj_failure(bytes: &[u8], e: tobj::LoadError) -> String {
+    match (e, std::str::from_utf8(bytes)) {
+        (tobj::LoadError::ReadError, Err(bad)) => {
+            let line = 1 + bytes[..bad.valid_up_to()]
+                .iter()
+                .filter(|b| **b == b'\n')
+                .count();
+            format!("line {line} is not UTF-8 text; a Wavefront OBJ is a text file")
+        }
+        (e, _) => format!("{e}, in a Wavefront OBJ line"),
+    }
+}
+
+/// Where an accessor's dense elements lie in its buffer, checked against the bytes there:
+/// one reaching past its view or buffer was read as no triangles.
+fn accessor_in_buffer(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Result<(), String> {
+    let Some(view) = a.view() else {
+        return Ok(());
+    };
+    let stride = view.stride().unwrap_or(a.size());
+    let needed = match a.count() {
+        0 => 0,
+        n => a.offset() + stride * (n - 1) + a.size(),
+    };
+    let held = buffers.get(view.buffer().index()).map_or(0, |d| d.0.len());
+    if needed > view.length() || view.offset() + view.length() > held {
+        return Err(format!(
+            "accessor {} needs {needed} bytes of buffer view {} ({} bytes at {}), whose buffer holds {held}",
+            a.index(),
+            view.index(),
+            view.length(),
+            view.offset()
+        ));
+    }
+    Ok(())
 }
 
 /// The triangles of every node under `roots`, walked without recursion: a node reached
@@ -611,12 +650,25 @@ fn gltf_nodes<'a>(
                 if prim.mode() != gltf::mesh::Mode::Triangles {
                     continue;
                 }
+                use gltf::accessor::{DataType, Dimensions};
+                if let Some(p) = prim.get(&gltf::Semantic::Positions)
+                    && (p.data_type() != DataType::F32 || p.dimensions() != Dimensions::Vec3)
+                {
+                    // The reader takes any POSITION as three floats: u8 ones read as garbage.
+                    return Err(format!(
+                        "accessor {}: POSITION is {:?} {:?}, expected VEC3 of FLOAT",
+                        p.index(),
+                        p.dimensions(),
+                        p.data_type()
+                    ));
+                }
                 for accessor in prim
                     .get(&gltf::Semantic::Positions)
                     .into_iter()
                     .chain(prim.indices())
                 {
                     readable(&accessor)?;
+                    accessor_in_buffer(&accessor, buffers)?;
                 }
                 let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
                 let Some(positions) = reader.read_positions() else {
@@ -829,5 +881,26 @@ mod tests {
         std::fs::write(p.join("short.bin"), &bin[..40]).unwrap();
         let e = refused("short.gltf", tetra_gltf("short.bin").0);
         assert!(e.contains("buffer 0 has 40 bytes, the glTF says 72"), "{e}");
+        // An accessor reaching past its view was read as no triangles; u8 positions were
+        // read as floats.
+        let past = json.replace(r#""count":4,"type":"VEC3""#, r#""count":5,"type":"VEC3""#);
+        assert_ne!(past, json);
+        let e = refused("past.gltf", past);
+        assert!(
+            e.contains("accessor 0 needs 60 bytes of buffer view 0"),
+            "{e}"
+        );
+        let bytes = json.replace(r#""componentType":5126"#, r#""componentType":5121"#);
+        assert_ne!(bytes, json);
+        let e = refused("u8.gltf", bytes);
+        assert!(
+            e.contains("POSITION is Vec3 U8, expected VEC3 of FLOAT"),
+            "{e}"
+        );
+        // An OBJ that is not text says where.
+        let binary = p.join("binary.obj");
+        std::fs::write(&binary, b"v 0 0 0\nv 1 0 0\n\xff\xfe\x00garbage").unwrap();
+        let e = load(&binary).unwrap_err().to_string();
+        assert!(e.contains("line 3 is not UTF-8 text"), "{e}");
     }
 }
