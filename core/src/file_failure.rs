@@ -39,7 +39,12 @@ pub fn json_failure(text: &str, e: &serde_json::Error) -> String {
         .map(str::len)
         .sum::<usize>()
         + column;
-    match last_key(&text[..offset.min(text.len())]) {
+    // serde's column counts bytes: it can fall inside a character.
+    let mut end = offset.min(text.len());
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    match last_key(&text[..end]) {
         Some(key) => format!("field `{key}` (line {line}, column {column}): {message}"),
         None => format!("line {line}, column {column}: {message}"),
     }
@@ -96,5 +101,18 @@ mod tests {
         let compact = r#"{"model":"m","timeout_s":"abc"}"#;
         let e = serde_json::from_str::<Config>(compact).unwrap_err();
         assert!(json_failure(compact, &e).starts_with("field `timeout_s`"));
+    }
+
+    /// serde's column counts bytes: a column inside a character panicked on the slice.
+    #[test]
+    fn an_error_at_a_character_of_several_bytes_is_named_not_a_panic() {
+        for text in [
+            "\u{feff}{\"model\": \"m\"}",
+            "{\"model\": \"m\", \"timeout_s\": é}",
+        ] {
+            let e = serde_json::from_str::<Config>(text).unwrap_err();
+            let said = json_failure(text, &e);
+            assert!(said.contains("line 1, column"), "{said}");
+        }
     }
 }

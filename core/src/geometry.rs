@@ -127,6 +127,10 @@ impl Default for CameraIntrinsics {
     }
 }
 
+/// The longest focal length a camera's intrinsics may give, in pixels (a 4096 px wide image
+/// seen through a 2.3 degree field of view).
+pub const MAX_FOCAL_PX: f64 = 1e5;
+
 impl CameraIntrinsics {
     /// What makes these intrinsics unusable, if anything: a camera has 1 to 4096 pixels a side
     /// (the most an image tactex reads has), positive finite focal lengths and a finite
@@ -136,14 +140,19 @@ impl CameraIntrinsics {
         let finite = [self.fx, self.fy, self.cx, self.cy]
             .iter()
             .all(|v| v.is_finite());
+        // A focal length of 1e-300 px or a principal point 1e9 px off the image maps the
+        // table onto a height map of gigabytes; lenses give 1 to 1e5 px and a centre on the chip.
+        let focal = 1.0..=MAX_FOCAL_PX;
         if !(finite
-            && self.fx > 0.0
-            && self.fy > 0.0
+            && focal.contains(&self.fx)
+            && focal.contains(&self.fy)
             && side.contains(&self.width)
-            && side.contains(&self.height))
+            && side.contains(&self.height)
+            && (0.0..=f64::from(self.width)).contains(&self.cx)
+            && (0.0..=f64::from(self.height)).contains(&self.cy))
         {
             return Err(format!(
-                "need 0 < width, height <= {} and finite fx, fy > 0, cx, cy (got {}x{}, fx {}, fy {}, cx {}, cy {})",
+                "need 0 < width, height <= {}, fx, fy in 1..={MAX_FOCAL_PX} px and cx, cy inside the image (got {}x{}, fx {}, fy {}, cx {}, cy {})",
                 crate::image_file::MAX_SIDE_PX,
                 self.width,
                 self.height,
@@ -178,6 +187,23 @@ impl CameraIntrinsics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A focal length of 1e-300 px or a centre 1e9 px off the chip sized a height map in
+    /// gigabytes; intrinsics no lens has are refused.
+    #[test]
+    fn intrinsics_no_lens_has_are_refused() {
+        assert!(CameraIntrinsics::default().check().is_ok());
+        for edit in [
+            |k: &mut CameraIntrinsics| k.fx = 1e-300,
+            |k: &mut CameraIntrinsics| k.fy = 1e6,
+            |k: &mut CameraIntrinsics| k.cx = 1e9,
+            |k: &mut CameraIntrinsics| k.cy = -1.0,
+        ] {
+            let mut k = CameraIntrinsics::default();
+            edit(&mut k);
+            assert!(k.check().is_err(), "{k:?}");
+        }
+    }
 
     #[test]
     fn a_pixel_holds_the_points_within_half_a_pixel_of_its_centre() {

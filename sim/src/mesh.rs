@@ -586,12 +586,18 @@ fn accessor_in_buffer(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Res
         return Ok(());
     };
     let stride = view.stride().unwrap_or(a.size());
+    // Checked sums: offsets near 2^64 wrapped past the comparison.
     let needed = match a.count() {
-        0 => 0,
-        n => a.offset() + stride * (n - 1) + a.size(),
+        0 => Some(0),
+        n => stride
+            .checked_mul(n - 1)
+            .and_then(|v| v.checked_add(a.offset()))
+            .and_then(|v| v.checked_add(a.size())),
     };
     let held = buffers.get(view.buffer().index()).map_or(0, |d| d.0.len());
-    if needed > view.length() || view.offset() + view.length() > held {
+    let view_end = view.offset().checked_add(view.length());
+    if needed.is_none_or(|n| n > view.length()) || view_end.is_none_or(|e| e > held) {
+        let needed = needed.map_or("more than 2^64".into(), |n| n.to_string());
         return Err(format!(
             "accessor {} needs {needed} bytes of buffer view {} ({} bytes at {}), whose buffer holds {held}",
             a.index(),
@@ -662,6 +668,18 @@ fn gltf_nodes<'a>(
                         p.data_type()
                     ));
                 }
+                if let Some(i) = prim.indices()
+                    && (!matches!(i.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+                        || i.dimensions() != Dimensions::Scalar)
+                {
+                    // The reader reaches unreachable code on any other index type.
+                    return Err(format!(
+                        "accessor {}: indices are {:?} {:?}, expected SCALAR of UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT",
+                        i.index(),
+                        i.dimensions(),
+                        i.data_type()
+                    ));
+                }
                 for accessor in prim
                     .get(&gltf::Semantic::Positions)
                     .into_iter()
@@ -674,6 +692,14 @@ fn gltf_nodes<'a>(
                 let Some(positions) = reader.read_positions() else {
                     continue;
                 };
+                // Every node using a mesh adds its vertices again: bounded in all, not per
+                // accessor (300 nodes on one million-vertex accessor asked for 7 GB).
+                if out.vertices.len() + positions.len() > 3 * MAX_TRIANGLES {
+                    return Err(format!(
+                        "more than {} vertices over the scene's nodes",
+                        3 * MAX_TRIANGLES
+                    ));
+                }
                 let base = out.vertices.len() as u32;
                 out.vertices.extend(positions.map(|p| {
                     world.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
@@ -897,6 +923,11 @@ mod tests {
             e.contains("POSITION is Vec3 U8, expected VEC3 of FLOAT"),
             "{e}"
         );
+        // Float indices reached the importer's unreachable code.
+        let floats = json.replace(r#""componentType":5123"#, r#""componentType":5126"#);
+        assert_ne!(floats, json);
+        let e = refused("float-indices.gltf", floats);
+        assert!(e.contains("indices are Scalar F32"), "{e}");
         // An OBJ that is not text says where.
         let binary = p.join("binary.obj");
         std::fs::write(&binary, b"v 0 0 0\nv 1 0 0\n\xff\xfe\x00garbage").unwrap();

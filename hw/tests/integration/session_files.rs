@@ -88,7 +88,7 @@ impl Arm for PointArm {
 
 fn devices() -> (RampCamera, CountingTactile, PointArm) {
     let mut k = CameraIntrinsics::default();
-    (k.width, k.height) = (64, 48);
+    (k.width, k.height, k.cx, k.cy) = (64, 48, 32.0, 24.0);
     (
         RampCamera { k, t: 0.0 },
         CountingTactile {
