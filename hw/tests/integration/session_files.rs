@@ -167,20 +167,25 @@ fn replayed_devices_give_back_what_was_recorded_and_refuse_the_rest() {
     assert!(c.capture().is_err());
 }
 
-/// A manifest naming a file out of its folder (`../../etc/passwd`) is refused for that
-/// reason, not reported as a missing frame.
-#[test]
-fn a_manifest_pointing_out_of_its_session_is_refused_for_that() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("s");
+/// A finished session in `dir` of one RGB-D frame, one tactile frame and one move.
+fn record_one_of_each(dir: &std::path::Path) {
     let (mut cam, mut tac, mut arm) = devices();
-    let recorder = SessionRecorder::create(&dir).unwrap();
+    let recorder = SessionRecorder::create(dir).unwrap();
     {
         recorder.camera(&mut cam).capture().unwrap();
         recorder.tactile(&mut tac).capture().unwrap();
         recorder.arm(&mut arm).unwrap();
     }
     recorder.finish("test", "How hard is it?", None).unwrap();
+}
+
+/// A manifest naming a file out of its folder (`../../etc/passwd`) is refused for that
+/// reason, not reported as a missing frame.
+#[test]
+fn a_manifest_pointing_out_of_its_session_is_refused_for_that() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    record_one_of_each(&dir);
     let manifest = dir.join("manifest.json");
     let mut m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&manifest).unwrap()).unwrap();
@@ -201,14 +206,7 @@ fn a_manifest_pointing_out_of_its_session_is_refused_for_that() {
 fn a_session_no_device_could_have_recorded_is_refused_when_opened() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("s");
-    let (mut cam, mut tac, mut arm) = devices();
-    let recorder = SessionRecorder::create(&dir).unwrap();
-    {
-        recorder.camera(&mut cam).capture().unwrap();
-        recorder.tactile(&mut tac).capture().unwrap();
-        recorder.arm(&mut arm).unwrap();
-    }
-    recorder.finish("test", "How hard is it?", None).unwrap();
+    record_one_of_each(&dir);
     assert!(open_session(&dir).is_ok());
     let manifest = dir.join("manifest.json");
     let text = std::fs::read_to_string(&manifest).unwrap();
