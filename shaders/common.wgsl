@@ -35,22 +35,27 @@ struct GlowTerm {
     // The source (GlowSource::code): 0 the change, 1 its magnitude (in channel 0), 2 the
     // gel's indentation in mm (in channel 0), 3 the change times the indentation.
     source: u32,
-    // The spacing of the grid the blur is computed on (1: every pixel), as `blur_step`.
-    step: u32,
+    // The size of the blocks the source is averaged over before the blur (1: every pixel), as
+    // `gel_glow::blur_factor`.
+    factor: u32,
 }
 
-// Samples a blur with `step` takes along an axis of `len` pixels: every step-th and the last
-// (`blur_samples`).
-fn sample_count(len: u32, step: u32) -> u32 {
-    if ((len - 1u) % step == 0u) {
-        return (len - 1u) / step + 1u;
-    }
-    return (len - 1u) / step + 2u;
+// Blocks of size d along an axis of `len` pixels: one outside each end and those covering it
+// (`gel_glow::block_count`).
+fn block_count(len: u32, d: u32) -> u32 {
+    return (len + d - 1u) / d + 2u;
 }
 
-// The pixel sample j of an axis of `len` pixels lies at.
-fn sample_at(j: u32, len: u32, step: u32) -> u32 {
-    return min(j * step, len - 1u);
+// Where block (x, y) of a frame's grid of blocks of size d is kept: frame after frame.
+fn block_index(frame: u32, x: u32, y: u32, d: u32) -> u32 {
+    let w = block_count(params.width, d);
+    return (frame * block_count(params.height, d) + y) * w + x;
+}
+
+// Whether an invocation of a per-block stage falls outside the batch's grids of blocks.
+fn outside_blocks(id: vec3<u32>, d: u32) -> bool {
+    return id.x >= block_count(params.width, d) || id.y >= block_count(params.height, d)
+        || id.z >= params.frames;
 }
 
 fn pixel_count() -> u32 {

@@ -1,12 +1,12 @@
-// Glow, pass 3 of a term: the blur at the term's samples interpolated bilinearly to every
-// pixel (exactly the sample where the step is 1), mixed across channels and added to the
-// glow.
+// Glow, pass 4 of a term: the blurred blocks interpolated bilinearly to every pixel (exactly
+// the block where the factor is 1), mixed across channels and added to the glow.
 
 @group(0) @binding(1) var<uniform> term: GlowTerm;
 @group(0) @binding(2) var<storage, read> blurred: array<f32>;
 @group(0) @binding(3) var<storage, read_write> glow: array<f32>;
 
-// The samples around pixel p of an axis of `len` pixels, and the second one's weight.
+// The blocks whose centres lie either side of pixel p of an axis of `len` pixels, and the
+// second one's weight (`gel_glow::between_blocks`).
 struct Between {
     first: u32,
     second: u32,
@@ -14,20 +14,20 @@ struct Between {
 }
 
 fn between(p: u32, len: u32) -> Between {
-    let n = sample_count(len, term.step);
-    let first = min(p / term.step, n - 1u);
-    let second = min(first + 1u, n - 1u);
-    let a = sample_at(first, len, term.step);
-    let b = sample_at(second, len, term.step);
-    var t = 0.0;
-    if (b > a) {
-        t = f32(p - a) / f32(b - a);
+    let d = i32(term.factor);
+    let n = i32(block_count(len, term.factor));
+    // Block i is centred at (i - 1) d + (d - 1) / 2: in half pixels, 2 p + 1 + d from block 0's.
+    let from_first = 2 * i32(p) + 1 + d;
+    let i = from_first / (2 * d);
+    if (i + 1 >= n) {
+        return Between(u32(n - 1), u32(n - 1), 0.0);
     }
-    return Between(first, second, t);
+    let t = f32(from_first - 2 * (d * i)) / f32(2 * d);
+    return Between(u32(i), u32(i + 1), t);
 }
 
 fn sample(frame: u32, x: u32, y: u32) -> vec3<f32> {
-    let k = (frame * pixel_count() + y * params.width + x) * 3u;
+    let k = block_index(frame, x, y, term.factor) * 3u;
     return vec3<f32>(blurred[k], blurred[k + 1u], blurred[k + 2u]);
 }
 

@@ -4,8 +4,7 @@
 //! boundaries, so an imprint touching the edge is not wrapped onto the opposite side.
 
 use super::slopes::SlopeField;
-use crate::spectral::{fft2, real_pair_at};
-use rustfft::num_complex::Complex;
+use crate::spectral::{Mirror, idct2_2d, mirror_transform};
 
 /// Sides of the border whose medians differ by more than this share of the imprint's depth
 /// are not level: the imprint presses one of them in.
@@ -20,53 +19,31 @@ const UNLEVEL_BAND: f64 = 0.2;
 pub fn integrate_slopes(field: &SlopeField) -> Vec<f64> {
     let mm_per_px = field.mm_per_px;
     let (w, h) = (field.width, field.height);
-    let (w2, h2) = (2 * w, 2 * h);
-    // Mirror extension: gx is odd across vertical edges and even across horizontal ones,
-    // gy the other way round. Both are real, so one transform of gx + i gy carries both.
-    let mut p = vec![Complex::new(0.0, 0.0); w2 * h2];
-    for y in 0..h2 {
-        let (sy, yy) = if y < h { (1.0, y) } else { (-1.0, h2 - 1 - y) };
-        for x in 0..w2 {
-            let (sx, xx) = if x < w { (1.0, x) } else { (-1.0, w2 - 1 - x) };
-            let k = yy * w + xx;
-            if field.valid[k] {
-                p[y * w2 + x] = Complex::new(
-                    sx * field.gx[k] as f64 * mm_per_px,
-                    sy * field.gy[k] as f64 * mm_per_px,
-                );
-            }
-        }
-    }
-    fft2(&mut p, w2, h2, false);
-    let freq = |k: usize, n: usize| {
-        let signed = if k <= n / 2 {
-            k as f64
-        } else {
-            k as f64 - n as f64
-        };
-        2.0 * std::f64::consts::PI * signed / n as f64
+    // On the mirror extension gx is odd across vertical edges and even across horizontal
+    // ones, gy the other way round, and the surface even both ways: each is the transform
+    // of its own kind, frequency by frequency the extension's FFT up to one phase.
+    let slope = |g: &[f32]| -> Vec<f64> {
+        g.iter()
+            .zip(&field.valid)
+            .map(|(&v, &ok)| if ok { f64::from(v) * mm_per_px } else { 0.0 })
+            .collect()
     };
-    let mut z = vec![Complex::new(0.0, 0.0); w2 * h2];
-    for v in 0..h2 {
-        let wy = freq(v, h2);
-        for u in 0..w2 {
-            let wx = freq(u, w2);
+    let px = mirror_transform(&slope(&field.gx), w, h, Mirror::Odd, Mirror::Even);
+    let py = mirror_transform(&slope(&field.gy), w, h, Mirror::Even, Mirror::Odd);
+    let mut z = vec![0.0; w * h];
+    for u in 0..w {
+        let wx = std::f64::consts::PI * u as f64 / w as f64;
+        for v in 0..h {
+            let wy = std::f64::consts::PI * v as f64 / h as f64;
             let d = wx * wx + wy * wy;
             if d > 0.0 {
-                let k = v * w2 + u;
-                let (px, py) = real_pair_at(&p, w2, h2, k);
-                // Z = -j (wx Px + wy Py) / (wx^2 + wy^2)
-                let num = px * wx + py * wy;
-                z[k] = Complex::new(num.im, -num.re) / d;
+                // Z = -j (wx Px + wy Py) / (wx^2 + wy^2), with the sine transform's -2j.
+                let k = u * h + v;
+                z[k] = -(wx * px[k] + wy * py[k]) / d;
             }
         }
     }
-    fft2(&mut z, w2, h2, true);
-    let scale = 1.0 / (w2 * h2) as f64;
-    let mut depth: Vec<f64> = (0..h)
-        .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| z[y * w2 + x].re * scale)
-        .collect();
+    let mut depth = idct2_2d(&z, w, h);
     let zero = zero_level(&depth, w, h);
     depth.iter_mut().for_each(|d| *d -= zero);
     depth

@@ -3,8 +3,8 @@
 //! of the gel's indentation. Reading a frame's change per pixel through the table as if it
 //! were S takes the glow for slope (a wide bowl round every contact). The linear part is a
 //! 3x3 matrix per spatial frequency, A(f) = sum_k M_k g_k(f), so S is recovered by a
-//! regularised inverse per frequency (on the frame's mirror extension, so nothing wraps); the
-//! other terms are taken from the previous reading and subtracted.
+//! regularised inverse per frequency (of the frame's mirror extension, so nothing wraps: its
+//! cosine transform); the other terms are taken from the previous reading and subtracted.
 //!
 //! What the regulariser gives up (a colour the glow nearly cancels at a frequency) is taken
 //! from a prior change when there is one: the table's change of a first reading's slopes.
@@ -12,9 +12,8 @@
 //! profile, whose glow cancels much of a small contact's colour, read its own renders of a
 //! ball pressed 0.3-0.6 mm about 30% shallow.
 
-use crate::spectral::{fft2, real_pair_at};
+use crate::spectral::{dct2_2d, idct2_2d};
 use crate::tactile::gel_glow::{GelGlow, GlowSource, gaussian_kernel};
-use rustfft::num_complex::Complex;
 use std::sync::{Arc, Mutex};
 
 /// Tikhonov weight, relative to the zero-frequency gain: how much of a frequency the glow
@@ -25,7 +24,8 @@ const RIDGE: f64 = 0.01;
 pub struct GlowInverse {
     width: usize,
     height: usize,
-    /// Per frequency of the 2w x 2h extension, the 3x3 regularised inverse, row-major.
+    /// Per frequency (u, v) of the cosine transform (at u h + v, as `dct2_2d` leaves it), the
+    /// 3x3 regularised inverse, row-major.
     inverse: Vec<[f64; 9]>,
     /// Per frequency, the 3x3 share of a prior change the inverse keeps: ridge (A^T A +
     /// ridge I)^-1, so that a prior the glow's image of which is the observation comes back
@@ -136,10 +136,12 @@ impl GlowInverse {
         };
         let zero = gain_at(0, 0);
         let ridge = RIDGE * zero.iter().map(|v| v * v).sum::<f64>() / 3.0;
-        let mut inverse = Vec::with_capacity(n * m);
-        let mut toward_prior = Vec::with_capacity(n * m);
-        for v in 0..m {
-            for u in 0..n {
+        // The mirror extension's frequencies a cosine transform keeps: the first half of each
+        // axis.
+        let mut inverse = Vec::with_capacity(width * height);
+        let mut toward_prior = Vec::with_capacity(width * height);
+        for u in 0..width {
+            for v in 0..height {
                 let a = gain_at(u, v);
                 // (A^T A + ridge I)^-1 A^T
                 let mut ata = [0.0f64; 9];
@@ -201,83 +203,37 @@ impl GlowInverse {
         self.solve_from(observed, Some(prior))
     }
 
-    /// The channels are real and the filters real and even in frequency, so two channels
-    /// share one transform each way (as re and im): the observation's first two, the prior's
-    /// first two, and both third channels.
+    /// Each channel of the observation (and the prior) to its cosine transform, mixed per
+    /// frequency, and back.
     fn solve_from(&self, observed: &[[f32; 3]], prior: Option<&[[f32; 3]]>) -> Vec<[f32; 3]> {
         let (w, h) = (self.width, self.height);
-        let (n, m) = (2 * w, 2 * h);
-        // One channel of an image in the real part, another (or none) in the imaginary,
-        // mirrored and transformed.
-        let transform = |re: (&[[f32; 3]], usize), im: Option<(&[[f32; 3]], usize)>| {
-            let mut out = vec![Complex::new(0.0, 0.0); n * m];
-            for y in 0..m {
-                let yy = if y < h { y } else { m - 1 - y };
-                for x in 0..n {
-                    let xx = if x < w { x } else { n - 1 - x };
-                    let i = yy * w + xx;
-                    out[y * n + x] = Complex::new(
-                        f64::from(re.0[i][re.1]),
-                        im.map_or(0.0, |(image, c)| f64::from(image[i][c])),
-                    );
-                }
-            }
-            fft2(&mut out, n, m, false);
-            out
+        let transform = |image: &[[f32; 3]], c: usize| {
+            let channel: Vec<f64> = image.iter().map(|p| f64::from(p[c])).collect();
+            dct2_2d(&channel, w, h)
         };
-        let pair = transform((observed, 0), Some((observed, 1)));
-        let mut third = transform((observed, 2), prior.map(|p| (p, 2)));
-        let prior_pair = prior.map(|p| transform((p, 0), Some((p, 1))));
-        let mut pair_out = vec![Complex::new(0.0, 0.0); n * m];
-        // Without a prior `third` is read at k alone, so its result can take its place.
-        let mut third_out = match prior_pair {
-            Some(_) => vec![Complex::new(0.0, 0.0); n * m],
-            None => Vec::new(),
-        };
+        let o: [Vec<f64>; 3] = std::array::from_fn(|c| transform(observed, c));
+        let p: Option<[Vec<f64>; 3]> = prior.map(|p| std::array::from_fn(|c| transform(p, c)));
+        let mut s: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; w * h]);
         for (k, b) in self.inverse.iter().enumerate() {
-            let (o0, o1) = real_pair_at(&pair, n, m, k);
-            let (o2, p2) = match prior_pair {
-                Some(_) => real_pair_at(&third, n, m, k),
-                None => (third[k], Complex::new(0.0, 0.0)),
-            };
-            let o = [o0, o1, o2];
-            let mut s: [Complex<f64>; 3] = std::array::from_fn(|i| {
-                o[0] * b[3 * i] + o[1] * b[3 * i + 1] + o[2] * b[3 * i + 2]
+            let ok = [o[0][k], o[1][k], o[2][k]];
+            let mut sk: [f64; 3] = std::array::from_fn(|i| {
+                ok[0] * b[3 * i] + ok[1] * b[3 * i + 1] + ok[2] * b[3 * i + 2]
             });
-            if let Some(prior_pair) = &prior_pair {
-                let (p0, p1) = real_pair_at(prior_pair, n, m, k);
-                let p = [p0, p1, p2];
+            if let Some(p) = &p {
+                let pk = [p[0][k], p[1][k], p[2][k]];
                 let t = &self.toward_prior[k];
-                for (i, s) in s.iter_mut().enumerate() {
-                    *s += p[0] * t[3 * i] + p[1] * t[3 * i + 1] + p[2] * t[3 * i + 2];
+                for (i, s) in sk.iter_mut().enumerate() {
+                    *s += pk[0] * t[3 * i] + pk[1] * t[3 * i + 1] + pk[2] * t[3 * i + 2];
                 }
             }
-            // S0 + i S1, whose inverse is s0 + i s1.
-            pair_out[k] = Complex::new(s[0].re - s[1].im, s[0].im + s[1].re);
-            match prior_pair {
-                Some(_) => third_out[k] = s[2],
-                None => third[k] = s[2],
+            for (c, v) in sk.into_iter().enumerate() {
+                s[c][k] = v;
             }
         }
-        let mut third_out = match prior_pair {
-            Some(_) => third_out,
-            None => third,
-        };
-        fft2(&mut pair_out, n, m, true);
-        fft2(&mut third_out, n, m, true);
-        let scale = 1.0 / (n * m) as f64;
-        let mut out = vec![[0.0f32; 3]; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                let (p, t) = (pair_out[y * n + x], third_out[y * n + x]);
-                out[y * w + x] = [
-                    (p.re * scale) as f32,
-                    (p.im * scale) as f32,
-                    (t.re * scale) as f32,
-                ];
-            }
-        }
-        out
+        let back: [Vec<f64>; 3] = std::array::from_fn(|c| idct2_2d(&s[c], w, h));
+        (0..w * h)
+            .map(|i| std::array::from_fn(|c| back[c][i] as f32))
+            .collect()
     }
 }
 

@@ -1,4 +1,4 @@
-//! The WGSL compute renderer: the stages of `shaders/` (four, and four more for a glow) as
+//! The WGSL compute renderer: the stages of `shaders/` (four, and five more for a glow) as
 //! wgpu compute pipelines, a whole batch of presses per dispatch (the frame is the third
 //! dispatch dimension), read back as RGBA8 and unpacked.
 
@@ -9,13 +9,13 @@ use super::{
 };
 use crate::render::device::GpuDevice;
 use image::RgbImage;
-use tactex_core::tactile::gel_glow::{blur_step, gaussian_kernel};
+use tactex_core::tactile::gel_glow::{blur_factor, blur_kernel};
 use wgpu::util::DeviceExt;
 
 const COMMON: &str = include_str!("../../../../shaders/common.wgsl");
 
 /// Each stage's own source; the shared prelude (`common.wgsl`) goes in front of it.
-pub const SHADER_SOURCES: [(&str, &str); 8] = [
+pub const SHADER_SOURCES: [(&str, &str); 9] = [
     (
         "gel_slopes",
         include_str!("../../../../shaders/gel_slopes.wgsl"),
@@ -31,6 +31,10 @@ pub const SHADER_SOURCES: [(&str, &str); 8] = [
     (
         "sensor_exposure",
         include_str!("../../../../shaders/sensor_exposure.wgsl"),
+    ),
+    (
+        "gel_glow_blocks",
+        include_str!("../../../../shaders/gel_glow_blocks.wgsl"),
     ),
     (
         "gel_glow_rows",
@@ -55,10 +59,11 @@ const SLOPES: usize = 0;
 const SHADING: usize = 1;
 const MARKERS: usize = 2;
 const EXPOSURE: usize = 3;
-const GLOW_ROWS: usize = 4;
-const GLOW_COLUMNS: usize = 5;
-const GLOW_SPREAD: usize = 6;
-const GLOW_APPLY: usize = 7;
+const GLOW_BLOCKS: usize = 4;
+const GLOW_ROWS: usize = 5;
+const GLOW_COLUMNS: usize = 6;
+const GLOW_SPREAD: usize = 7;
+const GLOW_APPLY: usize = 8;
 
 /// The complete WGSL module of a stage, as the device compiles it.
 pub fn shader_source(stage: &str) -> Option<String> {
@@ -74,7 +79,7 @@ const MAX_FRAMES_PER_DISPATCH: usize = 64;
 pub struct GpuRenderer {
     gpu: GpuDevice,
     /// One per entry of SHADER_SOURCES.
-    pipelines: [wgpu::ComputePipeline; 8],
+    pipelines: [wgpu::ComputePipeline; 9],
 }
 
 impl GpuRenderer {
@@ -215,29 +220,39 @@ impl GpuRenderer {
         ];
         let mut glow_sum = None;
         if let Some(glow) = &shared.glow {
+            // A term's blocks (the finest, of one pixel, with one outside each edge) are
+            // averaged into `blurred`, blurred along rows into `along_rows` and down columns
+            // back into `blurred`.
+            let blocks_px = (glow_blocks_per_frame(w, h) * count) as u64;
             let along_rows = self.scratch(
                 "glow along rows",
-                frame_px * 12,
+                blocks_px * 12,
                 wgpu::BufferUsages::empty(),
             );
-            let blurred = self.scratch("glow blurred", frame_px * 12, wgpu::BufferUsages::empty());
+            let blurred = self.scratch("glow blurred", blocks_px * 12, wgpu::BufferUsages::empty());
             let sum = self.scratch("glow", frame_px * 12, wgpu::BufferUsages::COPY_DST);
-            for term in &glow.terms {
+            for (term, factor) in &glow.terms {
+                let d = *factor;
+                let grid = [
+                    (w.div_ceil(d) + 2).div_ceil(8),
+                    (h.div_ceil(d) + 2).div_ceil(8),
+                    count as u32,
+                ];
+                steps.push((
+                    GLOW_BLOCKS,
+                    self.bind(
+                        GLOW_BLOCKS,
+                        &[&uniform, term, &glow.flat, &shaded, &heights, &blurred],
+                    ),
+                    grid,
+                ));
                 steps.push((
                     GLOW_ROWS,
                     self.bind(
                         GLOW_ROWS,
-                        &[
-                            &uniform,
-                            term,
-                            &glow.kernel,
-                            &glow.flat,
-                            &shaded,
-                            &heights,
-                            &along_rows,
-                        ],
+                        &[&uniform, term, &glow.kernel, &blurred, &along_rows],
                     ),
-                    tiles,
+                    grid,
                 ));
                 steps.push((
                     GLOW_COLUMNS,
@@ -245,7 +260,7 @@ impl GpuRenderer {
                         GLOW_COLUMNS,
                         &[&uniform, term, &glow.kernel, &along_rows, &blurred],
                     ),
-                    tiles,
+                    grid,
                 ));
                 steps.push((
                     GLOW_SPREAD,
@@ -322,11 +337,17 @@ struct OpticsBuffers {
 }
 
 /// The glow's inputs: the flat gel's shading, every term's kernel back to back, and one
-/// uniform block per term.
+/// uniform block per term with its block size.
 struct GlowBuffers {
     flat: wgpu::Buffer,
     kernel: wgpu::Buffer,
-    terms: Vec<wgpu::Buffer>,
+    terms: Vec<(wgpu::Buffer, u32)>,
+}
+
+/// The most blocks a glow term's grid has for a frame: blocks of one pixel, one outside
+/// each edge.
+fn glow_blocks_per_frame(width: u32, height: u32) -> usize {
+    (width as usize + 2) * (height as usize + 2)
 }
 
 /// A glow term as the glow stages read it (`GlowTerm` in shaders/common.wgsl).
@@ -337,7 +358,7 @@ struct GlowTermBlock {
     offset: u32,
     radius: u32,
     source: u32,
-    step: u32,
+    factor: u32,
 }
 
 impl GpuRenderer {
@@ -347,16 +368,17 @@ impl GpuRenderer {
         let mut kernel = Vec::new();
         let mut terms = Vec::new();
         for term in glow.terms() {
-            let k = gaussian_kernel(term.sigma_px);
+            let k = blur_kernel(term.sigma_px);
+            let factor = blur_factor(term.sigma_px) as u32;
             let block = GlowTermBlock {
                 mix: term.mix.map(|r| [r[0], r[1], r[2], 0.0]),
                 offset: kernel.len() as u32,
                 radius: (k.len() / 2) as u32,
                 source: term.source.code(),
-                step: blur_step(term.sigma_px) as u32,
+                factor,
             };
             kernel.extend(k);
-            terms.push(
+            terms.push((
                 self.gpu
                     .device
                     .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -364,7 +386,8 @@ impl GpuRenderer {
                         contents: bytemuck::bytes_of(&block),
                         usage: wgpu::BufferUsages::UNIFORM,
                     }),
-            );
+                factor,
+            ));
         }
         GlowBuffers {
             flat: self.storage("flat shading", bytemuck::cast_slice(&flat)),
@@ -385,7 +408,11 @@ impl GelRenderer for GpuRenderer {
         frames: &[PressFrame],
     ) -> Result<Vec<RgbImage>, RenderError> {
         optics.check_frames(frames)?;
-        let per_frame = optics.pixel_count() as u64 * 12;
+        let per_frame = match optics.glow {
+            Some(_) => glow_blocks_per_frame(optics.width, optics.height),
+            None => optics.pixel_count(),
+        } as u64
+            * 12;
         if per_frame > self.gpu.limits.max_storage_buffer_binding_size {
             return Err(super::invalid(
                 "optics.size",
