@@ -114,25 +114,44 @@ mod tests {
             .collect()
     }
 
+    /// The DFT of `data`'s mirror extension (odd or even across its left and right ends, even
+    /// across top and bottom) at (u, v) < (nx, ny), at u * ny + v, with the half-sample phase
+    /// e^(-i pi (u / 2nx + v / 2ny)) taken out.
+    fn mirror_spectrum(data: &[f64], nx: usize, ny: usize, along_x: Mirror) -> Vec<Complex<f64>> {
+        let mut mirrored = vec![Complex::new(0.0, 0.0); 4 * nx * ny];
+        for y in 0..2 * ny {
+            for x in 0..2 * nx {
+                let sign = if x >= nx && along_x == Mirror::Odd {
+                    -1.0
+                } else {
+                    1.0
+                };
+                let (xx, yy) = (x.min(2 * nx - 1 - x), y.min(2 * ny - 1 - y));
+                mirrored[y * 2 * nx + x] = Complex::new(sign * data[yy * nx + xx], 0.0);
+            }
+        }
+        let spectrum = dft2(&mirrored, 2 * nx, 2 * ny);
+        let tau = 2.0 * std::f64::consts::PI;
+        let mut out = Vec::with_capacity(nx * ny);
+        for u in 0..nx {
+            for v in 0..ny {
+                let phase = tau * (u as f64 / (4 * nx) as f64 + v as f64 / (4 * ny) as f64);
+                out.push(spectrum[v * 2 * nx + u] * Complex::new(phase.cos(), -phase.sin()));
+            }
+        }
+        out
+    }
+
     #[test]
     fn a_cosine_transform_is_the_mirror_extensions_fft_and_comes_back() {
         let (nx, ny) = (6, 5);
         let data = signal(nx, ny, 0.9);
         let coefficients = dct2_2d(&data, nx, ny);
-        let mut mirrored = vec![Complex::new(0.0, 0.0); 4 * nx * ny];
-        for y in 0..2 * ny {
-            for x in 0..2 * nx {
-                let (xx, yy) = (x.min(2 * nx - 1 - x), y.min(2 * ny - 1 - y));
-                mirrored[y * 2 * nx + x] = Complex::new(data[yy * nx + xx], 0.0);
-            }
-        }
-        let spectrum = dft2(&mirrored, 2 * nx, 2 * ny);
-        let tau = 2.0 * std::f64::consts::PI;
+        let spectrum = mirror_spectrum(&data, nx, ny, Mirror::Even);
         for u in 0..nx {
             for v in 0..ny {
                 // X(u, v) = 4 e^(i pi u / 2nx) e^(i pi v / 2ny) C(u, v).
-                let phase = tau * (u as f64 / (4 * nx) as f64 + v as f64 / (4 * ny) as f64);
-                let want = spectrum[v * 2 * nx + u] * Complex::new(phase.cos(), -phase.sin());
+                let want = spectrum[u * ny + v];
                 let got = 4.0 * coefficients[u * ny + v];
                 assert!((want - got).norm() < 1e-9, "({u}, {v}): {want} vs {got}");
             }
@@ -147,21 +166,11 @@ mod tests {
         let (nx, ny) = (5, 4);
         let data = signal(nx, ny, 1.7);
         let coefficients = mirror_transform(&data, nx, ny, Mirror::Odd, Mirror::Even);
-        let mut mirrored = vec![Complex::new(0.0, 0.0); 4 * nx * ny];
-        for y in 0..2 * ny {
-            for x in 0..2 * nx {
-                let sign = if x < nx { 1.0 } else { -1.0 };
-                let (xx, yy) = (x.min(2 * nx - 1 - x), y.min(2 * ny - 1 - y));
-                mirrored[y * 2 * nx + x] = Complex::new(sign * data[yy * nx + xx], 0.0);
-            }
-        }
-        let spectrum = dft2(&mirrored, 2 * nx, 2 * ny);
-        let tau = 2.0 * std::f64::consts::PI;
+        let spectrum = mirror_spectrum(&data, nx, ny, Mirror::Odd);
         for u in 0..nx {
             for v in 0..ny {
                 // X(u, v) = -2i e^(i pi u / 2nx) 2 e^(i pi v / 2ny) S(u, v).
-                let phase = tau * (u as f64 / (4 * nx) as f64 + v as f64 / (4 * ny) as f64);
-                let want = spectrum[v * 2 * nx + u] * Complex::new(phase.cos(), -phase.sin());
+                let want = spectrum[u * ny + v];
                 let got = Complex::new(0.0, -4.0 * coefficients[u * ny + v]);
                 assert!((want - got).norm() < 1e-9, "({u}, {v}): {want} vs {got}");
             }
