@@ -11,6 +11,7 @@ use crate::geometry::Pose;
 use crate::hardness::estimate::PressSequence;
 use crate::press::protocol::{Look, PressOutcome, PressProbe, PressProtocol, run_press};
 use crate::tactile::contact::ContactEvidence;
+use crate::tactile::separable::{imageproc_gaussian_taps, separable_blur};
 use glam::DVec3;
 
 pub(super) struct Press {
@@ -93,12 +94,14 @@ pub(super) fn imprint_offset(
         return None;
     }
     let (w, h) = a.dimensions();
-    let change = image::ImageBuffer::<image::Luma<f32>, Vec<f32>>::from_fn(w, h, |x, y| {
-        let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
-        image::Luma([(0..3).map(|c| (p[c] as f32 - q[c] as f32).abs()).sum()])
-    });
-    let smooth = imageproc::filter::gaussian_blur_f32(&change, 4.0);
-    let mut levels: Vec<f32> = smooth.pixels().map(|p| p[0]).collect();
+    let change: Vec<[f32; 1]> = a
+        .pixels()
+        .zip(b.pixels())
+        .map(|(p, q)| [(0..3).map(|c| (p[c] as f32 - q[c] as f32).abs()).sum()])
+        .collect();
+    let taps = imageproc_gaussian_taps(4.0);
+    let smooth = separable_blur(&change, w as usize, h as usize, &taps).into_flattened();
+    let mut levels = smooth.clone();
     let peak = levels.iter().copied().fold(0.0, f32::max);
     let middle_level = levels.len() / 2;
     let noise = *levels
@@ -109,9 +112,13 @@ pub(super) fn imprint_offset(
     }
     let cut = noise + 0.5 * (peak - noise);
     let inside: Vec<glam::DVec2> = smooth
-        .enumerate_pixels()
-        .filter(|(_, _, p)| p[0] > cut)
-        .map(|(x, y, _)| glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5))
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| **p > cut)
+        .map(|(i, _)| {
+            let (x, y) = (i as u32 % w, i as u32 / w);
+            glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5)
+        })
         .collect();
     let n = inside.len() as f64;
     let mean = inside.iter().sum::<glam::DVec2>() / n;

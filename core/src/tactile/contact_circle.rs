@@ -19,9 +19,10 @@
 //! (`tests/integration/sim_to_real.rs`; `tactex compare` reports it per image).
 
 use super::circle_fit::fit_circle;
+use super::separable::{imageproc_gaussian_taps, separable_blur};
 use super::slopes::{dark_level, is_dark};
 use image::{ImageBuffer, Luma, RgbImage};
-use imageproc::filter::{filter3x3, gaussian_blur_f32};
+use imageproc::filter::filter3x3;
 use serde::Serialize;
 
 type FloatImage = ImageBuffer<Luma<f32>, Vec<f32>>;
@@ -60,8 +61,9 @@ pub fn estimate_contact_circle(frame: &RgbImage, reference: &RgbImage) -> Option
     if !readable(frame, reference) {
         return None;
     }
+    let (w, h) = frame.dimensions();
     let change = colour_change(frame, reference);
-    circle_of(&channel_norm(&change), imprint_starts(&change))
+    circle_of(&channel_norm(&change, w, h), imprint_starts(&change, w, h))
 }
 
 /// The contact circle found from a known middle of the imprint (px), as a reader that has
@@ -74,8 +76,9 @@ pub fn contact_circle_around(
     if !readable(frame, reference) {
         return None;
     }
+    let (w, h) = frame.dimensions();
     circle_of(
-        &channel_norm(&colour_change(frame, reference)),
+        &channel_norm(&colour_change(frame, reference), w, h),
         vec![middle_px],
     )
 }
@@ -112,38 +115,40 @@ fn circle_of(magnitude: &FloatImage, starts: Vec<(f64, f64)>) -> Option<ContactC
 /// shading and are filled from their neighbours (normalised convolution), so a moved dot does
 /// not read as an edge. Saturated pixels are kept: their other channels still see the slope
 /// (a deep press saturates red over thousands of pixels around the imprint on the FOTS frames).
-fn colour_change(frame: &RgbImage, reference: &RgbImage) -> [FloatImage; 3] {
-    let (w, h) = frame.dimensions();
+/// Row-major, the frame's size. The weight and the three weighted channels are blurred in one
+/// pass (imageproc's Gaussian to the bit, a quarter of the passes over the frame).
+fn colour_change(frame: &RgbImage, reference: &RgbImage) -> Vec<[f32; 3]> {
+    let (w, h) = (frame.width() as usize, frame.height() as usize);
     let level = dark_level(reference);
-    let weight = FloatImage::from_fn(w, h, |x, y| {
-        let (p, r) = (frame.get_pixel(x, y), reference.get_pixel(x, y));
-        let shaded = !(is_dark(p, level) || is_dark(r, level));
-        Luma([if shaded { 1.0 } else { 0.0 }])
-    });
-    let weight_blur = gaussian_blur_f32(&weight, CHANGE_SIGMA_PX);
-    std::array::from_fn(|c| {
-        let weighted = FloatImage::from_fn(w, h, |x, y| {
-            let d = frame.get_pixel(x, y)[c] as f32 - reference.get_pixel(x, y)[c] as f32;
-            Luma([d * weight.get_pixel(x, y)[0]])
-        });
-        let blurred = gaussian_blur_f32(&weighted, CHANGE_SIGMA_PX);
-        FloatImage::from_fn(w, h, |x, y| {
-            let wsum = weight_blur.get_pixel(x, y)[0];
-            Luma([if wsum > 1e-3 {
-                blurred.get_pixel(x, y)[0] / wsum
-            } else {
-                0.0
-            }])
+    let weighted: Vec<[f32; 4]> = frame
+        .pixels()
+        .zip(reference.pixels())
+        .map(|(p, r)| {
+            let shaded = !(is_dark(p, level) || is_dark(r, level));
+            let weight = if shaded { 1.0f32 } else { 0.0 };
+            let d = |c: usize| (p[c] as f32 - r[c] as f32) * weight;
+            [weight, d(0), d(1), d(2)]
         })
-    })
+        .collect();
+    separable_blur(&weighted, w, h, &imageproc_gaussian_taps(CHANGE_SIGMA_PX))
+        .into_iter()
+        .map(|[wsum, c0, c1, c2]| {
+            if wsum > 1e-3 {
+                [c0 / wsum, c1 / wsum, c2 / wsum]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect()
 }
 
-fn channel_norm(change: &[FloatImage; 3]) -> FloatImage {
-    let (w, h) = change[0].dimensions();
-    FloatImage::from_fn(w, h, |x, y| {
-        let s: f32 = change.iter().map(|c| c.get_pixel(x, y)[0].powi(2)).sum();
-        Luma([s.sqrt()])
-    })
+/// The change's size per pixel (its three channels' Euclidean norm).
+fn channel_norm(change: &[[f32; 3]], w: u32, h: u32) -> FloatImage {
+    let norms = change
+        .iter()
+        .map(|c| c.iter().map(|v| v.powi(2)).sum::<f32>().sqrt())
+        .collect();
+    FloatImage::from_raw(w, h, norms).expect("one norm per pixel")
 }
 
 /// Fits from `start`, re-centring REFITS times.
@@ -166,20 +171,27 @@ fn circle_from(magnitude: &FloatImage, start: (f64, f64), reach: f64) -> Option<
 /// texture's peak, where the gel inside a real contact is rough, and the centroid of the
 /// texture above half that peak, which is the middle also when only the rim is sharp (the
 /// twin's smooth gel).
-fn imprint_starts(change: &[FloatImage; 3]) -> Vec<(f64, f64)> {
-    let (w, h) = change[0].dimensions();
+fn imprint_starts(change: &[[f32; 3]], w: u32, h: u32) -> Vec<(f64, f64)> {
     let sx: [f32; 9] = [-1.0, 0.0, 1.0, -2.0, 0.0, 2.0, -1.0, 0.0, 1.0];
     let sy: [f32; 9] = [-1.0, -2.0, -1.0, 0.0, 0.0, 0.0, 1.0, 2.0, 1.0];
     let mut texture = FloatImage::new(w, h);
-    for c in change {
-        let gx: FloatImage = filter3x3(c, &sx);
-        let gy: FloatImage = filter3x3(c, &sy);
+    for c in 0..3 {
+        let channel: Vec<f32> = change.iter().map(|p| p[c]).collect();
+        let c = FloatImage::from_raw(w, h, channel).expect("one value per pixel");
+        let gx: FloatImage = filter3x3(&c, &sx);
+        let gy: FloatImage = filter3x3(&c, &sy);
         for (t, (a, b)) in texture.pixels_mut().zip(gx.pixels().zip(gy.pixels())) {
             t[0] += a[0] * a[0] + b[0] * b[0];
         }
     }
-    texture.pixels_mut().for_each(|p| p[0] = p[0].sqrt());
-    let smooth = gaussian_blur_f32(&texture, START_SIGMA_PX);
+    let texture: Vec<[f32; 1]> = texture.pixels().map(|p| [p[0].sqrt()]).collect();
+    let smooth = separable_blur(
+        &texture,
+        w as usize,
+        h as usize,
+        &imageproc_gaussian_taps(START_SIGMA_PX),
+    );
+    let smooth = FloatImage::from_raw(w, h, smooth.into_flattened()).expect("one per pixel");
     let (mut best, mut at) = (f32::MIN, (w as f64 / 2.0, h as f64 / 2.0));
     for (x, y, p) in smooth.enumerate_pixels() {
         if p[0] > best {

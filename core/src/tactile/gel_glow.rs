@@ -6,6 +6,7 @@
 //! real presses in `tactex calibrate` and applied by both renderers.
 
 use crate::scoped_map::map_on_cores;
+use crate::tactile::separable::separable_blur;
 use serde::{Deserialize, Serialize};
 
 /// The largest blur a profile may ask for (pixels, 1 sigma): bounds the work per frame.
@@ -196,24 +197,24 @@ fn between_blocks(len: usize, d: usize, blocks: usize) -> Vec<(usize, usize, f32
         .collect()
 }
 
-/// The mean of each `d` x `d` block of `block_count`'s grid (edges extended), each block's
-/// pixels summed row by row.
+/// The mean of each `d` x `d` block of `block_count`'s grid (edges extended) of the
+/// `width` x `height` source whose pixel i is `at(i)`, each block's pixels summed row by row.
 fn block_means<const N: usize>(
-    src: &[[f32; N]],
+    at: impl Fn(usize) -> [f32; N],
     width: usize,
     height: usize,
     d: usize,
 ) -> Vec<[f32; N]> {
     let (cw, ch) = (block_count(width, d), block_count(height, d));
     let area = (d * d) as f32;
-    let at = |i: usize, len: usize| (i.saturating_sub(d)).min(len - 1);
+    let inside = |i: usize, len: usize| (i.saturating_sub(d)).min(len - 1);
     let mut out = vec![[0.0f32; N]; cw * ch];
     for (by, row_out) in out.chunks_exact_mut(cw).enumerate() {
         for dy in 0..d {
-            let row = &src[at(by * d + dy, height) * width..][..width];
+            let row = inside(by * d + dy, height) * width;
             for (bx, o) in row_out.iter_mut().enumerate() {
                 for dx in 0..d {
-                    let v = row[at(bx * d + dx, width)];
+                    let v = at(row + inside(bx * d + dx, width));
                     for c in 0..N {
                         o[c] += v[c];
                     }
@@ -238,105 +239,91 @@ pub fn blur<const N: usize>(
     height: usize,
     sigma_px: f32,
 ) -> Vec<[f32; N]> {
-    let k = blur_kernel(sigma_px);
-    if k.len() == 1 || src.is_empty() {
-        return src.to_vec();
-    }
-    let d = blur_factor(sigma_px);
-    if d == 1 {
-        return blur_every_pixel(src, width, height, &k);
-    }
-    let (cw, ch) = (block_count(width, d), block_count(height, d));
-    let coarse = blur_every_pixel(&block_means(src, width, height, d), cw, ch, &k);
-    // Back to every pixel: each block row across to every column, then each pixel row
-    // between its two block rows.
-    let across = between_blocks(width, d, cw);
-    let mut wide = vec![[0.0f32; N]; width * ch];
-    for (a, row_out) in coarse.chunks_exact(cw).zip(wide.chunks_exact_mut(width)) {
-        for (o, &(x0, x1, tx)) in row_out.iter_mut().zip(&across) {
-            for c in 0..N {
-                o[c] = a[x0][c] * (1.0 - tx) + a[x1][c] * tx;
-            }
-        }
-    }
-    let mut out = vec![[0.0f32; N]; src.len()];
-    for (row_out, &(y0, y1, ty)) in out
-        .chunks_exact_mut(width)
-        .zip(&between_blocks(height, d, ch))
-    {
-        let (top, bottom) = (
-            wide[y0 * width..][..width].as_flattened(),
-            wide[y1 * width..][..width].as_flattened(),
-        );
-        for ((o, t), b) in row_out.as_flattened_mut().iter_mut().zip(top).zip(bottom) {
-            *o = t * (1.0 - ty) + b * ty;
-        }
+    let rows = BlurRows::of(|i| src[i], width, height, sigma_px);
+    let mut out = Vec::with_capacity(src.len());
+    let mut scratch = vec![[0.0f32; N]; width];
+    for y in 0..height {
+        out.extend_from_slice(rows.row(y, &mut scratch));
     }
     out
 }
 
-/// `blur` at every pixel: rows first, then columns.
-fn blur_every_pixel<const N: usize>(
-    src: &[[f32; N]],
-    width: usize,
-    height: usize,
-    k: &[f32],
-) -> Vec<[f32; N]> {
-    let r = k.len() / 2;
-    let mut rows = vec![[0.0f32; N]; src.len()];
-    let mut padded = vec![[0.0f32; N]; width + 2 * r];
-    for (row_in, row_out) in src.chunks_exact(width).zip(rows.chunks_exact_mut(width)) {
-        padded[..r].fill(row_in[0]);
-        padded[r..r + width].copy_from_slice(row_in);
-        padded[r + width..].fill(row_in[width - 1]);
-        let taps: Vec<&[f32]> = (0..k.len())
-            .map(|i| padded[i..i + width].as_flattened())
-            .collect();
-        weighted_sum(row_out.as_flattened_mut(), &taps, k);
-    }
-    let mut out = vec![[0.0f32; N]; src.len()];
-    let mut taps: Vec<&[f32]> = Vec::with_capacity(k.len());
-    for (y, row_out) in out.chunks_exact_mut(width).enumerate() {
-        taps.clear();
-        taps.extend((0..k.len()).map(|i| {
-            let yy = (y + i).saturating_sub(r).min(height - 1);
-            rows[yy * width..][..width].as_flattened()
-        }));
-        weighted_sum(row_out.as_flattened_mut(), &taps, k);
-    }
-    out
+/// A blur's result, row by row: a whole frame (a blur at every pixel), or a wide blur's
+/// block rows already interpolated across, each pixel row made between its two when asked.
+/// A caller that sums blurs row by row so never holds a frame per wide blur.
+enum BlurRows<const N: usize> {
+    Frame {
+        values: Vec<[f32; N]>,
+        width: usize,
+    },
+    Blocks {
+        across: Vec<[f32; N]>,
+        down: Vec<(usize, usize, f32)>,
+        width: usize,
+    },
 }
 
-/// `out[j] = k[0] taps[0][j] + k[1] taps[1][j] + ...`, summed in that order from zero (so
-/// every renderer's sum of a sample's taps from -r to r gives the same bits), a block of
-/// outputs at a time with its sums held in registers across the taps.
-fn weighted_sum(out: &mut [f32], taps: &[&[f32]], k: &[f32]) {
-    const BLOCK: usize = 32;
-    let n = out.len();
-    let whole = n - n % BLOCK;
-    for start in (0..whole).step_by(BLOCK) {
-        let mut sum = [0.0f32; BLOCK];
-        for (tap, w) in taps.iter().zip(k) {
-            for (s, v) in sum.iter_mut().zip(&tap[start..start + BLOCK]) {
-                *s += w * v;
+impl<const N: usize> BlurRows<N> {
+    /// The blur of the `width` x `height` source whose pixel i is `at(i)`.
+    fn of(at: impl Fn(usize) -> [f32; N], width: usize, height: usize, sigma_px: f32) -> Self {
+        let k = blur_kernel(sigma_px);
+        let d = blur_factor(sigma_px);
+        if k.len() == 1 || d == 1 || width == 0 || height == 0 {
+            let src: Vec<[f32; N]> = (0..width * height).map(at).collect();
+            let values = if k.len() == 1 || src.is_empty() {
+                src
+            } else {
+                separable_blur(&src, width, height, &k)
+            };
+            return Self::Frame { values, width };
+        }
+        let (cw, ch) = (block_count(width, d), block_count(height, d));
+        let coarse = separable_blur(&block_means(at, width, height, d), cw, ch, &k);
+        // Each block row across to every column; the pixel rows between them come in `row`.
+        let between = between_blocks(width, d, cw);
+        let mut across = vec![[0.0f32; N]; width * ch];
+        for (a, row_out) in coarse.chunks_exact(cw).zip(across.chunks_exact_mut(width)) {
+            for (o, &(x0, x1, tx)) in row_out.iter_mut().zip(&between) {
+                for c in 0..N {
+                    o[c] = a[x0][c] * (1.0 - tx) + a[x1][c] * tx;
+                }
             }
         }
-        out[start..start + BLOCK].copy_from_slice(&sum);
-    }
-    for (j, o) in out.iter_mut().enumerate().skip(whole) {
-        let mut sum = 0.0f32;
-        for (tap, w) in taps.iter().zip(k) {
-            sum += w * tap[j];
+        Self::Blocks {
+            across,
+            down: between_blocks(height, d, ch),
+            width,
         }
-        *o = sum;
+    }
+
+    /// Row `y` of the blur; a wide blur's is made in `scratch` (a row long).
+    fn row<'a>(&'a self, y: usize, scratch: &'a mut [[f32; N]]) -> &'a [[f32; N]] {
+        match self {
+            Self::Frame { values, width } => &values[y * width..][..*width],
+            Self::Blocks {
+                across,
+                down,
+                width,
+            } => {
+                let (y0, y1, ty) = down[y];
+                let top = across[y0 * width..][..*width].as_flattened();
+                let bottom = across[y1 * width..][..*width].as_flattened();
+                for ((o, t), b) in scratch.as_flattened_mut().iter_mut().zip(top).zip(bottom) {
+                    *o = t * (1.0 - ty) + b * ty;
+                }
+                scratch
+            }
+        }
     }
 }
 
 /// A term's source over a whole frame, blurred: a one-channel source alone (a third of the
-/// work, and no frame of zeros to mix), the others in all three channels.
+/// work, and no frame of zeros to mix), the others in all three channels; an unblurred
+/// source is read where it is mixed.
 enum BlurredSource {
-    One(Vec<[f32; 1]>),
-    Three(Vec<[f32; 3]>),
+    Unblurred,
+    One(BlurRows<1>),
+    Three(BlurRows<3>),
 }
 
 fn blur_source(
@@ -346,19 +333,17 @@ fn blur_source(
     width: usize,
     height: usize,
 ) -> BlurredSource {
-    let at = change
-        .iter()
-        .zip(indentation_mm)
-        .map(|(&c, &d)| term.source.at(c, d));
-    if term.source.channels() == 1 {
-        let src: Vec<[f32; 1]> = at.map(|v| [v[0]]).collect();
-        BlurredSource::One(blur(&src, width, height, term.sigma_px))
+    let at = |i: usize| term.source.at(change[i], indentation_mm[i]);
+    if blur_kernel(term.sigma_px).len() == 1 {
+        BlurredSource::Unblurred
+    } else if term.source.channels() == 1 {
+        BlurredSource::One(BlurRows::of(|i| [at(i)[0]], width, height, term.sigma_px))
     } else {
-        BlurredSource::Three(blur(&at.collect::<Vec<_>>(), width, height, term.sigma_px))
+        BlurredSource::Three(BlurRows::of(at, width, height, term.sigma_px))
     }
 }
 
-/// `blur_source` in channel 0 of three, the others zero, as the shaders hold it.
+/// The term's blurred source in channel 0 of three, the others zero, as the shaders hold it.
 fn blurred_source(
     term: &GlowTerm,
     change: &[[f32; 3]],
@@ -366,9 +351,16 @@ fn blurred_source(
     width: usize,
     height: usize,
 ) -> Vec<[f32; 3]> {
-    match blur_source(term, change, indentation_mm, width, height) {
-        BlurredSource::One(b) => b.into_iter().map(|[v]| [v, 0.0, 0.0]).collect(),
-        BlurredSource::Three(b) => b,
+    let at = |i: usize| term.source.at(change[i], indentation_mm[i]);
+    if term.source.channels() == 1 {
+        let src: Vec<[f32; 1]> = (0..change.len()).map(|i| [at(i)[0]]).collect();
+        blur(&src, width, height, term.sigma_px)
+            .into_iter()
+            .map(|[v]| [v, 0.0, 0.0])
+            .collect()
+    } else {
+        let src: Vec<[f32; 3]> = (0..change.len()).map(at).collect();
+        blur(&src, width, height, term.sigma_px)
     }
 }
 
@@ -516,31 +508,62 @@ impl GelGlow {
         height: usize,
     ) -> Vec<[f32; 3]> {
         let terms = self.terms();
-        // The blurs are independent: made on the cores, summed in the terms' order.
+        // The blurs are independent: made on the cores, then summed in the terms' order
+        // row by row, the rows shared out over the cores.
         let blurred = map_on_cores(&terms, |term| {
             blur_source(term, change, indentation_mm, width, height)
         });
-        let mut out = vec![[0.0f32; 3]; change.len()];
-        for (term, blurred) in terms.iter().zip(blurred) {
-            match blurred {
-                // The shaders' sum with the zero channels left out: the same bits.
-                BlurredSource::One(b) => {
-                    for (o, [v]) in out.iter_mut().zip(&b) {
+        if width == 0 {
+            return Vec::new();
+        }
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let band = height.div_ceil(cores).max(1);
+        let bands: Vec<usize> = (0..height).step_by(band).collect();
+        let mixed = map_on_cores(&bands, |&y0| {
+            let rows = y0..(y0 + band).min(height);
+            let mut out = vec![[0.0f32; 3]; rows.len() * width];
+            let (mut one, mut three) = (vec![[0.0f32; 1]; width], vec![[0.0f32; 3]; width]);
+            for (y, out_row) in rows.zip(out.chunks_exact_mut(width)) {
+                for (term, blurred) in terms.iter().zip(&blurred) {
+                    // The shaders' sum with the zero channels left out: the same bits.
+                    let mix_one = |o: &mut [f32; 3], v: f32| {
                         for (c, row) in term.mix.iter().enumerate() {
                             o[c] += row[0] * v;
                         }
-                    }
-                }
-                BlurredSource::Three(b) => {
-                    for (o, b) in out.iter_mut().zip(&b) {
+                    };
+                    let mix_three = |o: &mut [f32; 3], b: [f32; 3]| {
                         for (c, row) in term.mix.iter().enumerate() {
                             o[c] += row[0] * b[0] + row[1] * b[1] + row[2] * b[2];
+                        }
+                    };
+                    match blurred {
+                        BlurredSource::Unblurred => {
+                            for (x, o) in out_row.iter_mut().enumerate() {
+                                let i = y * width + x;
+                                let v = term.source.at(change[i], indentation_mm[i]);
+                                if term.source.channels() == 1 {
+                                    mix_one(o, v[0]);
+                                } else {
+                                    mix_three(o, v);
+                                }
+                            }
+                        }
+                        BlurredSource::One(b) => {
+                            for (o, [v]) in out_row.iter_mut().zip(b.row(y, &mut one)) {
+                                mix_one(o, *v);
+                            }
+                        }
+                        BlurredSource::Three(b) => {
+                            for (o, v) in out_row.iter_mut().zip(b.row(y, &mut three)) {
+                                mix_three(o, *v);
+                            }
                         }
                     }
                 }
             }
-        }
-        out
+            out
+        });
+        mixed.concat()
     }
 
     /// The glow with the design's blurs that best maps the rendered changes onto the real

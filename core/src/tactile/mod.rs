@@ -18,6 +18,7 @@ pub mod marker_grid;
 pub mod markers;
 pub mod photometric;
 pub mod sensor_profile;
+pub mod separable;
 pub mod shading_inverse;
 pub mod shading_table;
 pub mod slopes;
