@@ -484,7 +484,8 @@ impl Scene {
                                 format!("'{}' is a directory, not a mesh file", path.display()),
                             ));
                         }
-                        if !path.exists() {
+                        // A link looping or leading nowhere is named by `regular` below.
+                        if std::fs::symlink_metadata(&path).is_err() {
                             return Err(err(
                                 &field("mesh"),
                                 format!("mesh file '{}' not found", path.display()),

@@ -517,6 +517,9 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
                 single_index: true,
                 ..Default::default()
             };
+            if let Some(problem) = std::str::from_utf8(&bytes).ok().and_then(obj_line_problem) {
+                return Err(read_err(problem));
+            }
             // Materials are not simulated: an `mtllib` is never opened.
             let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &opts, |_| {
                 Err(tobj::LoadError::OpenFileFailed)
@@ -546,7 +549,13 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
             let gltf::Gltf {
                 document: doc,
                 blob,
-            } = gltf::Gltf::from_slice(&bytes).map_err(|e| read_err(e.to_string()))?;
+            } = gltf::Gltf::from_slice_without_validation(&bytes)
+                .map_err(|e| read_err(e.to_string()))?;
+            // gltf-json's validation indexes a POSITION accessor before checking it exists
+            // (a panic): that one is checked here first, then the whole document validated.
+            positions_exist(doc.as_json()).map_err(read_err)?;
+            let doc =
+                gltf::Document::from_json(doc.into_json()).map_err(|e| read_err(e.to_string()))?;
             let dir = path.parent().unwrap_or(Path::new("."));
             let buffers = gltf_buffers(&doc, dir, blob).map_err(read_err)?;
             let mut m = TriMesh::default();
@@ -577,6 +586,101 @@ fn obj_failure(bytes: &[u8], e: tobj::LoadError) -> String {
         }
         (e, _) => format!("{e}, in a Wavefront OBJ line"),
     }
+}
+
+/// The first line of an OBJ that its parser would refuse without saying where, or would
+/// drop (a face of fewer than three vertices): a vertex whose coordinates are not numbers,
+/// a face whose index is not one or names no vertex read so far.
+fn obj_line_problem(text: &str) -> Option<String> {
+    let (mut positions, mut texcoords, mut normals) = (0i64, 0i64, 0i64);
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let (kind, rest) = (words.next(), words);
+        let numbers = |wanted: usize, what: &str, rest: std::str::SplitWhitespace| {
+            let read: Vec<&str> = rest.take(wanted).collect();
+            (read.len() < wanted || read.iter().any(|w| w.parse::<f32>().is_err())).then(|| {
+                format!(
+                    "line {}: {what} needs {wanted} numbers, has '{}'",
+                    n + 1,
+                    shown_excerpt(line)
+                )
+            })
+        };
+        let problem = match kind {
+            Some("v") => {
+                positions += 1;
+                numbers(3, "a vertex (v)", rest)
+            }
+            Some("vt") => {
+                texcoords += 1;
+                numbers(1, "a texture coordinate (vt)", rest)
+            }
+            Some("vn") => {
+                normals += 1;
+                numbers(3, "a normal (vn)", rest)
+            }
+            Some("f") => {
+                let corners: Vec<&str> = rest.collect();
+                if corners.len() < 3 {
+                    Some(format!(
+                        "line {}: a face (f) of {} vertices; a face needs 3 or more",
+                        n + 1,
+                        corners.len()
+                    ))
+                } else {
+                    corners.iter().find_map(|corner| {
+                        let bad = corner.split('/').zip([positions, texcoords, normals]).any(
+                            |(index, count)| {
+                                !index.is_empty()
+                                    && !index.parse::<i64>().is_ok_and(|i| {
+                                        (1..=count).contains(&i) || (-count..=-1).contains(&i)
+                                    })
+                            },
+                        );
+                        (bad || corner.starts_with('/')).then(|| {
+                            format!(
+                                "line {}: face corner '{}' names no vertex read before it \
+                                 (1-based, or negative from the last)",
+                                n + 1,
+                                shown_excerpt(corner)
+                            )
+                        })
+                    })
+                }
+            }
+            _ => None,
+        };
+        if problem.is_some() {
+            return problem;
+        }
+    }
+    None
+}
+
+/// Text from the file as one short, printable excerpt of an error line.
+fn shown_excerpt(text: &str) -> String {
+    tactex_core::printable::printable(&text.chars().take(60).collect::<String>())
+}
+
+/// Every primitive's POSITION names an accessor the file has.
+fn positions_exist(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::validation::Checked;
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(gltf::json::mesh::Semantic::Positions));
+            if let Some(index) = position.filter(|i| i.value() >= root.accessors.len()) {
+                return Err(format!(
+                    "meshes[{m}].primitives[{p}].attributes.POSITION: accessor {} does not \
+                     exist (the file has {})",
+                    index.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Where an accessor's dense elements lie in its buffer, checked against the bytes there:
@@ -648,6 +752,17 @@ fn gltf_nodes<'a>(
                 "node {} is reached twice (a cycle, or a child of two parents)",
                 node.index()
             ));
+        }
+        // glTF's rotation is a unit quaternion; another length would scale and shear the
+        // mesh as a matrix built from it.
+        if let gltf::scene::Transform::Decomposed { rotation, .. } = node.transform() {
+            let length = rotation.iter().map(|v| v * v).sum::<f32>().sqrt();
+            if (length - 1.0).abs() > 1e-3 {
+                return Err(format!(
+                    "nodes[{}].rotation {rotation:?} is not a unit quaternion (length {length})",
+                    node.index()
+                ));
+            }
         }
         let local = glam::Mat4::from_cols_array_2d(&node.transform().matrix()).as_dmat4();
         let world = parent * local;
@@ -846,6 +961,71 @@ mod tests {
 {{"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}}]}}"#
         );
         (json, bin)
+    }
+
+    #[test]
+    fn a_position_naming_no_accessor_or_a_long_rotation_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let (json, bin) = tetra_gltf("tetra.bin");
+        std::fs::write(dir.path().join("tetra.bin"), bin).unwrap();
+        let path = dir.path().join("missing-accessor.gltf");
+        std::fs::write(&path, json.replace(r#""POSITION":0"#, r#""POSITION":7"#)).unwrap();
+        let e = load(&path).unwrap_err().to_string();
+        let rotated = dir.path().join("long-rotation.gltf");
+        let long = json.replace(r#"{"mesh":0}"#, r#"{"mesh":0,"rotation":[0,0,0,2]}"#);
+        std::fs::write(&rotated, long).unwrap();
+        let r = load(&rotated).unwrap_err().to_string();
+        assert!(
+            r.contains("nodes[0].rotation") && r.contains("not a unit quaternion"),
+            "{r}"
+        );
+        assert!(
+            e.contains("missing-accessor.gltf")
+                && e.contains("meshes[0].primitives[0].attributes.POSITION")
+                && e.contains("accessor 7"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn an_obj_line_that_cannot_be_read_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let refused = |text: &str| {
+            let path = dir.path().join("bad.obj");
+            std::fs::write(&path, text).unwrap();
+            load(&path).unwrap_err().to_string()
+        };
+        let tet = "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nv 0 0 0.05\n";
+        for (text, says) in [
+            (
+                format!("{tet}f 1 3 2\nf 1 2\n"),
+                "line 6: a face (f) of 2 vertices",
+            ),
+            (format!("{tet}f 1 3\n"), "line 5: a face (f) of 2 vertices"),
+            (format!("{tet}f 1 3 9\n"), "line 5: face corner '9'"),
+            (format!("{tet}f 1 3 -5\n"), "line 5: face corner '-5'"),
+            (format!("{tet}f 1 3 x\n"), "line 5: face corner 'x'"),
+            (format!("{tet}f 1/7 3 2\n"), "line 5: face corner '1/7'"),
+            (
+                format!("v 0 0\n{tet}"),
+                "line 1: a vertex (v) needs 3 numbers",
+            ),
+            (
+                format!("{tet}vn 0 zero 1\n"),
+                "line 5: a normal (vn) needs 3 numbers",
+            ),
+        ] {
+            let e = refused(&text);
+            assert!(e.contains("bad.obj") && e.contains(says), "{says}: {e}");
+        }
+        // Negative (relative) corners and texture/normal slots are read.
+        let path = dir.path().join("good.obj");
+        std::fs::write(
+            &path,
+            format!("{tet}vt 0 0\nvn 0 0 1\nf -4/1/1 -2//1 -3\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"),
+        )
+        .unwrap();
+        assert_eq!(load(&path).unwrap().triangles.len(), 4);
     }
 
     #[test]

@@ -193,6 +193,11 @@ pub fn answer(args: &AskRequest) -> Result<Answer> {
             if args.record.is_some() {
                 bail!("--record: a replay is already a recording; record from --backend sim");
             }
+            if args.scene.is_some() {
+                bail!(
+                    "--scene: only with --backend sim (a replay's objects are the ones its session recorded)"
+                );
+            }
             let opened = args.twin.open()?;
             answer_on_replay(dir, &opened, &args.prompt, &config)?
         }

@@ -193,6 +193,19 @@ fn broken_or_missing_sessions_and_misused_flags_are_one_line_errors() {
     assert!(one_line_error(&out).contains("--session"));
     let out = tactex(&["ask", "--session", dir.to_str().unwrap(), p]);
     assert!(one_line_error(&out).contains("--backend replay"));
+    // A scene beside a replay would be ignored: it is refused instead.
+    let d = dir.to_str().unwrap();
+    let out = tactex(&[
+        "ask",
+        "--backend",
+        "replay",
+        "--session",
+        d,
+        "--scene",
+        "x.toml",
+        p,
+    ]);
+    assert!(one_line_error(&out).contains("--scene: only with --backend sim"));
 }
 
 fn compare_session(dir: &Path, extra: &[&str]) -> Output {

@@ -52,15 +52,39 @@ pub fn open_session(
             format!("'{}' is not {FORMAT}", manifest.format),
         ));
     }
+    // Both are shown in reports: one printable line each.
+    tactex_core::printable::check_name(&manifest.backend).map_err(|m| field("backend", m))?;
+    if let Some(twin) = &manifest.twin
+        && twin
+            .scene_path
+            .chars()
+            .any(|c| c.is_control() || tactex_core::printable::is_hidden(c))
+    {
+        return Err(field(
+            "twin.scene_path",
+            format!(
+                "'{}' holds control or hidden characters; it is shown in reports",
+                tactex_core::printable::printable(
+                    &twin.scene_path.chars().take(60).collect::<String>()
+                )
+            ),
+        ));
+    }
     manifest
         .camera
         .intrinsics
         .check()
         .map_err(|m| field("camera.intrinsics", m))?;
-    if !(manifest.camera.depth_scale_m.is_finite() && manifest.camera.depth_scale_m > 0.0) {
+    // A depth unit is a fraction of a metre (a RealSense's is 1 mm); one of 1e308 m puts
+    // the table beyond any pose.
+    let scale = manifest.camera.depth_scale_m;
+    if !(scale.is_finite() && scale > 0.0 && scale <= 1.0) {
         return Err(field(
             "camera.depth_scale_m",
-            "must be a positive number".into(),
+            format!(
+                "{} must be a positive number of metres per depth unit, at most 1",
+                tactex_core::printable::short_number(scale)
+            ),
         ));
     }
     // The sensor as recorded is what the replay reads the frames through: a scale of zero
@@ -93,8 +117,23 @@ pub fn open_session(
                 FrameKind::Colour,
             )
         }));
+    let listed = manifest.camera.frames.len() + manifest.tactile.frames.len();
+    if listed > MAX_SESSION_FRAMES {
+        return Err(field(
+            "frames",
+            format!(
+                "{listed} frames listed; a session holds at most {MAX_SESSION_FRAMES} (a whole \
+                 question is a few hundred)"
+            ),
+        ));
+    }
     let inside = dir.canonicalize().map_err(|e| SessionError::file(dir, e))?;
+    // A file listed again as the same kind of frame is checked once.
+    let mut checked = std::collections::HashSet::new();
     for (file, size, says, kind) in files {
+        if !checked.insert((file, kind)) {
+            continue;
+        }
         let p = dir.join(file);
         let outside = Path::new(file).is_absolute()
             || Path::new(file)
@@ -112,7 +151,9 @@ pub fn open_session(
                 ),
             });
         }
-        if !p.exists() {
+        // Only a name with nothing behind it is missing: a link looping or leading nowhere
+        // is named as such by `regular` below.
+        if std::fs::symlink_metadata(&p).is_err() {
             return Err(SessionError::file(&p, "listed in the manifest but missing"));
         }
         tactex_core::text_file::regular(&p).map_err(|e| SessionError::file(&p, e))?;
@@ -177,7 +218,7 @@ pub fn open_session(
 
 /// What a recorded frame file holds: the recorder writes colour as 8-bit RGB and depth as
 /// one 16-bit channel.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
 enum FrameKind {
     Colour,
     Depth,
@@ -225,10 +266,49 @@ fn check_poses(manifest: &Manifest) -> Result<(), (String, String)> {
             .map(|(i, f)| (format!("tactile.frames[{i}].arm_pose"), &f.arm_pose)),
     );
     for (field, pose) in poses {
-        pose.check().map_err(|m| (field, m))?;
+        pose.check().map_err(|m| (field.clone(), m))?;
+        if pose.position.length() > MAX_PLACE_M {
+            return Err((
+                field,
+                format!(
+                    "position {} is more than {MAX_PLACE_M} m from the world's origin; a \
+                     session's poses lie in one workcell",
+                    pose.position
+                ),
+            ));
+        }
+    }
+    let times = [("arm.start_time_s".to_string(), manifest.arm.start_time_s)]
+        .into_iter()
+        .chain(
+            manifest
+                .arm
+                .moves
+                .iter()
+                .enumerate()
+                .map(|(i, m)| (format!("arm.moves[{i}].time_s"), m.time_s)),
+        );
+    for (field, time) in times {
+        if let Some(t) = time.filter(|t| !(t.is_finite() && t.abs() <= MAX_CLOCK_S)) {
+            return Err((
+                field,
+                format!(
+                    "{} is not a robot clock's time (seconds within 1e10)",
+                    tactex_core::printable::short_number(t)
+                ),
+            ));
+        }
     }
     Ok(())
 }
+
+/// The most frames a session may list: a question's few hundred, many times over.
+const MAX_SESSION_FRAMES: usize = 100_000;
+
+/// How far from the world's origin a recorded pose may lie: a workcell, generously.
+const MAX_PLACE_M: f64 = 100.0;
+/// The furthest a recorded robot clock may read (s): an epoch clock's 1.7e9 fits.
+const MAX_CLOCK_S: f64 = 1e10;
 
 /// The recorded robot clock, where the recorded backend had one of its own (the twin's
 /// simulated time): it stands at the time of the last frame or move given back, so a
@@ -369,16 +449,26 @@ impl Arm for ReplayArm {
             return Err(exhausted(&self.name, "moves", self.record.moves.len()));
         };
         let off = (m.target.position - target.position).length();
-        if off > MOVE_TOLERANCE_M || m.target.rotation.angle_between(target.rotation) > 1e-3 {
+        let turned = m.target.rotation.angle_between(target.rotation);
+        if off > MOVE_TOLERANCE_M || turned > 1e-3 {
             let p = |v: tactex_core::glam::DVec3| format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z);
-            return Err(failure(
-                &self.name,
+            // Name what differs: two equal positions say nothing of a turned tool.
+            let differs = if off > MOVE_TOLERANCE_M {
                 format!(
-                    "move {n} was recorded to {} m but is asked to {} m: this run diverged \
-                     from the recorded one",
+                    "was recorded to {} m but is asked to {} m",
                     p(m.target.position),
                     p(target.position)
-                ),
+                )
+            } else {
+                format!(
+                    "to {} m was recorded with the tool turned {:.3} degrees from the one asked",
+                    p(target.position),
+                    turned.to_degrees()
+                )
+            };
+            return Err(failure(
+                &self.name,
+                format!("move {n} {differs}: this run diverged from the recorded one"),
             ));
         }
         if (m.speed_m_s - speed_m_s).abs() > 1e-9 * m.speed_m_s.abs().max(1.0) {
@@ -395,7 +485,13 @@ impl Arm for ReplayArm {
         self.clock.set(m.time_s);
         match &m.error {
             // The recorded device refused or failed this move; the replay does the same.
-            Some(e) => Err(failure(&self.name, format!("recorded: {e}"))),
+            // Shown as one short line whatever the file holds.
+            Some(e) => {
+                let shown: String = e.chars().take(200).collect();
+                let more = if shown.len() < e.len() { " ..." } else { "" };
+                let shown = tactex_core::printable::printable(&shown);
+                Err(failure(&self.name, format!("recorded: {shown}{more}")))
+            }
             None => Ok(()),
         }
     }

@@ -157,6 +157,13 @@ fn replayed_devices_give_back_what_was_recorded_and_refuse_the_rest() {
         .move_linear(&Pose::tool_down(DVec3::new(0.2, 0.0, 0.05)), 0.01)
         .unwrap_err();
     assert!(err.to_string().contains("diverged"), "{err}");
+    let mut turned = goal;
+    turned.rotation *= tactex_core::glam::DQuat::from_rotation_z(0.1);
+    let err = a.move_linear(&turned, 0.01).unwrap_err().to_string();
+    assert!(
+        err.contains("turned 5.730 degrees") && err.contains("diverged"),
+        "{err}"
+    );
     a.move_linear(&goal, 0.01).unwrap();
     assert_eq!(a.pose().unwrap(), goal);
     for want in &touches {
@@ -264,11 +271,33 @@ fn a_session_no_device_could_have_recorded_is_refused_when_opened() {
     assert!(err.contains("arm.start_pose: rotation"), "{err}");
     let err = refused(&|m| m["camera"]["pose"]["rotation"] = serde_json::json!([0, 0, 0, 2]));
     assert!(err.contains("camera.pose: rotation"), "{err}");
+    let err = refused(&|m| m["camera"]["pose"]["position"] = serde_json::json!([1e308, 0, 0]));
+    assert!(err.contains("camera.pose: position"), "{err}");
+    let err = refused(&|m| m["camera"]["depth_scale_m"] = 1e308.into());
+    assert!(err.contains("camera.depth_scale_m: 1e308"), "{err}");
+    let err = refused(&|m| m["arm"]["start_time_s"] = (-1e308).into());
+    assert!(err.contains("arm.start_time_s: -1e308"), "{err}");
+    // One frame listed past any question's count is refused before a frame is decoded.
+    let err = refused(&|m| {
+        let frame = m["tactile"]["frames"][0].clone();
+        m["tactile"]["frames"] = serde_json::Value::Array(vec![frame; 100_001]);
+    });
+    assert!(
+        err.contains("manifest.json: frames: 100002 frames listed"),
+        "{err}"
+    );
     let err = refused(&|m| {
         m["twin"] = serde_json::json!({"scene_toml": "", "scene_path": "x", "seed": 1,
             "sensor": {"name": "GelSight Mini", "sha256": "ééééééééé"}})
     });
     assert!(err.contains("twin.sensor.sha256"), "{err}");
+    // Names shown in reports: one printable line.
+    let err = refused(&|m| m["backend"] = "sim\u{1b}[2J".into());
+    assert!(err.contains("manifest.json: backend:"), "{err}");
+    let err = refused(&|m| {
+        m["twin"] = serde_json::json!({"scene_toml": "", "scene_path": "x\u{202e}y", "seed": 1})
+    });
+    assert!(err.contains("manifest.json: twin.scene_path:"), "{err}");
 
     // Frames: each replaced by one no recorder writes, then put back.
     let frame = |file: &str, bytes: &[u8]| {
@@ -310,5 +339,13 @@ fn a_session_no_device_could_have_recorded_is_refused_when_opened() {
         std::os::unix::fs::symlink(&outside, dir.join("tactile/0000.png")).unwrap();
         let err = open_session(&dir).err().expect("refused").to_string();
         assert!(err.contains("out of the session folder"), "{err}");
+        // A link that loops is named for what it is, not as a missing frame.
+        std::fs::remove_file(dir.join("tactile/0000.png")).unwrap();
+        std::os::unix::fs::symlink("0000.png", dir.join("tactile/0000.png")).unwrap();
+        let err = open_session(&dir).err().expect("refused").to_string();
+        assert!(
+            err.contains("tactile/0000.png") && !err.contains("missing"),
+            "{err}"
+        );
     }
 }
