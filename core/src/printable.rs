@@ -44,6 +44,14 @@ pub fn printable(text: &str) -> String {
     out
 }
 
+/// At most `max_chars` of `text` from outside, `printable`, with " ..." where it was cut:
+/// an excerpt that keeps an error to one short line.
+pub fn excerpt(text: &str, max_chars: usize) -> String {
+    let kept: String = text.chars().take(max_chars).collect();
+    let cut = if kept.len() < text.len() { " ..." } else { "" };
+    format!("{}{cut}", printable(&kept))
+}
+
 /// A number shown short: 1e308 as "1e308", not 309 digits; everyday values as written.
 pub fn short_number(v: f64) -> String {
     if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
@@ -56,6 +64,13 @@ pub fn short_number(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_excerpt_is_short_printable_and_says_where_it_was_cut() {
+        assert_eq!(excerpt("f 1 2", 60), "f 1 2");
+        assert_eq!(excerpt("a\u{1b}[2Jbcdef", 4), "a\\u{1b}[2 ...");
+        assert_eq!(excerpt("ééé", 3), "ééé");
+    }
 
     #[test]
     fn escape_sequences_and_line_breaks_are_shown_not_acted_on() {

@@ -4,6 +4,7 @@ use glam::{DQuat, DVec3};
 use std::f64::consts::PI;
 use std::path::Path;
 use tactex_core::catalog::FruitShape;
+use tactex_core::printable::excerpt;
 use tactex_core::text_file;
 
 #[derive(Clone, Debug, Default)]
@@ -598,11 +599,16 @@ fn obj_line_problem(text: &str) -> Option<String> {
         let (kind, rest) = (words.next(), words);
         let numbers = |wanted: usize, what: &str, rest: std::str::SplitWhitespace| {
             let read: Vec<&str> = rest.take(wanted).collect();
+            let needs = if wanted == 1 {
+                "a number".to_string()
+            } else {
+                format!("{wanted} numbers")
+            };
             (read.len() < wanted || read.iter().any(|w| w.parse::<f32>().is_err())).then(|| {
                 format!(
-                    "line {}: {what} needs {wanted} numbers, has '{}'",
+                    "line {}: {what} needs {needs}, has '{}'",
                     n + 1,
-                    shown_excerpt(line)
+                    excerpt(line, 60)
                 )
             })
         };
@@ -642,7 +648,7 @@ fn obj_line_problem(text: &str) -> Option<String> {
                                 "line {}: face corner '{}' names no vertex read before it \
                                  (1-based, or negative from the last)",
                                 n + 1,
-                                shown_excerpt(corner)
+                                excerpt(corner, 60)
                             )
                         })
                     })
@@ -655,11 +661,6 @@ fn obj_line_problem(text: &str) -> Option<String> {
         }
     }
     None
-}
-
-/// Text from the file as one short, printable excerpt of an error line.
-fn shown_excerpt(text: &str) -> String {
-    tactex_core::printable::printable(&text.chars().take(60).collect::<String>())
 }
 
 /// Every primitive's POSITION names an accessor the file has.

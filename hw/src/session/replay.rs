@@ -64,9 +64,7 @@ pub fn open_session(
             "twin.scene_path",
             format!(
                 "'{}' holds control or hidden characters; it is shown in reports",
-                tactex_core::printable::printable(
-                    &twin.scene_path.chars().take(60).collect::<String>()
-                )
+                tactex_core::printable::excerpt(&twin.scene_path, 60)
             ),
         ));
     }
@@ -486,12 +484,10 @@ impl Arm for ReplayArm {
         match &m.error {
             // The recorded device refused or failed this move; the replay does the same.
             // Shown as one short line whatever the file holds.
-            Some(e) => {
-                let shown: String = e.chars().take(200).collect();
-                let more = if shown.len() < e.len() { " ..." } else { "" };
-                let shown = tactex_core::printable::printable(&shown);
-                Err(failure(&self.name, format!("recorded: {shown}{more}")))
-            }
+            Some(e) => Err(failure(
+                &self.name,
+                format!("recorded: {}", tactex_core::printable::excerpt(e, 200)),
+            )),
             None => Ok(()),
         }
     }
