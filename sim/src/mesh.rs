@@ -714,6 +714,75 @@ fn accessor_in_buffer(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Res
     Ok(())
 }
 
+/// An accessor's sparse substitutions, checked where gltf's reader does not: a count past
+/// the accessor's read as no triangles, an index past its elements was dropped without a
+/// word, and the indices' and values' views must hold what they are said to.
+fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Result<(), String> {
+    let Some(sparse) = a.sparse() else {
+        return Ok(());
+    };
+    let n = sparse.count();
+    if n > a.count() {
+        return Err(format!(
+            "accessor {}: sparse.count {n} is more than its {} elements",
+            a.index(),
+            a.count()
+        ));
+    }
+    // The bytes of a sparse part's view from `offset`, if `needed` of them are there.
+    let bytes = |view: gltf::buffer::View, offset: usize, needed: Option<usize>, part: &str| {
+        let held = buffers.get(view.buffer().index()).map(|d| &d.0[..]);
+        let start = view.offset().checked_add(offset);
+        let end = start.zip(needed).and_then(|(s, n)| s.checked_add(n));
+        match (held, start, end) {
+            (Some(held), Some(start), Some(end))
+                if offset <= view.length()
+                    && needed.is_some_and(|n| n <= view.length() - offset)
+                    && end <= held.len() =>
+            {
+                Ok(&held[start..end])
+            }
+            _ => Err(format!(
+                "accessor {}: sparse.{part} needs {} bytes of buffer view {} ({} bytes at {})",
+                a.index(),
+                needed.map_or("more than 2^64".into(), |n| n.to_string()),
+                view.index(),
+                view.length(),
+                view.offset()
+            )),
+        }
+    };
+    let indices = sparse.indices();
+    let size = indices.index_type().size();
+    let raw = bytes(
+        indices.view(),
+        indices.offset(),
+        n.checked_mul(size),
+        "indices",
+    )?;
+    let values = sparse.values();
+    bytes(
+        values.view(),
+        values.offset(),
+        n.checked_mul(a.size()),
+        "values",
+    )?;
+    for (k, chunk) in raw.chunks_exact(size).enumerate() {
+        let index = chunk
+            .iter()
+            .rev()
+            .fold(0usize, |v, b| (v << 8) | *b as usize);
+        if index >= a.count() {
+            return Err(format!(
+                "accessor {}: sparse.indices[{k}] is {index}, past its {} elements",
+                a.index(),
+                a.count()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The triangles of every node under `roots`, walked without recursion: a node reached
 /// twice (a cycle, or a child shared by two parents, which glTF forbids) is refused, as is
 /// an accessor whose stride is shorter than its element or whose count alone passes the
@@ -803,6 +872,7 @@ fn gltf_nodes<'a>(
                 {
                     readable(&accessor)?;
                     accessor_in_buffer(&accessor, buffers)?;
+                    sparse_in_bounds(&accessor, buffers)?;
                 }
                 let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
                 let Some(positions) = reader.read_positions() else {
@@ -962,6 +1032,64 @@ mod tests {
 {{"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}}]}}"#
         );
         (json, bin)
+    }
+
+    #[test]
+    fn a_sparse_accessor_reaching_past_its_elements_or_its_views_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let (json, bin) = tetra_gltf("tetra.bin");
+        // One sparse substitution: its index (u16) at byte 72, its VEC3 value at 76.
+        let sparse_bin = |index: u16| {
+            let mut b = bin.clone();
+            b.extend(index.to_le_bytes());
+            b.extend([0u8; 2]);
+            b.extend([0.01f32, 0.0, 0.0].iter().flat_map(|x| x.to_le_bytes()));
+            b
+        };
+        let with_sparse = |sparse: &str| {
+            json.replace(r#""byteLength":72,"#, r#""byteLength":88,"#)
+                .replace(
+                    r#"{"buffer":0,"byteOffset":48,"byteLength":24}]"#,
+                    r#"{"buffer":0,"byteOffset":48,"byteLength":24},{"buffer":0,"byteOffset":72,"byteLength":2},{"buffer":0,"byteOffset":76,"byteLength":12}]"#,
+                )
+                .replace(r#""min":[0,0,0]}"#, &format!(r#""min":[0,0,0],"sparse":{sparse}}}"#))
+        };
+        let one = r#"{"count":1,"indices":{"bufferView":2,"componentType":5123},"values":{"bufferView":3}}"#;
+        let load_with = |index: u16, sparse: &str| {
+            std::fs::write(dir.path().join("tetra.bin"), sparse_bin(index)).unwrap();
+            let path = dir.path().join("sparse.gltf");
+            std::fs::write(&path, with_sparse(sparse)).unwrap();
+            load(&path).map_err(|e| e.to_string())
+        };
+        // A substitution inside the accessor is read: vertex 1 moved to x = 1 cm.
+        let moved = load_with(1, one).unwrap();
+        assert!(
+            moved.vertices.iter().any(|v| (v.x - 0.01).abs() < 1e-9),
+            "{:?}",
+            moved.vertices
+        );
+        let past = load_with(100, one).unwrap_err();
+        assert!(
+            past.contains("sparse.indices[0] is 100, past its 4 elements"),
+            "{past}"
+        );
+        let many = load_with(1, &one.replace(r#""count":1"#, r#""count":1000"#)).unwrap_err();
+        assert!(
+            many.contains("sparse.count 1000 is more than its 4 elements"),
+            "{many}"
+        );
+        let far = load_with(
+            1,
+            &one.replace(
+                r#""values":{"bufferView":3}"#,
+                r#""values":{"bufferView":3,"byteOffset":8}"#,
+            ),
+        )
+        .unwrap_err();
+        assert!(
+            far.contains("sparse.values needs 12 bytes of buffer view 3"),
+            "{far}"
+        );
     }
 
     #[test]
