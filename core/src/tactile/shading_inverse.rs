@@ -13,11 +13,24 @@ pub struct ShadingRow<'a> {
     /// The ring's slopes, and each one's change as quadratics in u, per channel: a slope's
     /// bin is fixed, so its change along the row is its four nodes' quadratics, weighted.
     ring: Vec<((f32, f32), ChangeAlongRow)>,
+    /// The bins of the flat gel and of the four slopes a descent from it differences over
+    /// (+h, -h along gx, then gy): every pixel's read looks the flat gel up, so these are
+    /// placed once a row.
+    at_flat: [BinPosition; 5],
 }
 
-/// A lookup of the descent: the cost, the residual and the change's derivatives along gx
-/// and gy.
-type Local = (f32, [f32; 3], [f32; 3], [f32; 3]);
+/// A slope read from the table, and where it falls among the table's nodes: the next pixel's
+/// descent starts from it without placing it again.
+#[derive(Clone, Copy, Debug)]
+pub struct ReadSlope {
+    pub gx: f32,
+    pub gy: f32,
+    bin: BinPosition,
+}
+
+/// A lookup of the descent: the cost, the residual, the change's derivatives along gx and gy,
+/// and the slope's bin.
+type Local = (f32, [f32; 3], [f32; 3], [f32; 3], BinPosition);
 
 /// A change as quadratics in u, per channel: [a0, a1, a2] for a0 + u (a1 + u a2).
 type ChangeAlongRow = [[f32; 3]; 3];
@@ -26,6 +39,9 @@ type ChangeAlongRow = [[f32; 3]; 3];
 /// ring a descent left unexplained is searched again from.
 const RING_MAGNITUDES: [f32; 5] = [0.1, 0.3, 0.6, 1.0, 1.6];
 const RING_DIRECTIONS: usize = 12;
+
+/// The step of the central differences at the flat gel, as a fraction of the table's range.
+const FLAT_DIFFERENCE: f32 = 1e-3;
 
 impl ShadingTable {
     /// The table collapsed to normalised row position `v`, for shading a row forwards: each
@@ -37,10 +53,28 @@ impl ShadingTable {
             .chunks_exact(TERMS)
             .map(|t| [t[0] + t[2] * v + t[5] * v * v, t[1] + t[4] * v, t[3]])
             .collect();
+        let h = FLAT_DIFFERENCE * self.mag_max;
+        let at = |gx: f32, gy: f32| {
+            bin_position_at(
+                self.mag_bins,
+                self.dir_bins,
+                self.mag_max,
+                gx,
+                gy,
+                direction(gy, gx),
+            )
+        };
         ShadingRow {
             table: self,
             poly,
             ring: Vec::new(),
+            at_flat: [
+                at(0.0, 0.0),
+                at(h, 0.0),
+                at(-h, 0.0),
+                at(0.0, h),
+                at(0.0, -h),
+            ],
         }
     }
 
@@ -110,6 +144,18 @@ impl ShadingRow<'_> {
         bin_position_at(t.mag_bins, t.dir_bins, t.mag_max, gx, gy, direction(gy, gx))
     }
 
+    /// The table's change at the slope placed at `b`, position u along the row.
+    fn change_in(&self, b: &BinPosition, u: f32) -> [f32; 3] {
+        let n = self.corners(b, u);
+        let mut out = [0.0f32; 3];
+        for (o, [n00, n01, n10, n11]) in out.iter_mut().zip(n) {
+            let lo = n00 * (1.0 - b.td) + n01 * b.td;
+            let hi = n10 * (1.0 - b.td) + n11 * b.td;
+            *o = lo * (1.0 - b.tm) + hi * b.tm;
+        }
+        out
+    }
+
     /// The four nodes around `b` (n00, n01, n10, n11), as indices of their channel 0 in `poly`.
     fn nodes(&self, b: &BinPosition) -> [usize; 4] {
         let dir_bins = self.table.dir_bins;
@@ -137,23 +183,26 @@ impl ShadingRow<'_> {
 
     /// The table's change at slope (gx, gy) and position u along the row.
     pub fn change(&self, gx: f32, gy: f32, u: f32) -> [f32; 3] {
-        let b = self.bin(gx, gy);
-        let n = self.corners(&b, u);
-        let mut out = [0.0f32; 3];
-        for (o, [n00, n01, n10, n11]) in out.iter_mut().zip(n) {
-            let lo = n00 * (1.0 - b.td) + n01 * b.td;
-            let hi = n10 * (1.0 - b.td) + n11 * b.td;
-            *o = lo * (1.0 - b.tm) + hi * b.tm;
-        }
-        out
+        self.change_in(&self.bin(gx, gy), u)
     }
 
     /// `change` and its derivatives along gx and gy, from one lookup of the four nodes (the
     /// inverse's Gauss-Newton needs all three at every step). Away from the flat gel only:
     /// at gx = gy = 0 the direction, and so the derivative, is undefined.
+    #[cfg(test)]
     fn change_with_derivatives(&self, gx: f32, gy: f32, u: f32) -> ([f32; 3], [f32; 3], [f32; 3]) {
+        self.change_with_derivatives_in(&self.bin(gx, gy), gx, gy, u)
+    }
+
+    /// `change_with_derivatives` at a slope already placed at `b`.
+    fn change_with_derivatives_in(
+        &self,
+        b: &BinPosition,
+        gx: f32,
+        gy: f32,
+        u: f32,
+    ) -> ([f32; 3], [f32; 3], [f32; 3]) {
         let t = self.table;
-        let b = self.bin(gx, gy);
         let mag2 = gx * gx + gy * gy;
         let mag = mag2.sqrt();
         // d tm / d g and d td / d g: magnitude is clamped at mag_max, direction wraps.
@@ -164,7 +213,7 @@ impl ShadingRow<'_> {
         };
         let dtd = t.dir_bins as f32 / TAU / mag2;
         let (mut c, mut jx, mut jy) = ([0.0f32; 3], [0.0f32; 3], [0.0f32; 3]);
-        for (k, [n00, n01, n10, n11]) in self.corners(&b, u).into_iter().enumerate() {
+        for (k, [n00, n01, n10, n11]) in self.corners(b, u).into_iter().enumerate() {
             let lo = n00 * (1.0 - b.td) + n01 * b.td;
             let hi = n10 * (1.0 - b.td) + n11 * b.td;
             c[k] = lo * (1.0 - b.tm) + hi * b.tm;
@@ -191,47 +240,74 @@ impl ShadingRow<'_> {
         u: f32,
         prior: f32,
         max_rms: f32,
-        near: Option<(f32, f32)>,
-    ) -> Option<(f32, f32)> {
+        near: Option<ReadSlope>,
+    ) -> Option<ReadSlope> {
         let mag_max = self.table.mag_max;
-        let residual = |gx: f32, gy: f32| {
-            let c = self.change(gx, gy, u);
+        let residual_in = |b: &BinPosition| {
+            let c = self.change_in(b, u);
             [c[0] - change[0], c[1] - change[1], c[2] - change[2]]
         };
+        let residual = |gx: f32, gy: f32| residual_in(&self.bin(gx, gy));
         let norm2 = |r: [f32; 3]| r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        let cost = |gx: f32, gy: f32| norm2(residual(gx, gy)) + prior * (gx * gx + gy * gy);
-        let flat = cost(0.0, 0.0);
+        let [at_flat, at_xp, at_xm, at_yp, at_ym] = &self.at_flat;
+        let flat_change = self.change_in(at_flat, u);
+        let flat_residual: [f32; 3] = std::array::from_fn(|c| flat_change[c] - change[c]);
+        let flat = norm2(flat_residual) + prior * (0.0f32 * 0.0 + 0.0f32 * 0.0);
         // A flat gel shows no change: most of a stock-sensor press frame ends here.
         if flat <= 3.0 * 0.25 {
-            return Some((0.0, 0.0));
+            return Some(ReadSlope {
+                gx: 0.0,
+                gy: 0.0,
+                bin: *at_flat,
+            });
         }
-        let h = 1e-3f32 * mag_max;
-        // The change, the cost and the change's derivatives at a slope: analytic derivatives
-        // of the bilinear lookup, except at the flat gel, where the table is a cone with no
-        // gradient: there central differences average the directions, which is what lets the
-        // descent leave the apex.
-        let local = |gx: f32, gy: f32| -> Local {
-            let (c, jx, jy) = if gx * gx + gy * gy > h * h {
-                self.change_with_derivatives(gx, gy, u)
+        let h = FLAT_DIFFERENCE * mag_max;
+        // The change, the cost and the change's derivatives at a slope (placed at `placed`
+        // when known): analytic derivatives of the bilinear lookup, except at the flat gel,
+        // where the table is a cone with no gradient: there central differences average the
+        // directions, which is what lets the descent leave the apex.
+        let local = |gx: f32, gy: f32, placed: Option<&BinPosition>| -> Local {
+            let (c, jx, jy, b) = if gx * gx + gy * gy > h * h {
+                let b = placed.copied().unwrap_or_else(|| self.bin(gx, gy));
+                let (c, jx, jy) = self.change_with_derivatives_in(&b, gx, gy, u);
+                (c, jx, jy, b)
             } else {
-                let dx = residual(gx + h, gy);
-                let dxm = residual(gx - h, gy);
-                let dy = residual(gx, gy + h);
-                let dym = residual(gx, gy - h);
+                // At the flat gel itself the five slopes are the row's, already placed.
+                let (c, dx, dxm, dy, dym, b) = if gx == 0.0 && gy == 0.0 {
+                    (
+                        flat_change,
+                        residual_in(at_xp),
+                        residual_in(at_xm),
+                        residual_in(at_yp),
+                        residual_in(at_ym),
+                        *at_flat,
+                    )
+                } else {
+                    let b = self.bin(gx, gy);
+                    (
+                        self.change_in(&b, u),
+                        residual(gx + h, gy),
+                        residual(gx - h, gy),
+                        residual(gx, gy + h),
+                        residual(gx, gy - h),
+                        b,
+                    )
+                };
                 (
-                    self.change(gx, gy, u),
+                    c,
                     std::array::from_fn(|c| (dx[c] - dxm[c]) / (2.0 * h)),
                     std::array::from_fn(|c| (dy[c] - dym[c]) / (2.0 * h)),
+                    b,
                 )
             };
             let r: [f32; 3] = [c[0] - change[0], c[1] - change[1], c[2] - change[2]];
-            (norm2(r) + prior * (gx * gx + gy * gy), r, jx, jy)
+            (norm2(r) + prior * (gx * gx + gy * gy), r, jx, jy, b)
         };
-        // From a start and its lookup to the slope, its cost and its residual (which the
-        // final check reuses: every lookup is kept, none made twice).
+        // From a start and its lookup to the slope, its cost, its residual (which the final
+        // check reuses: every lookup is kept, none made twice) and its bin.
         let descend = |(mut gx, mut gy): (f32, f32), at_start: Local| {
             let mut damping = 1e-2f32;
-            let (mut err, mut r, mut jx, mut jy) = at_start;
+            let (mut err, mut r, mut jx, mut jy, mut bin) = at_start;
             for _ in 0..20 {
                 let dot = |a: [f32; 3], b: [f32; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
                 let (a, b, d) = (dot(jx, jx) + prior, dot(jx, jy), dot(jy, jy) + prior);
@@ -246,14 +322,14 @@ impl ShadingRow<'_> {
                     }
                     let (sx, sy) = ((d2 * ex - b * ey) / det, (a2 * ey - b * ex) / det);
                     // The trial's derivatives come with its lookup, ready for the next step.
-                    let trial = local(gx + sx, gy + sy);
+                    let trial = local(gx + sx, gy + sy, None);
                     if trial.0 < err {
                         gx += sx;
                         gy += sy;
                         // A thousandth of a unit of slope is a fortieth of a grey level.
                         let converged =
                             (sx * sx + sy * sy).sqrt() < 1e-3 || err - trial.0 < 1e-4 * err;
-                        (err, r, jx, jy) = trial;
+                        (err, r, jx, jy, bin) = trial;
                         damping = (damping / 3.0).max(1e-6);
                         stepped = !converged;
                         break;
@@ -264,13 +340,13 @@ impl ShadingRow<'_> {
                     break;
                 }
             }
-            (gx, gy, err, r)
+            (gx, gy, err, r, bin)
         };
         // The better start of the flat gel and `near`, whose lookup the descent begins with.
-        let from_near = near.map(|(nx, ny)| ((nx, ny), local(nx, ny)));
+        let from_near = near.map(|n| ((n.gx, n.gy), local(n.gx, n.gy, Some(&n.bin))));
         let mut best = match from_near {
             Some((g, at)) if at.0 < flat => descend(g, at),
-            _ => descend((0.0, 0.0), local(0.0, 0.0)),
+            _ => descend((0.0, 0.0), local(0.0, 0.0, None)),
         };
         // Left over after the descent: more than a camera's noise (4 grey levels a channel)
         // may be a local minimum, so the ring's global start gets its chance.
@@ -287,14 +363,14 @@ impl ShadingRow<'_> {
                 }
             }
             if ring.2 < best.2 {
-                let again = descend((ring.0, ring.1), local(ring.0, ring.1));
+                let again = descend((ring.0, ring.1), local(ring.0, ring.1, None));
                 if again.2 < best.2 {
                     best = again;
                 }
             }
         }
-        let (gx, gy, _, r) = best;
-        ((norm2(r) / 3.0).sqrt() <= max_rms).then_some((gx, gy))
+        let (gx, gy, _, r, bin) = best;
+        ((norm2(r) / 3.0).sqrt() <= max_rms).then_some(ReadSlope { gx, gy, bin })
     }
 }
 
@@ -344,6 +420,7 @@ mod tests {
                 let (rx, ry) = table
                     .row(v)
                     .slope_for_change(change, u, 0.0, 1.0, None)
+                    .map(|s| (s.gx, s.gy))
                     .unwrap();
                 let tol = 0.02 + 0.03 * (gx * gx + gy * gy).sqrt();
                 assert!(

@@ -498,7 +498,7 @@ fn read_row(
         }
         let (u, _) = frame_position(x as u32, y as u32, w as u32, h as u32);
         let read = row.slope_for_change(change[x], u, TABLE_SLOPE_PRIOR, TABLE_MAX_RMS, near);
-        (gx[x], gy[x]) = read.unwrap_or((0.0, 0.0));
+        (gx[x], gy[x]) = read.map_or((0.0, 0.0), |s| (s.gx, s.gy));
         valid[x] = read.is_some();
         near = read;
     }
