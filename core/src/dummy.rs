@@ -60,6 +60,7 @@ impl DummyWorld {
                 centre: (48.0, 40.0),
                 object_m: None,
                 shows: true,
+                blown_out_from_mm: None,
                 spec: TactileSpec::gelsight_mini(),
             },
             arm: DummyArm {
@@ -152,6 +153,9 @@ pub struct DummyGel {
     pub object_m: Option<(f64, f64)>,
     /// Whether the gel ever shows a contact.
     pub shows: bool,
+    /// A frame taken this far (mm) or more below the apple's top is blown out (every pixel
+    /// 255); None: never. Below the top's height (a negative depth) every frame is.
+    pub blown_out_from_mm: Option<f64>,
     pub spec: TactileSpec,
 }
 /// Where the pad is, shared by the gel and whichever arm moves the pad.
@@ -206,8 +210,12 @@ impl TactileSensor for DummyGel {
                 40.0 - (oy - py) * 1e3 / mm_per_px,
             )
         });
+        let blown_out = self.blown_out_from_mm.is_some_and(|d| depth_mm >= d);
         Ok(TactileFrame {
             image: RgbImage::from_fn(96, 80, |x, y| {
+                if blown_out {
+                    return Rgb([255; 3]);
+                }
                 let base = 120 + ((x * 7 + y * 13) % 17) as u8;
                 let r = (x as f64 - centre.0).hypot(y as f64 - centre.1);
                 if r < radius {

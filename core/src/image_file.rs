@@ -68,7 +68,12 @@ pub fn tactile_frame_fault(decoded: &DynamicImage) -> Option<String> {
                 .into(),
         );
     }
-    let frame = decoded.to_rgb8();
+    rgb_frame_fault(&decoded.to_rgb8())
+}
+
+/// Why a colour frame (a file's, or a sensor's as captured) carries no shading to read, if it
+/// carries none: more than half saturated, or featureless (a blank frame, the LEDs off).
+pub fn rgb_frame_fault(frame: &image::RgbImage) -> Option<String> {
     let saturated = frame.pixels().filter(|p| p.0.contains(&255)).count();
     if 2 * saturated > frame.pixels().len() {
         return Some(format!(
@@ -76,7 +81,7 @@ pub fn tactile_frame_fault(decoded: &DynamicImage) -> Option<String> {
             100.0 * saturated as f64 / frame.pixels().len() as f64
         ));
     }
-    let spread = spread_grey(&frame);
+    let spread = spread_grey(frame);
     (spread < MIN_SPREAD_GREY).then(|| {
         format!(
             "featureless (98% of its pixels within {spread} grey levels in every channel); a tactile frame shows its gel's shading and markers"

@@ -55,6 +55,9 @@ pub enum NotMeasuredReason {
     ImprintCut,
     /// The estimator could not read the press.
     Estimator,
+    /// A frame of the press (its no-contact reference or a pressed one) carries no shading:
+    /// blank, or blown out. Read, it would show a deep imprint everywhere.
+    UnreadableFrame,
     /// The press was read, but where the estimator cannot resolve a modulus (its fit failed,
     /// or the object is too soft against the gel): no number is better than a wrong one.
     OutsideCompetence,

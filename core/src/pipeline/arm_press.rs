@@ -37,6 +37,9 @@ pub(super) struct ArmProbe<'d, T: TactileSensor, A: Arm> {
     pad_yaw_rad: f64,
     start_z_m: f64,
     config: &'d PipelineConfig,
+    /// Why the no-contact reference carries no shading, if it carries none: a search
+    /// against it ends in 'no contact', which would not say why.
+    reference_fault: Option<String>,
 }
 
 impl<T: TactileSensor, A: Arm> ArmProbe<'_, T, A> {
@@ -65,6 +68,9 @@ impl<T: TactileSensor, A: Arm> PressProbe for ArmProbe<'_, T, A> {
             Look::Search(k) => k,
         };
         let (frame, z) = self.lowered(k)?;
+        if at == Look::Reference {
+            self.reference_fault = crate::image_file::rgb_frame_fault(&frame.image);
+        }
         Ok((frame.image.clone(), (frame, z)))
     }
 
@@ -221,10 +227,23 @@ pub(super) fn press_at<T: TactileSensor, A: Arm>(
         pad_yaw_rad: target.pad_yaw_rad,
         start_z_m,
         config,
+        reference_fault: None,
     };
     let outcome = run_press(&protocol, &mut probe);
+    let reference_fault = probe.reference_fault.take();
     // Whatever happened below, the pad goes back up before the next object.
     arm.move_linear(&safe, config.travel_speed_m_s)?;
+    let unreadable = |which: &str, why: String| {
+        Attempt::NotMeasured(NotMeasured {
+            reason: NotMeasuredReason::UnreadableFrame,
+            detail: format!("the tactile sensor's {which} cannot be read: {why}"),
+        })
+    };
+    // A sensor whose LEDs failed, or a camera blown out, gives frames that read as a deep
+    // imprint everywhere (or as no contact at all): that object is not measured, with why.
+    if let Some(why) = reference_fault {
+        return Ok(unreadable("no-contact frame", why));
+    }
     let pressed = match outcome {
         Ok(PressOutcome::Pressed(p)) => p,
         Ok(PressOutcome::NoContact { travel_mm, .. }) => {
@@ -238,6 +257,12 @@ pub(super) fn press_at<T: TactileSensor, A: Arm>(
         }
     };
     let (reference, _) = pressed.reference;
+    let faulty = pressed.frames.iter().enumerate().find_map(|(k, (f, _))| {
+        crate::image_file::rgb_frame_fault(&f.image).map(|why| (k, why))
+    });
+    if let Some((k, why)) = faulty {
+        return Ok(unreadable(&format!("pressed frame {}", k + 1), why));
+    }
     let contact_z = pressed.frames[0].1;
     let travel_mm = pressed
         .frames

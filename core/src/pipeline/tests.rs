@@ -118,6 +118,37 @@ fn a_gel_that_never_changes_is_no_contact_not_a_failed_question() {
 }
 
 #[test]
+fn a_blown_out_or_blank_sensor_is_an_unreadable_frame_not_an_imprint_or_no_contact() {
+    for (from_mm, which) in [
+        (1.0, "pressed frame 5 cannot be read: 100% of its pixels are saturated"),
+        (-1e3, "no-contact frame cannot be read: 100% of its pixels are saturated"),
+    ] {
+        let mut world = DummyWorld::apple();
+        world.tactile.blown_out_from_mm = Some(from_mm);
+        let a = answer(
+            "How hard is the apple?",
+            &FruitCatalog::builtin(),
+            Devices {
+                camera: &mut world.camera,
+                tactile: &mut world.tactile,
+                arm: &mut world.arm,
+            },
+            &world.detector,
+            &FixedEstimator::new(2.0),
+            Language::OFFLINE,
+            &PipelineConfig::default(),
+        )
+        .expect("the question is answered");
+        let o = &a.objects[0];
+        let why = o.not_measured.as_ref().unwrap();
+        assert_eq!(why.reason, NotMeasuredReason::UnreadableFrame, "{why:?}");
+        assert!(why.detail.contains(which), "{}", why.detail);
+        assert!(o.hardness.is_none());
+        assert!(a.answer.contains("could not measure"), "{}", a.answer);
+    }
+}
+
+#[test]
 fn a_refused_move_is_reported_with_the_arms_reason() {
     // The arm will not go below 1 mm above the apple's top: the search is cut short.
     let a = ask((48.0, 40.0), true, TOP_M + 0.001);
