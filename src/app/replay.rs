@@ -2,7 +2,7 @@
 
 use crate::app::detector_choice::DetectorChoice;
 use crate::app::question::Question;
-use crate::app::twin_options::OpenedTwin;
+use crate::app::twin_options::TwinOptions;
 use anyhow::{Context, Result, anyhow, bail};
 use std::path::Path;
 use tactex_core::catalog::FruitCatalog;
@@ -12,14 +12,14 @@ use tactex_hw::session::{MANIFEST, open_session};
 use tactex_sim::contact::Fidelity;
 
 /// Answers `prompt` from the recorded session in `dir`: its frames in the order they were
-/// taken, its moves checked against the pipeline's.
+/// taken, its moves checked against the pipeline's. The estimates' intervals are the ones
+/// calibrated at the session's fidelity, where it was recorded on the twin.
 pub fn answer_on_replay(
     dir: &Path,
-    opened: &OpenedTwin,
+    options: &TwinOptions,
     prompt: &str,
     config: &PipelineConfig,
 ) -> Result<Answer> {
-    let choice = &opened.detector;
     let catalog = FruitCatalog::builtin();
     let (manifest, mut camera, mut tactile, mut arm) = open_session(dir).context("--session")?;
     // A session recorded on the twin says at which fidelity, and the answer repeats it.
@@ -33,7 +33,12 @@ pub fn answer_on_replay(
         })?),
         None => None,
     };
-    let detector = detector_without_truth(choice, &catalog)?;
+    let opened = TwinOptions {
+        fidelity: fidelity.unwrap_or(options.fidelity),
+        ..options.clone()
+    }
+    .open()?;
+    let detector = detector_without_truth(&opened.detector, &catalog)?;
     let question = Question {
         prompt,
         catalog: &catalog,

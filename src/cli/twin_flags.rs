@@ -38,10 +38,11 @@ pub struct TwinFlags {
     /// --parser llm.
     #[arg(long)]
     pub llm_config: Option<PathBuf>,
-    /// Contact physics of the sim GelSight: rigid, hertz, halfspace or layer (the bonded
-    /// 4 mm gel, the most faithful; see `tactex bench contact` for what each costs).
-    #[arg(long, default_value = "layer")]
-    pub fidelity: Fidelity,
+    /// Contact physics of the sim GelSight: rigid, hertz, halfspace or layer (the default:
+    /// the bonded 4 mm gel, the most faithful; see `tactex bench contact` for what each
+    /// costs). A replay's is its session's.
+    #[arg(long)]
+    pub fidelity: Option<Fidelity>,
     /// Hardness estimator that reads the presses: learned (the built-in model),
     /// indentation, hertz or FILE.onnx (a model with its card FILE.json beside it).
     #[arg(long, default_value = DEFAULT_ESTIMATOR)]
@@ -79,7 +80,7 @@ impl TwinFlags {
             explainer: self.explainer,
             parser: self.parser,
             llm_config: self.llm_config.clone(),
-            fidelity: self.fidelity,
+            fidelity: self.fidelity.unwrap_or(Fidelity::Layer),
             estimator: self.estimator.clone(),
             intervals: self.intervals.clone(),
             sensor: self.sensor.clone(),

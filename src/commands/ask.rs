@@ -198,8 +198,7 @@ pub fn answer(args: &AskRequest) -> Result<Answer> {
                     "--scene: only with --backend sim (a replay's objects are the ones its session recorded)"
                 );
             }
-            let opened = args.twin.open()?;
-            answer_on_replay(dir, &opened, &args.prompt, &config)?
+            answer_on_replay(dir, &args.twin, &args.prompt, &config)?
         }
         Backend::Sim => {
             if args.session.is_some() {
@@ -230,6 +229,12 @@ pub fn answer(args: &AskRequest) -> Result<Answer> {
 }
 
 pub(crate) fn run(args: &AskArgs) -> Result<()> {
+    if let (Backend::Replay, Some(f)) = (args.backend, args.twin.fidelity) {
+        bail!(
+            "--fidelity {}: a replay reads the frames its session recorded, at the session's fidelity; the flag is for --backend sim",
+            f.name()
+        );
+    }
     let answer = answer(&args.request())?;
     print_json_or_text(&answer, args.json, || {
         print_answer(&answer);

@@ -206,6 +206,23 @@ fn broken_or_missing_sessions_and_misused_flags_are_one_line_errors() {
         p,
     ]);
     assert!(one_line_error(&out).contains("--scene: only with --backend sim"));
+    // The frames were rendered at the session's fidelity: another one is refused, not
+    // reported as the session's while its intervals are another's.
+    let out = tactex(&[
+        "ask",
+        "--backend",
+        "replay",
+        "--session",
+        d,
+        "--fidelity",
+        "rigid",
+        p,
+    ]);
+    let stderr = one_line_error(&out);
+    assert!(
+        stderr.contains("--fidelity rigid: a replay reads the frames its session recorded"),
+        "{stderr}"
+    );
 }
 
 fn compare_session(dir: &Path, extra: &[&str]) -> Output {
