@@ -257,9 +257,10 @@ pub(super) fn press_at<T: TactileSensor, A: Arm>(
         }
     };
     let (reference, _) = pressed.reference;
-    let faulty = pressed.frames.iter().enumerate().find_map(|(k, (f, _))| {
-        crate::image_file::rgb_frame_fault(&f.image).map(|why| (k, why))
-    });
+    let faulty =
+        pressed.frames.iter().enumerate().find_map(|(k, (f, _))| {
+            crate::image_file::rgb_frame_fault(&f.image).map(|why| (k, why))
+        });
     if let Some((k, why)) = faulty {
         return Ok(unreadable(&format!("pressed frame {}", k + 1), why));
     }

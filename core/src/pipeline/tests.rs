@@ -120,8 +120,14 @@ fn a_gel_that_never_changes_is_no_contact_not_a_failed_question() {
 #[test]
 fn a_blown_out_or_blank_sensor_is_an_unreadable_frame_not_an_imprint_or_no_contact() {
     for (from_mm, which) in [
-        (1.0, "pressed frame 5 cannot be read: 100% of its pixels are saturated"),
-        (-1e3, "no-contact frame cannot be read: 100% of its pixels are saturated"),
+        (
+            1.0,
+            "pressed frame 5 cannot be read: 100% of its pixels are saturated",
+        ),
+        (
+            -1e3,
+            "no-contact frame cannot be read: 100% of its pixels are saturated",
+        ),
     ] {
         let mut world = DummyWorld::apple();
         world.tactile.blown_out_from_mm = Some(from_mm);

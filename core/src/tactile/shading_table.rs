@@ -71,6 +71,7 @@ fn bin_position(mag_bins: u32, dir_bins: u32, mag_max: f32, gx: f32, gy: f32) ->
     bin_position_at(mag_bins, dir_bins, mag_max, gx, gy, gy.atan2(gx))
 }
 
+#[inline(always)]
 pub(super) fn bin_position_at(
     mag_bins: u32,
     dir_bins: u32,

@@ -116,8 +116,10 @@ struct ShadedFrame<'a> {
     p: &'a RenderParams,
     optics: &'a SensorOptics,
     lit: Lit,
-    /// Pixel-centre x in [-1/2, 1/2] across the frame, for vignetting and the table.
+    /// Pixel-centre x in [-1/2, 1/2] across the frame, for vignetting.
     us: Vec<f32>,
+    /// The same in the table's [-1, 1].
+    table_us: Vec<f32>,
 }
 
 impl<'a> ShadedFrame<'a> {
@@ -128,6 +130,9 @@ impl<'a> ShadedFrame<'a> {
             optics,
             lit: Lit::new(p),
             us: (0..w).map(|x| (x as f32 + 0.5) / w as f32 - 0.5).collect(),
+            table_us: (0..w)
+                .map(|x| 2.0 * ((x as f32 + 0.5) / w as f32 - 0.5))
+                .collect(),
         }
     }
 
@@ -152,13 +157,14 @@ impl<'a> ShadedFrame<'a> {
         match &self.optics.shading {
             Shading::Lights(_) => shade_row_lit(&self.lit, g, bg, fade, row),
             Shading::Table(table) => {
-                let table = table.lookup_row(2.0 * v);
+                // The row's changes first (into `row`), then each pixel's colour from its own.
+                table.lookup_row(2.0 * v).changes(g, &self.table_us, row);
                 for x in 0..w {
                     if let Some(flat) = flat.filter(|_| g[x] == [0.0, 0.0]) {
                         row[x] = flat[x];
                         continue;
                     }
-                    let d = table.change(g[x][0], g[x][1], 2.0 * self.us[x]);
+                    let d = row[x];
                     row[x] = std::array::from_fn(|c| (bg[x][c] + d[c]) * fade[x]);
                 }
             }
