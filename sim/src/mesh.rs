@@ -715,8 +715,9 @@ fn accessor_in_buffer(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Res
 }
 
 /// An accessor's sparse substitutions, checked where gltf's reader does not: a count past
-/// the accessor's read as no triangles, an index past its elements was dropped without a
-/// word, and the indices' and values' views must hold what they are said to.
+/// the accessor's read as no triangles, an index past its elements or out of order was
+/// dropped without a word, a strided view dropped the primitive, and the indices' and
+/// values' views must hold what they are said to (glTF 2.0, 3.6.2.3).
 fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Result<(), String> {
     let Some(sparse) = a.sparse() else {
         return Ok(());
@@ -731,6 +732,13 @@ fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Resul
     }
     // The bytes of a sparse part's view from `offset`, if `needed` of them are there.
     let bytes = |view: gltf::buffer::View, offset: usize, needed: Option<usize>, part: &str| {
+        if let Some(stride) = view.stride() {
+            return Err(format!(
+                "accessor {}: sparse.{part}'s buffer view {} has byteStride {stride}; a sparse part's view is tightly packed and has none",
+                a.index(),
+                view.index()
+            ));
+        }
         let held = buffers.get(view.buffer().index()).map(|d| &d.0[..]);
         let start = view.offset().checked_add(offset);
         let end = start.zip(needed).and_then(|(s, n)| s.checked_add(n));
@@ -743,7 +751,7 @@ fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Resul
                 Ok(&held[start..end])
             }
             _ => Err(format!(
-                "accessor {}: sparse.{part} needs {} bytes of buffer view {} ({} bytes at {})",
+                "accessor {}: sparse.{part} needs {} bytes from byteOffset {offset} of buffer view {} ({} bytes at {})",
                 a.index(),
                 needed.map_or("more than 2^64".into(), |n| n.to_string()),
                 view.index(),
@@ -767,6 +775,7 @@ fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Resul
         n.checked_mul(a.size()),
         "values",
     )?;
+    let mut last = None;
     for (k, chunk) in raw.chunks_exact(size).enumerate() {
         let index = chunk
             .iter()
@@ -779,6 +788,13 @@ fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Resul
                 a.count()
             ));
         }
+        if let Some(before) = last.filter(|b| *b >= index) {
+            return Err(format!(
+                "accessor {}: sparse.indices[{k}] is {index}, after {before}; they must increase",
+                a.index()
+            ));
+        }
+        last = Some(index);
     }
     Ok(())
 }
@@ -876,7 +892,11 @@ fn gltf_nodes<'a>(
                 }
                 let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
                 let Some(positions) = reader.read_positions() else {
-                    continue;
+                    return Err(format!(
+                        "mesh {}: primitive {}: its POSITION could not be read",
+                        mesh.index(),
+                        prim.index()
+                    ));
                 };
                 // Every node using a mesh adds its vertices again: bounded in all, not per
                 // accessor (300 nodes on one million-vertex accessor asked for 7 GB).
@@ -1087,9 +1107,43 @@ mod tests {
         )
         .unwrap_err();
         assert!(
-            far.contains("sparse.values needs 12 bytes of buffer view 3"),
+            far.contains("sparse.values needs 12 bytes from byteOffset 8 of buffer view 3"),
             "{far}"
         );
+        // Two substitutions must name increasing vertices.
+        let two = one
+            .replace(r#""count":1"#, r#""count":2"#)
+            .replace(r#""componentType":5123"#, r#""componentType":5121"#);
+        let mut b = bin.clone();
+        b.extend([2u8, 1, 0, 0]);
+        b.extend(
+            [0.01f32, 0.0, 0.0, 0.0, 0.01, 0.0]
+                .iter()
+                .flat_map(|x| x.to_le_bytes()),
+        );
+        std::fs::write(dir.path().join("tetra.bin"), b).unwrap();
+        let path = dir.path().join("sparse.gltf");
+        let text = with_sparse(&two)
+            .replace(r#""byteLength":88,"#, r#""byteLength":100,"#)
+            .replace(
+                r#"{"buffer":0,"byteOffset":76,"byteLength":12}"#,
+                r#"{"buffer":0,"byteOffset":76,"byteLength":24}"#,
+            );
+        std::fs::write(&path, &text).unwrap();
+        let unsorted = load(&path).map_err(|e| e.to_string()).unwrap_err();
+        assert!(
+            unsorted.contains("sparse.indices[1] is 1, after 2; they must increase"),
+            "{unsorted}"
+        );
+        // A sparse part's view has no stride.
+        std::fs::write(dir.path().join("tetra.bin"), sparse_bin(1)).unwrap();
+        let strided = with_sparse(one).replace(
+            r#"{"buffer":0,"byteOffset":76,"byteLength":12}"#,
+            r#"{"buffer":0,"byteOffset":76,"byteLength":12,"byteStride":16}"#,
+        );
+        std::fs::write(&path, strided).unwrap();
+        let strided = load(&path).map_err(|e| e.to_string()).unwrap_err();
+        assert!(strided.contains("has byteStride 16"), "{strided}");
     }
 
     #[test]

@@ -37,9 +37,13 @@ pub(super) struct ArmProbe<'d, T: TactileSensor, A: Arm> {
     pad_yaw_rad: f64,
     start_z_m: f64,
     config: &'d PipelineConfig,
-    /// Why the no-contact reference carries no shading, if it carries none: a search
-    /// against it ends in 'no contact', which would not say why.
-    reference_fault: Option<String>,
+    /// Pressed frames so far (the first is the search's contact frame), to name a frame that
+    /// cannot be read.
+    recorded: usize,
+    /// The first frame that carries no shading (which, and why), if one did: the press
+    /// stopped there, since a blank reference makes every later frame read as contact and a
+    /// blank pressed frame reads as a deep imprint.
+    unreadable: Option<(String, String)>,
 }
 
 impl<T: TactileSensor, A: Arm> ArmProbe<'_, T, A> {
@@ -47,12 +51,26 @@ impl<T: TactileSensor, A: Arm> ArmProbe<'_, T, A> {
         Pose::tool_down_turned(DVec3::new(self.touch.x, self.touch.y, z), self.pad_yaw_rad)
     }
 
-    /// The frame with the pad `k` steps down, and where the arm says the pad is (m).
-    fn lowered(&mut self, k: usize) -> Result<(TactileFrame, f64), DeviceError> {
+    /// The frame with the pad `k` steps down, and where the arm says the pad is (m); a frame
+    /// that carries no shading (blank, or blown out) ends the press, as `which`.
+    fn lowered(
+        &mut self,
+        k: usize,
+        which: impl FnOnce() -> String,
+    ) -> Result<(TactileFrame, f64), DeviceError> {
         let z = self.start_z_m - k as f64 * self.config.press.step_mm * 1e-3;
         self.arm
             .move_linear(&self.above(z), self.config.press_speed_m_s)?;
         let frame = self.tactile.capture()?;
+        if let Some(why) = crate::image_file::rgb_frame_fault(&frame.image) {
+            let which = which();
+            let message = format!("the {which} carries no shading");
+            self.unreadable = Some((which, why));
+            return Err(DeviceError::Failure {
+                device: self.tactile.name().to_string(),
+                message,
+            });
+        }
         Ok((frame, self.arm.pose()?.position.z))
     }
 }
@@ -62,20 +80,20 @@ impl<T: TactileSensor, A: Arm> PressProbe for ArmProbe<'_, T, A> {
     type Error = DeviceError;
 
     fn look(&mut self, at: Look) -> Result<(image::RgbImage, (TactileFrame, f64)), DeviceError> {
-        let k = match at {
+        let (k, which) = match at {
             // Both no-contact frames at the start: the second gives the noise floor.
-            Look::Reference | Look::NoiseFloor => 0,
-            Look::Search(k) => k,
+            Look::Reference => (0, "no-contact frame".to_string()),
+            Look::NoiseFloor => (0, "second no-contact frame".to_string()),
+            Look::Search(k) => (k, format!("search frame {k} steps down")),
         };
-        let (frame, z) = self.lowered(k)?;
-        if at == Look::Reference {
-            self.reference_fault = crate::image_file::rgb_frame_fault(&frame.image);
-        }
+        let (frame, z) = self.lowered(k, || which)?;
         Ok((frame.image.clone(), (frame, z)))
     }
 
     fn record(&mut self, k: usize) -> Result<(TactileFrame, f64), DeviceError> {
-        self.lowered(k)
+        self.recorded += 1;
+        let n = self.recorded;
+        self.lowered(k, || format!("pressed frame {n}"))
     }
     fn mm_per_px(&self) -> f64 {
         self.tactile.spec().mm_per_px
@@ -227,22 +245,20 @@ pub(super) fn press_at<T: TactileSensor, A: Arm>(
         pad_yaw_rad: target.pad_yaw_rad,
         start_z_m,
         config,
-        reference_fault: None,
+        recorded: 1,
+        unreadable: None,
     };
     let outcome = run_press(&protocol, &mut probe);
-    let reference_fault = probe.reference_fault.take();
+    let unreadable = probe.unreadable.take();
     // Whatever happened below, the pad goes back up before the next object.
     arm.move_linear(&safe, config.travel_speed_m_s)?;
-    let unreadable = |which: &str, why: String| {
-        Attempt::NotMeasured(NotMeasured {
+    // A sensor whose LEDs failed, or a camera blown out, gives frames that read as contact
+    // or a deep imprint everywhere: that object is not measured, with why.
+    if let Some((which, why)) = unreadable {
+        return Ok(Attempt::NotMeasured(NotMeasured {
             reason: NotMeasuredReason::UnreadableFrame,
             detail: format!("the tactile sensor's {which} cannot be read: {why}"),
-        })
-    };
-    // A sensor whose LEDs failed, or a camera blown out, gives frames that read as a deep
-    // imprint everywhere (or as no contact at all): that object is not measured, with why.
-    if let Some(why) = reference_fault {
-        return Ok(unreadable("no-contact frame", why));
+        }));
     }
     let pressed = match outcome {
         Ok(PressOutcome::Pressed(p)) => p,
@@ -257,13 +273,6 @@ pub(super) fn press_at<T: TactileSensor, A: Arm>(
         }
     };
     let (reference, _) = pressed.reference;
-    let faulty =
-        pressed.frames.iter().enumerate().find_map(|(k, (f, _))| {
-            crate::image_file::rgb_frame_fault(&f.image).map(|why| (k, why))
-        });
-    if let Some((k, why)) = faulty {
-        return Ok(unreadable(&format!("pressed frame {}", k + 1), why));
-    }
     let contact_z = pressed.frames[0].1;
     let travel_mm = pressed
         .frames
