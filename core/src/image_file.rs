@@ -74,14 +74,23 @@ pub fn tactile_frame_fault(decoded: &DynamicImage) -> Option<String> {
 /// Why a colour frame (a file's, or a sensor's as captured) carries no shading to read, if it
 /// carries none: more than half saturated, or featureless (a blank frame, the LEDs off).
 pub fn rgb_frame_fault(frame: &image::RgbImage) -> Option<String> {
-    let saturated = frame.pixels().filter(|p| p.0.contains(&255)).count();
-    if 2 * saturated > frame.pixels().len() {
+    // One pass over the pixels: the press checks every frame it looks at.
+    let mut histograms = [[0usize; 256]; 3];
+    let mut saturated = 0usize;
+    for p in frame.as_raw().chunks_exact(3) {
+        for (histogram, v) in histograms.iter_mut().zip(p) {
+            histogram[*v as usize] += 1;
+        }
+        saturated += usize::from(p.contains(&255));
+    }
+    let n = frame.pixels().len();
+    if 2 * saturated > n {
         return Some(format!(
             "{:.0}% of its pixels are saturated (255); a tactile frame this blown out carries no shading",
-            100.0 * saturated as f64 / frame.pixels().len() as f64
+            100.0 * saturated as f64 / n as f64
         ));
     }
-    let spread = spread_grey(frame);
+    let spread = spread_grey(&histograms, n);
     (spread < MIN_SPREAD_GREY).then(|| {
         format!(
             "featureless (98% of its pixels within {spread} grey levels in every channel); a tactile frame shows its gel's shading and markers"
@@ -94,15 +103,12 @@ pub fn rgb_frame_fault(frame: &image::RgbImage) -> Option<String> {
 /// noise. A reading of a blank frame against a reference finds a deep imprint everywhere.
 const MIN_SPREAD_GREY: u8 = 4;
 
-/// The largest, over the three channels, of the span between the 1st and 99th percentile.
-fn spread_grey(frame: &image::RgbImage) -> u8 {
-    let n = frame.pixels().len();
-    (0..3)
-        .map(|c| {
-            let mut histogram = [0usize; 256];
-            for p in frame.pixels() {
-                histogram[p.0[c] as usize] += 1;
-            }
+/// The largest, over the three channels' histograms of `n` pixels, of the span between the
+/// 1st and 99th percentile.
+fn spread_grey(histograms: &[[usize; 256]; 3], n: usize) -> u8 {
+    histograms
+        .iter()
+        .map(|histogram| {
             let level = |share: f64| {
                 let want = (share * n as f64) as usize;
                 let mut seen = 0;
