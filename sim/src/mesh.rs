@@ -723,6 +723,12 @@ fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Resul
         return Ok(());
     };
     let n = sparse.count();
+    if n == 0 {
+        return Err(format!(
+            "accessor {}: sparse.count is 0; a sparse part substitutes at least one element",
+            a.index()
+        ));
+    }
     if n > a.count() {
         return Err(format!(
             "accessor {}: sparse.count {n} is more than its {} elements",
@@ -730,6 +736,8 @@ fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Resul
             a.count()
         ));
     }
+    let indices = sparse.indices();
+    let size = indices.index_type().size();
     // The bytes of a sparse part's view from `offset`, if `needed` of them are there.
     let bytes = |view: gltf::buffer::View, offset: usize, needed: Option<usize>, part: &str| {
         if let Some(stride) = view.stride() {
@@ -739,8 +747,21 @@ fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Resul
                 view.index()
             ));
         }
-        let held = buffers.get(view.buffer().index()).map(|d| &d.0[..]);
+        // Every element starts at a multiple of its component's size.
+        let component = if part == "indices" {
+            size
+        } else {
+            a.data_type().size()
+        };
         let start = view.offset().checked_add(offset);
+        if let Some(at) = start.filter(|at| !at.is_multiple_of(component)) {
+            return Err(format!(
+                "accessor {}: sparse.{part} starts at byte {at} of its buffer (byteOffset {offset} of buffer view {}), not a multiple of its {component}-byte component",
+                a.index(),
+                view.index()
+            ));
+        }
+        let held = buffers.get(view.buffer().index()).map(|d| &d.0[..]);
         let end = start.zip(needed).and_then(|(s, n)| s.checked_add(n));
         match (held, start, end) {
             (Some(held), Some(start), Some(end))
@@ -760,8 +781,6 @@ fn sparse_in_bounds(a: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Resul
             )),
         }
     };
-    let indices = sparse.indices();
-    let size = indices.index_type().size();
     let raw = bytes(
         indices.view(),
         indices.offset(),
@@ -1144,6 +1163,20 @@ mod tests {
         std::fs::write(&path, strided).unwrap();
         let strided = load(&path).map_err(|e| e.to_string()).unwrap_err();
         assert!(strided.contains("has byteStride 16"), "{strided}");
+        let none = load_with(1, &one.replace(r#""count":1"#, r#""count":0"#)).unwrap_err();
+        assert!(none.contains("sparse.count is 0"), "{none}");
+        let askew = load_with(
+            1,
+            &one.replace(
+                r#""values":{"bufferView":3}"#,
+                r#""values":{"bufferView":3,"byteOffset":2}"#,
+            ),
+        )
+        .unwrap_err();
+        assert!(
+            askew.contains("sparse.values starts at byte 78 of its buffer"),
+            "{askew}"
+        );
     }
 
     #[test]

@@ -231,6 +231,10 @@ impl FrameKind {
             FrameKind::Colour if !colour.has_color() => {
                 Some("a greyscale image, where the recording holds a colour frame".into())
             }
+            // Alpha would be dropped and 16-bit levels cut to 8 without a word.
+            FrameKind::Colour if colour != tactex_core::image::ColorType::Rgb8 => Some(format!(
+                "a {colour:?} image, where the recording holds a colour frame: 8-bit RGB"
+            )),
             FrameKind::Depth if colour.has_color() || colour.bytes_per_pixel() != 2 => {
                 Some(format!(
                     "a {colour:?} image, where the recording holds a depth frame: one 16-bit channel"

@@ -322,6 +322,12 @@ fn a_session_no_device_could_have_recorded_is_refused_when_opened() {
     let grey = tactex_core::image::GrayImage::new(320, 240);
     let err = frame("tactile/0000.png", &png(grey.into()));
     assert!(err.contains("greyscale"), "{err}");
+    let rgba = tactex_core::image::RgbaImage::new(320, 240);
+    let err = frame("tactile/0000.png", &png(rgba.into()));
+    assert!(
+        err.contains("a Rgba8 image") && err.contains("8-bit RGB"),
+        "{err}"
+    );
     let colour = RgbImage::new(64, 48);
     let err = frame("camera/depth-0000.png", &png(colour.into()));
     assert!(err.contains("depth frame"), "{err}");
