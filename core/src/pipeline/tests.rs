@@ -36,6 +36,14 @@ fn ask_with(
     world.tactile.object_m = object_m;
     world.tactile.shows = shows;
     world.arm.refuse_below_m = refuse_below_m;
+    ask_in(&mut world, estimator)
+}
+
+/// "How hard is the apple?" in `world`.
+fn ask_in(
+    world: &mut DummyWorld,
+    estimator: &dyn HardnessEstimator,
+) -> Result<Answer, PipelineError> {
     answer(
         "How hard is the apple?",
         &FruitCatalog::builtin(),
@@ -131,20 +139,7 @@ fn a_blown_out_or_blank_sensor_is_an_unreadable_frame_not_an_imprint_or_no_conta
     ] {
         let mut world = DummyWorld::apple();
         world.tactile.blown_out_from_mm = Some(from_mm);
-        let a = answer(
-            "How hard is the apple?",
-            &FruitCatalog::builtin(),
-            Devices {
-                camera: &mut world.camera,
-                tactile: &mut world.tactile,
-                arm: &mut world.arm,
-            },
-            &world.detector,
-            &FixedEstimator::new(2.0),
-            Language::OFFLINE,
-            &PipelineConfig::default(),
-        )
-        .expect("the question is answered");
+        let a = ask_in(&mut world, &FixedEstimator::new(2.0)).expect("the question is answered");
         let o = &a.objects[0];
         let why = o.not_measured.as_ref().unwrap();
         assert_eq!(why.reason, NotMeasuredReason::UnreadableFrame, "{why:?}");
