@@ -54,16 +54,7 @@ impl ShadingTable {
             .map(|t| [t[0] + t[2] * v + t[5] * v * v, t[1] + t[4] * v, t[3]])
             .collect();
         let h = FLAT_DIFFERENCE * self.mag_max;
-        let at = |gx: f32, gy: f32| {
-            bin_position_at(
-                self.mag_bins,
-                self.dir_bins,
-                self.mag_max,
-                gx,
-                gy,
-                direction(gy, gx),
-            )
-        };
+        let at = |gx: f32, gy: f32| place(self, gx, gy);
         ShadingRow {
             table: self,
             poly,
@@ -110,6 +101,11 @@ impl ShadingTable {
         }
         row
     }
+}
+
+/// Where slope (gx, gy) falls among the table's nodes.
+fn place(t: &ShadingTable, gx: f32, gy: f32) -> BinPosition {
+    bin_position_at(t.mag_bins, t.dir_bins, t.mag_max, gx, gy, direction(gy, gx))
 }
 
 /// Many slopes' bins, a field at a time (so that placing them vectorises).
@@ -195,8 +191,7 @@ fn direction(gy: f32, gx: f32) -> f32 {
 
 impl ShadingRow<'_> {
     fn bin(&self, gx: f32, gy: f32) -> BinPosition {
-        let t = self.table;
-        bin_position_at(t.mag_bins, t.dir_bins, t.mag_max, gx, gy, direction(gy, gx))
+        place(self.table, gx, gy)
     }
 
     /// The table's change at the slope placed at `b`, position u along the row.
