@@ -888,6 +888,7 @@ def calibrate(
     source: str = "",
     glow: bool = True,
     fidelity: Optional[str] = None,
+    interval_placements: Optional[int] = None,
 ) -> Dict[str, Any]:
     """Calibrates a real sensor from ball presses, as ``tactex calibrate``: the gradient ->
     colour table from the frames in ``images`` (circles in the ``annotations`` CSV:
@@ -896,8 +897,12 @@ def calibrate(
     grid of a ``markers`` frame when given. Writes the sensor profile to ``out`` (its
     background beside it) and returns what ``calibrate --json`` prints: the profile's path
     and id, presses and pixels fitted, the table's rms residual per channel, the noise and
-    the markers read. ``Sensor(out)`` then presses through it. Arguments left as None take
-    the command's defaults (``tactex calibrate --help``)."""
+    the markers read. ``Sensor(out)`` then presses through it. Unless ``interval_placements``
+    is 0, the twin then presses every catalog fruit at that many places (default 16, 2-3
+    minutes) through the new profile and writes the default estimator's interval calibration
+    beside it (``intervals`` in the result; ``intervals_not_measured`` says why not when it
+    could not be made), so that answers through the profile carry measured intervals.
+    Arguments left as None take the command's defaults (``tactex calibrate --help``)."""
     request = _request(
         images=images,
         annotations=annotations,
@@ -919,6 +924,8 @@ def calibrate(
         source=source,
         glow=_flag("glow", glow),
         fidelity=fidelity,
+        interval_placements=None if interval_placements is None
+        else _whole("interval_placements", interval_placements, 2**32),
     )
     return json.loads(_tactex.calibrate(json.dumps(request)))
 

@@ -224,12 +224,13 @@ FOTS_SCALE = dict(ball_radius_mm=2.35, mm_per_px=0.051072522982635343)
 def test_calibrate_writes_the_profile_the_cli_writes_and_returns_its_fit(cli, tmp_path):
     inputs = dict(images=FOTS / "ball-presses", annotations=FOTS / "ball-presses/annotations.csv",
                   background=FOTS / "background.png")
-    fit = tactex.calibrate(**inputs, **FOTS_SCALE, markers=FOTS / "markers/press.png", out=tmp_path / "py/mine.toml")
+    fit = tactex.calibrate(**inputs, **FOTS_SCALE, markers=FOTS / "markers/press.png", out=tmp_path / "py/mine.toml",
+                           interval_placements=0)
     printed = json.loads(cli(
         "calibrate", "--images", str(inputs["images"]), "--annotations", str(inputs["annotations"]),
         "--background", str(inputs["background"]), "--ball-radius-mm", "2.35",
         "--mm-per-px", "0.051072522982635343", "--markers", str(FOTS / "markers/press.png"),
-        "--out", str(tmp_path / "cli/mine.toml"), "--json").stdout)
+        "--interval-placements", "0", "--out", str(tmp_path / "cli/mine.toml"), "--json").stdout)
     assert fit.pop("profile") == str(tmp_path / "py/mine.toml")
     printed.pop("profile")
     assert fit == printed

@@ -539,6 +539,52 @@ fn plots(dir: &std::path::Path, report: &FruitReport, rows: &[FruitRow]) -> Resu
 }
 
 pub(crate) fn run(args: &FruitEvalArgs) -> Result<()> {
+    let (report, _) = evaluate(args)?;
+    print_json_or_text(&report, args.json, || {
+        print!("{}", markdown(&report));
+        Ok(())
+    })
+}
+
+/// Placements of each kind `calibrate` measures a new profile's intervals on, by default:
+/// 176 presses, three bins (docs/sim-to-real.md).
+pub const BESIDE_PLACEMENTS: usize = 16;
+
+/// Measures the default estimator's interval calibration through the profile at `profile`
+/// (each kind alone at `placements` places, seed 1) and writes it beside the profile, where
+/// every command that loads the estimator through that profile finds it.
+pub(crate) fn measure_beside(
+    profile: &std::path::Path,
+    placements: usize,
+) -> Result<(PathBuf, IntervalCalibration)> {
+    let estimator: EstimatorChoice = crate::app::DEFAULT_ESTIMATOR
+        .parse()
+        .map_err(|e| anyhow::anyhow!("the default estimator: {e}"))?;
+    let fidelity = Fidelity::default();
+    let path =
+        crate::app::estimator_choice::profile_intervals_path(profile, &estimator, fidelity.name());
+    let args = FruitEvalArgs {
+        placements,
+        crowded: 0,
+        kinds: Vec::new(),
+        seed: 1,
+        fidelity,
+        sensor: Some(profile.to_path_buf()),
+        estimator,
+        intervals: None,
+        calibrate: Some(path.clone()),
+        device: DeviceChoice::Cpu,
+        out: None,
+        json: false,
+    };
+    let (_, calibration) = evaluate(&args)?;
+    let calibration = calibration.context("the interval calibration was not made")?;
+    Ok((path, calibration))
+}
+
+/// Answers every table and scores it; with `--calibrate` also writes the calibration, which
+/// it returns.
+fn evaluate(args: &FruitEvalArgs) -> Result<(FruitReport, Option<IntervalCalibration>)> {
     ensure!(
         args.placements + args.crowded >= 1,
         "--placements, --crowded: ask for at least one table"
@@ -616,6 +662,7 @@ pub(crate) fn run(args: &FruitEvalArgs) -> Result<()> {
         CROWDED_TOUCHING_SHARE * 1e2,
         PLACED_WITHIN_M * 1e3
     );
+    let mut calibration = None;
     if let Some(path) = &args.calibrate {
         let samples: Vec<HeldOutPress> = rows
             .iter()
@@ -640,16 +687,17 @@ pub(crate) fn run(args: &FruitEvalArgs) -> Result<()> {
                 None => String::new(),
             }
         );
-        let mut calibration =
+        let mut fitted =
             IntervalCalibration::fit(estimator.name(), fidelity, &command, &samples, 3)?;
-        calibration.sensor = Some(sensor_id.clone());
-        write_json_atomic(path, &calibration)?;
+        fitted.sensor = Some(sensor_id.clone());
+        write_json_atomic(path, &fitted)?;
         eprintln!(
             "wrote {} ({} presses, {} bins)",
             path.display(),
-            calibration.presses,
-            calibration.bins.len()
+            fitted.presses,
+            fitted.bins.len()
         );
+        calibration = Some(fitted);
     }
     let mut names: Vec<String> = rows.iter().map(|r| r.kind.clone()).collect();
     names.sort();
@@ -698,11 +746,7 @@ pub(crate) fn run(args: &FruitEvalArgs) -> Result<()> {
         plots(dir, &report, &rows)?;
         out.finish()?;
     }
-    print_json_or_text(&report, args.json, || {
-        print!("{}", markdown(&report));
-        Ok(())
-    })?;
-    Ok(())
+    Ok((report, calibration))
 }
 
 /// Where the scored intervals come from, in words (as `EstimatorChoice::open` chose them).

@@ -5,6 +5,7 @@
 use crate::app::ball_presses::{self, Split, contact_box, rebuild};
 use crate::app::flag_range::{FieldError, choice, count};
 use crate::app::request_json::parsed;
+use crate::eval::fruits::{BESIDE_PLACEMENTS, measure_beside};
 use crate::report::output::write_profile_atomic;
 use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
@@ -91,6 +92,12 @@ pub struct CalibrateArgs {
     /// Contact model that rebuilds the presses the glow is fitted to.
     #[arg(long, default_value = "layer")]
     pub fidelity: Fidelity,
+    /// Placements of each catalog fruit on which the twin, pressing through the new profile,
+    /// measures the default estimator's intervals, written beside the profile as
+    /// NAME.indentation-layer.intervals.json (what `ask --sensor NAME.toml` then quotes); 0
+    /// for none, else 4 to 1000 (16: 176 presses, 2-3 minutes).
+    #[arg(long, value_parser = count::<usize>(0, INTERVAL_PLACEMENTS_MAX), default_value_t = BESIDE_PLACEMENTS)]
+    pub interval_placements: usize,
     /// Print one JSON object on stdout: what was fitted.
     #[arg(long)]
     pub json: bool,
@@ -115,7 +122,26 @@ pub struct Calibration {
     pub markers: Option<MarkerReading>,
     /// Whether a glow was fitted.
     pub glow: bool,
+    /// The default estimator's interval calibration measured through the new profile and
+    /// written beside it (`--interval-placements`), if one was asked for and made.
+    pub intervals: Option<BesideIntervals>,
+    /// Why the intervals asked for were not measured.
+    pub intervals_not_measured: Option<String>,
 }
+
+/// An interval calibration written beside the profile.
+#[derive(Serialize, Debug)]
+pub struct BesideIntervals {
+    pub file: PathBuf,
+    /// Held-out presses of the twin, read through the profile, it rests on.
+    pub presses: usize,
+    pub bins: usize,
+}
+
+/// The fewest placements of each catalog fruit that make the presses an interval
+/// calibration needs (11 kinds: 44 presses against 40), and the most.
+pub const INTERVAL_PLACEMENTS_MIN: u64 = 4;
+pub const INTERVAL_PLACEMENTS_MAX: u64 = 1000;
 
 #[derive(Serialize, Debug)]
 pub struct MarkerReading {
@@ -246,6 +272,7 @@ impl CalibrateArgs {
             markers: self.markers.clone(),
             glow: !self.no_glow,
             fidelity: self.fidelity,
+            interval_placements: self.interval_placements,
         }
     }
 }
@@ -323,6 +350,13 @@ pub struct CalibrateRequest {
     /// Contact model that rebuilds the presses the glow is fitted to.
     #[serde(default, deserialize_with = "parsed")]
     pub fidelity: Fidelity,
+    /// Placements of each catalog fruit the profile's intervals are measured on; 0: none.
+    #[serde(default = "interval_placements")]
+    pub interval_placements: usize,
+}
+
+fn interval_placements() -> usize {
+    BESIDE_PLACEMENTS
 }
 
 fn calib() -> Split {
@@ -376,6 +410,18 @@ impl CalibrateRequest {
         }
         if let Some(name) = &self.name {
             profile_name(name).map_err(|e| FieldError::new("name", e))?;
+        }
+        let placements = self.interval_placements;
+        if !(placements == 0
+            || (INTERVAL_PLACEMENTS_MIN..=INTERVAL_PLACEMENTS_MAX).contains(&(placements as u64)))
+        {
+            return Err(FieldError::new(
+                "interval_placements",
+                format!(
+                    "{placements}: 0 for none, or {INTERVAL_PLACEMENTS_MIN} to {INTERVAL_PLACEMENTS_MAX} (fewer make under the {} presses an interval calibration needs)",
+                    tactex_core::hardness::interval_calibration::MIN_PER_BIN
+                ),
+            ));
         }
         Ok(())
     }
@@ -556,6 +602,22 @@ pub fn calibrate(args: &CalibrateRequest) -> Result<Calibration> {
         .validate()
         .map_err(|(field, message)| anyhow::anyhow!("the fitted profile: {field}: {message}"))?;
     write_profile_atomic(&args.out, &profile).context("--out")?;
+    // The profile stands on its own: intervals that cannot be measured through it are
+    // reported, and the profile is kept (its answers are then marked uncalibrated).
+    let (intervals, intervals_not_measured) = match args.interval_placements {
+        0 => (None, None),
+        placements => match measure_beside(&args.out, placements) {
+            Ok((file, c)) => (
+                Some(BesideIntervals {
+                    file,
+                    presses: c.presses,
+                    bins: c.bins.len(),
+                }),
+                None,
+            ),
+            Err(e) => (None, Some(format!("{e:#}"))),
+        },
+    };
     Ok(Calibration {
         profile: args.out.clone(),
         sensor: profile.id(),
@@ -567,11 +629,18 @@ pub fn calibrate(args: &CalibrateRequest) -> Result<Calibration> {
         noise_sigma_grey,
         markers,
         glow: profile.spec.glow.is_some(),
+        intervals,
+        intervals_not_measured,
     })
 }
 
 pub(crate) fn run(args: &CalibrateArgs) -> Result<()> {
     let fit = calibrate(&args.request())?;
+    if let Some(why) = &fit.intervals_not_measured {
+        eprintln!(
+            "warning: the profile is written, but its intervals were not measured ({why}); answers through it are marked uncalibrated"
+        );
+    }
     print_json_or_text(&fit, args.json, || {
         if let Some(m) = &fit.markers {
             println!(
@@ -599,6 +668,14 @@ pub(crate) fn run(args: &CalibrateArgs) -> Result<()> {
             "camera noise {:.2} grey levels (1 sigma); profile {}",
             fit.noise_sigma_grey, fit.sensor
         );
+        if let Some(i) = &fit.intervals {
+            println!(
+                "{}: intervals measured on {} twin presses through the profile ({} bins)",
+                i.file.display(),
+                i.presses,
+                i.bins
+            );
+        }
         Ok(())
     })
 }
@@ -628,11 +705,24 @@ mod request_tests {
             (r#", "gel_poisson": 0.7"#, "gel_poisson"),
             (r#", "smoothness": -1"#, "smoothness"),
             (r#", "name": "a\nb""#, "name"),
+            (r#", "interval_placements": 2"#, "interval_placements"),
+            (r#", "interval_placements": 1001"#, "interval_placements"),
         ] {
             assert_eq!(parse(extra).check().unwrap_err().field, field, "{extra}");
         }
         let e =
             from_json::<CalibrateRequest>(&format!("{{{base}, \"mm_per_px\": 0.05}}")).unwrap_err();
         assert_eq!(e.field, "ball_radius_mm", "{e}");
+        assert_eq!(request.interval_placements, BESIDE_PLACEMENTS);
+        assert!(parse(r#", "interval_placements": 0"#).check().is_ok());
+    }
+
+    #[test]
+    fn the_fewest_interval_placements_make_the_presses_a_calibration_needs() {
+        use tactex_core::hardness::interval_calibration::MIN_PER_BIN;
+        let kinds = tactex_core::catalog::FruitCatalog::builtin().names().len();
+        let presses = |placements: u64| placements as usize * kinds;
+        assert!(presses(INTERVAL_PLACEMENTS_MIN) >= MIN_PER_BIN);
+        assert!(presses(INTERVAL_PLACEMENTS_MIN - 1) < MIN_PER_BIN);
     }
 }

@@ -81,6 +81,7 @@ const NUMERIC_FLAGS: &[(&str, &str)] = &[
     ("calibrate", "--dir-bins"),
     ("calibrate", "--mag-max"),
     ("calibrate", "--smoothness"),
+    ("calibrate", "--interval-placements"),
     ("sensor check", "--seed"),
     ("compare", "--seed"),
     ("contact", "--mm-per-px"),

@@ -17,7 +17,7 @@ fn calibrated(dir: &Path) -> PathBuf {
     calibrated_with(dir, &[])
 }
 
-/// The same with `extra` flags.
+/// The same with `extra` flags; no intervals measured unless `extra` asks for them.
 fn calibrated_with(dir: &Path, extra: &[&str]) -> PathBuf {
     let f = fixtures();
     let presses = f.join("ball-presses");
@@ -41,6 +41,9 @@ fn calibrated_with(dir: &Path, extra: &[&str]) -> PathBuf {
         "FOTS (Zhao et al., RA-L 2024), MIT",
     ];
     args.extend_from_slice(extra);
+    if !extra.contains(&"--interval-placements") {
+        args.extend(["--interval-placements", "0"]);
+    }
     let out = tactex(&args);
     assert!(
         out.status.success(),
@@ -48,6 +51,82 @@ fn calibrated_with(dir: &Path, extra: &[&str]) -> PathBuf {
         String::from_utf8_lossy(&out.stderr)
     );
     profile
+}
+
+#[test]
+fn calibrate_measures_the_new_profiles_intervals_beside_it_and_ask_quotes_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let markers = fixtures().join("markers/press.png");
+    let profile = calibrated_with(
+        dir.path(),
+        &[
+            "--markers",
+            markers.to_str().unwrap(),
+            "--interval-placements",
+            "4",
+        ],
+    );
+    // The twin pressed each catalog fruit at 4 places through the profile: 44 presses, and a
+    // calibration needs 40 measured.
+    let beside = dir.path().join("fots.indentation-layer.intervals.json");
+    let written: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&beside).unwrap()).unwrap();
+    assert_eq!(written["sensor"]["name"], "fots", "{written}");
+    assert!(written["presses"].as_u64().unwrap() >= 40, "{written}");
+    let shown = json(&tactex(&[
+        "sensor",
+        "show",
+        profile.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(
+        written["sensor"], shown["sensor"],
+        "measured through this very profile"
+    );
+
+    let o = tactex(&[
+        "ask",
+        "--sensor",
+        profile.to_str().unwrap(),
+        "--json",
+        "How hard is the lime?",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("intervals measured through this sensor"),
+        "{err}"
+    );
+    let answer: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let lime = &answer["objects"][0];
+    assert_eq!(lime["interval"]["calibrated"], true, "{answer}");
+
+    // Fewer placements than make the presses a calibration needs are refused up front.
+    let f = fixtures();
+    let presses = f.join("ball-presses");
+    let other = dir.path().join("other.toml");
+    let run = tactex(&[
+        "calibrate",
+        "--images",
+        presses.to_str().unwrap(),
+        "--annotations",
+        presses.join("annotations.csv").to_str().unwrap(),
+        "--background",
+        f.join("background.png").to_str().unwrap(),
+        "--ball-radius-mm",
+        "2.35",
+        "--mm-per-px",
+        "0.0511",
+        "--interval-placements",
+        "2",
+        "--out",
+        other.to_str().unwrap(),
+    ]);
+    assert!(!run.status.success());
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("--interval-placements"), "{err}");
+    assert!(!other.exists());
 }
 
 /// `press --json` of the FOTS ball (radius 2.35 mm, rigid) 0.4 mm deep through `profile` on
@@ -405,6 +484,8 @@ fn calibrating_the_twins_own_mini_gives_the_mini_back() {
         "--mm-per-px",
         "0.0634",
         "--no-glow",
+        "--interval-placements",
+        "0",
         "--out",
         profile.to_str().unwrap(),
     ]);

@@ -44,6 +44,8 @@ fn calibrated_renderer_matches_held_out_real_presses() {
         "2.35",
         "--mm-per-px",
         MM_PER_PX,
+        "--interval-placements",
+        "0",
         "--out",
         calib.to_str().unwrap(),
     ]);
