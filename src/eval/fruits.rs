@@ -539,7 +539,16 @@ fn plots(dir: &std::path::Path, report: &FruitReport, rows: &[FruitRow]) -> Resu
 }
 
 pub(crate) fn run(args: &FruitEvalArgs) -> Result<()> {
-    let (report, _) = evaluate(args)?;
+    let (report, calibration) = evaluate(args)?;
+    if let (Some(path), Some(c)) = (&args.calibrate, &calibration) {
+        eprintln!(
+            "wrote {} ({} presses, {} {})",
+            path.display(),
+            c.presses,
+            c.bins.len(),
+            if c.bins.len() == 1 { "bin" } else { "bins" }
+        );
+    }
     print_json_or_text(&report, args.json, || {
         print!("{}", markdown(&report));
         Ok(())
@@ -577,6 +586,9 @@ pub(crate) fn measure_beside(
         out: None,
         json: false,
     };
+    if path.is_dir() {
+        bail!("the intervals file {}: is a directory", path.display());
+    }
     let (_, calibration) = evaluate(&args)?;
     let calibration = calibration.context("the interval calibration was not made")?;
     Ok((path, calibration))
@@ -691,12 +703,6 @@ fn evaluate(args: &FruitEvalArgs) -> Result<(FruitReport, Option<IntervalCalibra
             IntervalCalibration::fit(estimator.name(), fidelity, &command, &samples, 3)?;
         fitted.sensor = Some(sensor_id.clone());
         write_json_atomic(path, &fitted)?;
-        eprintln!(
-            "wrote {} ({} presses, {} bins)",
-            path.display(),
-            fitted.presses,
-            fitted.bins.len()
-        );
         calibration = Some(fitted);
     }
     let mut names: Vec<String> = rows.iter().map(|r| r.kind.clone()).collect();

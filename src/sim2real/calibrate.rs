@@ -3,6 +3,7 @@
 //! noise, and writes a sensor profile (TOML + its background PNG beside it).
 
 use crate::app::ball_presses::{self, Split, contact_box, rebuild};
+use crate::app::estimator_choice::{Beside, EstimatorChoice};
 use crate::app::flag_range::{FieldError, choice, count};
 use crate::app::request_json::parsed;
 use crate::eval::fruits::{BESIDE_PLACEMENTS, measure_beside};
@@ -96,7 +97,7 @@ pub struct CalibrateArgs {
     /// measures the default estimator's intervals, written beside the profile as
     /// NAME.indentation-layer.intervals.json (what `ask --sensor NAME.toml` then quotes); 0
     /// for none, else 4 to 1000 (16: 176 presses, 2-3 minutes).
-    #[arg(long, value_parser = count::<usize>(0, INTERVAL_PLACEMENTS_MAX), default_value_t = BESIDE_PLACEMENTS)]
+    #[arg(long, value_parser = interval_placements_flag, default_value_t = BESIDE_PLACEMENTS)]
     pub interval_placements: usize,
     /// Print one JSON object on stdout: what was fitted.
     #[arg(long)]
@@ -136,6 +137,34 @@ pub struct BesideIntervals {
     /// Held-out presses of the twin, read through the profile, it rests on.
     pub presses: usize,
     pub bins: usize,
+}
+
+/// `--interval-placements`: 0, or a count in the range the help states.
+fn interval_placements_flag(text: &str) -> Result<usize, String> {
+    let v: u64 = text.trim().parse().map_err(|_| {
+        format!(
+            "expected 0, or a whole number from {INTERVAL_PLACEMENTS_MIN} to {INTERVAL_PLACEMENTS_MAX}"
+        )
+    })?;
+    interval_placements_within(v)?;
+    usize::try_from(v).map_err(|_| format!("{v} is too large"))
+}
+
+/// 0 (none), or enough placements to make the presses a calibration needs, and not more
+/// than the most.
+fn interval_placements_within(v: u64) -> Result<(), String> {
+    if v == 0 || (INTERVAL_PLACEMENTS_MIN..=INTERVAL_PLACEMENTS_MAX).contains(&v) {
+        return Ok(());
+    }
+    if v > INTERVAL_PLACEMENTS_MAX {
+        return Err(format!(
+            "{v}: 0 for none, or {INTERVAL_PLACEMENTS_MIN} to {INTERVAL_PLACEMENTS_MAX}"
+        ));
+    }
+    Err(format!(
+        "{v}: 0 for none, or {INTERVAL_PLACEMENTS_MIN} to {INTERVAL_PLACEMENTS_MAX} (fewer make under the {} presses an interval calibration needs)",
+        tactex_core::hardness::interval_calibration::MIN_PER_BIN
+    ))
 }
 
 /// The fewest placements of each catalog fruit that make the presses an interval
@@ -411,18 +440,8 @@ impl CalibrateRequest {
         if let Some(name) = &self.name {
             profile_name(name).map_err(|e| FieldError::new("name", e))?;
         }
-        let placements = self.interval_placements;
-        if !(placements == 0
-            || (INTERVAL_PLACEMENTS_MIN..=INTERVAL_PLACEMENTS_MAX).contains(&(placements as u64)))
-        {
-            return Err(FieldError::new(
-                "interval_placements",
-                format!(
-                    "{placements}: 0 for none, or {INTERVAL_PLACEMENTS_MIN} to {INTERVAL_PLACEMENTS_MAX} (fewer make under the {} presses an interval calibration needs)",
-                    tactex_core::hardness::interval_calibration::MIN_PER_BIN
-                ),
-            ));
-        }
+        interval_placements_within(self.interval_placements as u64)
+            .map_err(|e| FieldError::new("interval_placements", e))?;
         Ok(())
     }
 }
@@ -433,6 +452,71 @@ impl CalibrateRequest {
 pub const MAX_TABLE_NODES: u32 = 768;
 
 pub fn calibrate(args: &CalibrateRequest) -> Result<Calibration> {
+    let mut fit = fit_profile(args)?;
+    fit.measure_intervals(args.interval_placements);
+    Ok(fit)
+}
+
+impl Calibration {
+    /// Measures the default estimator's intervals through the profile just written and keeps
+    /// them beside it. The profile stands on its own: intervals that cannot be made are
+    /// reported with why, and the profile is kept (answers through it are then marked
+    /// uncalibrated).
+    pub fn measure_intervals(&mut self, placements: usize) {
+        if placements == 0 {
+            self.intervals_not_measured = Some(self.none_asked_for());
+            return;
+        }
+        match measure_beside(&self.profile, placements) {
+            Ok((file, c)) => {
+                self.intervals = Some(BesideIntervals {
+                    file,
+                    presses: c.presses,
+                    bins: c.bins.len(),
+                });
+                self.intervals_not_measured = None;
+            }
+            Err(e) => {
+                self.intervals_not_measured = Some(format!(
+                    "{e:#} (more placements press more; a gel with marker dots reads far better with its --markers frame)"
+                ))
+            }
+        }
+    }
+
+    /// Why no intervals were measured when none were asked for, naming a file beside the
+    /// profile that was measured through another one.
+    fn none_asked_for(&self) -> String {
+        match self.stale_beside() {
+            Some(path) => format!(
+                "none asked for (interval placements 0); {} beside it was measured through another profile and is not used",
+                path.display()
+            ),
+            None => "none asked for (interval placements 0)".into(),
+        }
+    }
+
+    /// An interval file beside the profile, under the default estimator's name, measured
+    /// through another profile.
+    fn stale_beside(&self) -> Option<PathBuf> {
+        let estimator: EstimatorChoice = crate::app::DEFAULT_ESTIMATOR
+            .parse()
+            .expect("the default estimator is named");
+        let name = estimator.flag_value();
+        match estimator.look_beside(
+            &self.profile,
+            Fidelity::default().name(),
+            &name,
+            &self.sensor,
+        ) {
+            Beside::Stale(path, _) => Some(path),
+            _ => None,
+        }
+    }
+}
+
+/// Fits the profile the request describes and writes it (its background beside it).
+fn fit_profile(args: &CalibrateRequest) -> Result<Calibration> {
     args.check()?;
     let (radius, scale) = (args.ball_radius_mm, args.mm_per_px);
     let nodes = args.mag_bins * args.dir_bins;
@@ -602,22 +686,6 @@ pub fn calibrate(args: &CalibrateRequest) -> Result<Calibration> {
         .validate()
         .map_err(|(field, message)| anyhow::anyhow!("the fitted profile: {field}: {message}"))?;
     write_profile_atomic(&args.out, &profile).context("--out")?;
-    // The profile stands on its own: intervals that cannot be measured through it are
-    // reported, and the profile is kept (its answers are then marked uncalibrated).
-    let (intervals, intervals_not_measured) = match args.interval_placements {
-        0 => (None, None),
-        placements => match measure_beside(&args.out, placements) {
-            Ok((file, c)) => (
-                Some(BesideIntervals {
-                    file,
-                    presses: c.presses,
-                    bins: c.bins.len(),
-                }),
-                None,
-            ),
-            Err(e) => (None, Some(format!("{e:#}"))),
-        },
-    };
     Ok(Calibration {
         profile: args.out.clone(),
         sensor: profile.id(),
@@ -629,55 +697,70 @@ pub fn calibrate(args: &CalibrateRequest) -> Result<Calibration> {
         noise_sigma_grey,
         markers,
         glow: profile.spec.glow.is_some(),
-        intervals,
-        intervals_not_measured,
+        intervals: None,
+        intervals_not_measured: None,
     })
 }
 
 pub(crate) fn run(args: &CalibrateArgs) -> Result<()> {
-    let fit = calibrate(&args.request())?;
-    if let Some(why) = &fit.intervals_not_measured {
+    let request = args.request();
+    let mut fit = fit_profile(&request)?;
+    if !args.json {
+        print_fit(&fit);
+    }
+    if request.interval_placements > 0 {
         eprintln!(
-            "warning: the profile is written, but its intervals were not measured ({why}); answers through it are marked uncalibrated"
+            "measuring the default estimator's intervals through {}: each catalog fruit pressed at {} places (--interval-placements 0 skips this)",
+            fit.profile.display(),
+            request.interval_placements
         );
     }
-    print_json_or_text(&fit, args.json, || {
-        if let Some(m) = &fit.markers {
-            println!(
-                "{}: markers {} x {}, pitch {:.3} mm, dot radius {:.3} mm, darkness {:.2}",
-                m.frame.display(),
-                m.cols,
-                m.rows,
-                m.pitch_mm,
-                m.radius_mm,
-                m.darkness
-            );
-        }
+    fit.measure_intervals(request.interval_placements);
+    match (&fit.intervals, &fit.intervals_not_measured) {
+        (Some(i), _) if !args.json => println!(
+            "{}: intervals measured on {} twin presses through the profile ({} {})",
+            i.file.display(),
+            i.presses,
+            i.bins,
+            if i.bins == 1 { "bin" } else { "bins" }
+        ),
+        (None, Some(why)) if request.interval_placements > 0 => eprintln!(
+            "warning: the profile is written, but its intervals could not be made ({why}); answers through it are marked uncalibrated"
+        ),
+        (None, Some(why)) if fit.stale_beside().is_some() => eprintln!("note: {why}"),
+        _ => {}
+    }
+    print_json_or_text(&fit, args.json, || Ok(()))
+}
+
+/// What was fitted, in lines.
+fn print_fit(fit: &Calibration) {
+    if let Some(m) = &fit.markers {
         println!(
-            "{}: fitted {} x {} bins to {} pixels of {} presses; rms residual R {:.2} G {:.2} B {:.2} grey levels",
-            fit.profile.display(),
-            fit.mag_bins,
-            fit.dir_bins,
-            fit.samples,
-            fit.presses,
-            fit.rms_grey[0],
-            fit.rms_grey[1],
-            fit.rms_grey[2]
+            "{}: markers {} x {}, pitch {:.3} mm, dot radius {:.3} mm, darkness {:.2}",
+            m.frame.display(),
+            m.cols,
+            m.rows,
+            m.pitch_mm,
+            m.radius_mm,
+            m.darkness
         );
-        println!(
-            "camera noise {:.2} grey levels (1 sigma); profile {}",
-            fit.noise_sigma_grey, fit.sensor
-        );
-        if let Some(i) = &fit.intervals {
-            println!(
-                "{}: intervals measured on {} twin presses through the profile ({} bins)",
-                i.file.display(),
-                i.presses,
-                i.bins
-            );
-        }
-        Ok(())
-    })
+    }
+    println!(
+        "{}: fitted {} x {} bins to {} pixels of {} presses; rms residual R {:.2} G {:.2} B {:.2} grey levels",
+        fit.profile.display(),
+        fit.mag_bins,
+        fit.dir_bins,
+        fit.samples,
+        fit.presses,
+        fit.rms_grey[0],
+        fit.rms_grey[1],
+        fit.rms_grey[2]
+    );
+    println!(
+        "camera noise {:.2} grey levels (1 sigma); profile {}",
+        fit.noise_sigma_grey, fit.sensor
+    );
 }
 
 #[cfg(test)]
