@@ -555,10 +555,6 @@ pub(crate) fn run(args: &FruitEvalArgs) -> Result<()> {
     })
 }
 
-/// Placements of each kind `calibrate` measures a new profile's intervals on, by default:
-/// 176 presses, three bins (docs/sim-to-real.md).
-pub const BESIDE_PLACEMENTS: usize = 16;
-
 /// Measures the default estimator's interval calibration through the profile at `profile`
 /// (each kind alone at `placements` places, seed 1) and writes it beside the profile, where
 /// every command that loads the estimator through that profile finds it.

@@ -6,7 +6,8 @@ use crate::app::ball_presses::{self, Split, contact_box, rebuild};
 use crate::app::estimator_choice::{Beside, EstimatorChoice};
 use crate::app::flag_range::{FieldError, choice, count};
 use crate::app::request_json::parsed;
-use crate::eval::fruits::{BESIDE_PLACEMENTS, measure_beside};
+#[cfg(feature = "plots")]
+use crate::eval::fruits::measure_beside;
 use crate::report::output::write_profile_atomic;
 use crate::report::tail::print_json_or_text;
 use anyhow::{Context, Result, bail};
@@ -166,6 +167,10 @@ fn interval_placements_within(v: u64) -> Result<(), String> {
         tactex_core::hardness::interval_calibration::MIN_PER_BIN
     ))
 }
+
+/// Placements of each kind `calibrate` measures a new profile's intervals on, by default:
+/// 176 presses, three bins (docs/sim-to-real.md).
+pub const BESIDE_PLACEMENTS: usize = 16;
 
 /// The fewest placements of each catalog fruit that make the presses an interval
 /// calibration needs (11 kinds: 44 presses against 40), and the most.
@@ -467,6 +472,17 @@ impl Calibration {
             self.intervals_not_measured = Some(self.none_asked_for());
             return;
         }
+        #[cfg(not(feature = "plots"))]
+        let measure_beside = |_: &std::path::Path,
+                              _: usize|
+         -> Result<(
+            PathBuf,
+            tactex_core::hardness::interval_calibration::IntervalCalibration,
+        )> {
+            bail!(
+                "this build of the library has no fruit evaluation (its `plots` feature); `tactex calibrate` measures them"
+            )
+        };
         match measure_beside(&self.profile, placements) {
             Ok((file, c)) => {
                 self.intervals = Some(BesideIntervals {
