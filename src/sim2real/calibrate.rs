@@ -148,7 +148,7 @@ fn interval_placements_flag(text: &str) -> Result<usize, String> {
         )
     })?;
     interval_placements_within(v)?;
-    usize::try_from(v).map_err(|_| format!("{v} is too large"))
+    Ok(v as usize)
 }
 
 /// 0 (none), or enough placements to make the presses a calibration needs, and not more
@@ -157,14 +157,16 @@ fn interval_placements_within(v: u64) -> Result<(), String> {
     if v == 0 || (INTERVAL_PLACEMENTS_MIN..=INTERVAL_PLACEMENTS_MAX).contains(&v) {
         return Ok(());
     }
-    if v > INTERVAL_PLACEMENTS_MAX {
-        return Err(format!(
-            "{v}: 0 for none, or {INTERVAL_PLACEMENTS_MIN} to {INTERVAL_PLACEMENTS_MAX}"
-        ));
-    }
+    let why = if v < INTERVAL_PLACEMENTS_MIN {
+        format!(
+            " (fewer make under the {} presses an interval calibration needs)",
+            tactex_core::hardness::interval_calibration::MIN_PER_BIN
+        )
+    } else {
+        String::new()
+    };
     Err(format!(
-        "{v}: 0 for none, or {INTERVAL_PLACEMENTS_MIN} to {INTERVAL_PLACEMENTS_MAX} (fewer make under the {} presses an interval calibration needs)",
-        tactex_core::hardness::interval_calibration::MIN_PER_BIN
+        "{v}: 0 for none, or {INTERVAL_PLACEMENTS_MIN} to {INTERVAL_PLACEMENTS_MAX}{why}"
     ))
 }
 
@@ -472,17 +474,6 @@ impl Calibration {
             self.intervals_not_measured = Some(self.none_asked_for());
             return;
         }
-        #[cfg(not(feature = "plots"))]
-        let measure_beside = |_: &std::path::Path,
-                              _: usize|
-         -> Result<(
-            PathBuf,
-            tactex_core::hardness::interval_calibration::IntervalCalibration,
-        )> {
-            bail!(
-                "this build of the library has no fruit evaluation (its `plots` feature); `tactex calibrate` measures them"
-            )
-        };
         match measure_beside(&self.profile, placements) {
             Ok((file, c)) => {
                 self.intervals = Some(BesideIntervals {
@@ -529,6 +520,20 @@ impl Calibration {
             _ => None,
         }
     }
+}
+
+/// A library built without eval (the `plots` feature) cannot press the catalog.
+#[cfg(not(feature = "plots"))]
+fn measure_beside(
+    _profile: &std::path::Path,
+    _placements: usize,
+) -> Result<(
+    PathBuf,
+    tactex_core::hardness::interval_calibration::IntervalCalibration,
+)> {
+    bail!(
+        "this build of the library has no fruit evaluation (its `plots` feature); `tactex calibrate` measures them"
+    )
 }
 
 /// Fits the profile the request describes and writes it (its background beside it).
