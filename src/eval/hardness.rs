@@ -44,6 +44,10 @@ pub struct HardnessEvalArgs {
     /// Write hardness.png (predicted against true), predictions.jsonl and scores.json here.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Also write frames.jsonl to --out: every frame's gel peak and contact radius from the
+    /// solver beside what the reader makes of the frame (where a profile's reading fails).
+    #[arg(long, requires = "out")]
+    frames: bool,
     /// Also score this trained model (NAME.onnx with its card NAME.json beside it); repeatable.
     #[arg(long)]
     model: Vec<PathBuf>,
@@ -90,6 +94,22 @@ struct Prediction {
     error: Option<String>,
 }
 
+/// One frame of a held-out press: the solver's gel beside the reader's (`tactex read`'s
+/// figures, the peak also as the indentation estimator takes it, over the border's share).
+#[derive(Serialize)]
+struct FrameRecord {
+    index: u64,
+    frame: usize,
+    travel_mm: f64,
+    gel_peak_mm: f64,
+    contact_radius_mm: f64,
+    read_peak_mm: f64,
+    border_share: f64,
+    read_contact_radius_mm: f64,
+    contact_edge: &'static str,
+    within_frame: bool,
+}
+
 /// One held-out press and what each estimator made of it.
 #[derive(Serialize)]
 struct PressRecord {
@@ -99,6 +119,8 @@ struct PressRecord {
     true_shore_a: f64,
     true_modulus_mpa: f64,
     predictions: Vec<Prediction>,
+    #[serde(skip)]
+    frames: Vec<FrameRecord>,
 }
 
 pub(crate) fn run(args: &HardnessEvalArgs) -> Result<()> {
@@ -174,6 +196,10 @@ pub(crate) fn run(args: &HardnessEvalArgs) -> Result<()> {
                     }
                 })
                 .collect();
+            let frames = match args.frames {
+                true => frame_records(index, &press.frames, &sequence, &spec),
+                false => Vec::new(),
+            };
             bar.inc(1);
             Ok(PressRecord {
                 index,
@@ -182,6 +208,7 @@ pub(crate) fn run(args: &HardnessEvalArgs) -> Result<()> {
                 true_shore_a: draw.shore_a,
                 true_modulus_mpa: draw.modulus_mpa,
                 predictions,
+                frames,
             })
         })
         .collect::<Result<_>>()?;
@@ -253,6 +280,14 @@ pub(crate) fn run(args: &HardnessEvalArgs) -> Result<()> {
             lines.push('\n');
         }
         write_bytes_atomic(&dir.join("predictions.jsonl"), lines.as_bytes())?;
+        if args.frames {
+            let mut lines = String::new();
+            for f in records.iter().flat_map(|r| &r.frames) {
+                lines += &serde_json::to_string(f)?;
+                lines.push('\n');
+            }
+            write_bytes_atomic(&dir.join("frames.jsonl"), lines.as_bytes())?;
+        }
         write_json_atomic(&dir.join("scores.json"), &report)?;
         plot::predicted_vs_true(
             &dir.join("hardness.png"),
@@ -298,4 +333,38 @@ pub(crate) fn run(args: &HardnessEvalArgs) -> Result<()> {
         Ok(())
     })?;
     Ok(())
+}
+
+/// Each frame of a press read as the indentation estimator reads it, beside the solver's.
+fn frame_records(
+    index: u64,
+    solved: &[tactex_sim::datagen::press_protocol::PressedFrame],
+    sequence: &tactex_core::hardness::estimate::PressSequence,
+    spec: &tactex_core::tactile::spec::TactileSpec,
+) -> Vec<FrameRecord> {
+    use tactex_core::hardness::border_level::read_share_of_indentation;
+    use tactex_core::tactile::frame_reading::read_frame;
+    solved
+        .iter()
+        .zip(&sequence.frames)
+        .enumerate()
+        .filter_map(|(frame, (truth, image))| {
+            let reading = read_frame(&image.image, &sequence.reference.image, spec)?;
+            Some(FrameRecord {
+                index,
+                frame,
+                travel_mm: truth.travel_mm,
+                gel_peak_mm: truth.gel_max_indentation_mm,
+                contact_radius_mm: truth.contact_radius_mm,
+                read_peak_mm: reading.peak_mm,
+                border_share: read_share_of_indentation(&reading, &spec.gel),
+                read_contact_radius_mm: reading.contact_radius_mm(),
+                contact_edge: match reading.contact_outline_px {
+                    Some(_) => "outline",
+                    None => "half_depth",
+                },
+                within_frame: reading.within_frame,
+            })
+        })
+        .collect()
 }

@@ -44,6 +44,7 @@ fn scores_each_estimator_and_draws_predicted_against_true() {
         "--json",
         "--out",
         out.to_str().unwrap(),
+        "--frames",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
@@ -81,6 +82,39 @@ fn scores_each_estimator_and_draws_predicted_against_true() {
     let learned = &first["predictions"][2]["evidence"];
     assert_eq!(learned["kind"], "learned");
     assert_eq!(learned["backend"], "tract");
+    // Every frame's reading beside the solver's gel: on the stock Mini a sphere's frames
+    // within the frame read their peak (over the border's share) and contact radius within
+    // a fifth of the solver's, the median within a tenth.
+    let frames: Vec<serde_json::Value> = std::fs::read_to_string(out.join("frames.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(frames.len(), 4 * 8);
+    let f = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
+    let within: Vec<&serde_json::Value> = frames
+        .iter()
+        .filter(|v| v["within_frame"] == true)
+        .collect();
+    assert!(within.len() >= 16, "{} of 32 frames within", within.len());
+    let median_error = |read: &dyn Fn(&serde_json::Value) -> f64, truth: &str| {
+        let mut e: Vec<f64> = within
+            .iter()
+            .map(|v| (read(v) / f(v, truth) - 1.0).abs())
+            .collect();
+        e.sort_by(f64::total_cmp);
+        assert!(e[e.len() * 9 / 10] < 0.2, "{truth}: {e:?}");
+        e[e.len() / 2]
+    };
+    let peak = median_error(
+        &|v| f(v, "read_peak_mm") / f(v, "border_share"),
+        "gel_peak_mm",
+    );
+    let radius = median_error(&|v| f(v, "read_contact_radius_mm"), "contact_radius_mm");
+    assert!(
+        peak < 0.1 && radius < 0.1,
+        "median errors: peak {peak}, radius {radius}"
+    );
 }
 
 #[test]
@@ -207,6 +241,7 @@ fn bad_hardness_arguments_are_named() {
             (&["--count", "2"], "--count"),
             (&["--shapes", "cube"], "--shapes"),
             (&["--fidelity", "exact"], "--fidelity"),
+            (&["--frames"], "--out"),
             (&["--model", "no-such-model.onnx"], "no-such-model.json"),
         ],
     );

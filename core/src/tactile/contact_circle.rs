@@ -216,11 +216,10 @@ fn imprint_starts(change: &[[f32; 3]], w: u32, h: u32) -> Vec<(f64, f64)> {
 }
 
 /// On each ray from `centre`, the edge: halfway between the change's peak within `reach`
-/// and its steepest fall just outside it. When most rays are still rising at the reach (a
-/// round contact wider than it), those follow on towards the frame's border until the change
-/// falls below half its peak; a few rising rays are a strip's length or noise, not a wider
-/// contact, and give none. Rays that leave the frame before half the reach, or before the
-/// fall, or peak at the start, give none.
+/// and its steepest fall just outside it. Rays still rising at the reach (a contact wider
+/// than it, or a strip's length) follow on towards the frame's border until the change falls
+/// below half its peak. Rays that leave the frame before half the reach, or before the fall,
+/// or peak at the start, give none.
 fn ray_edges(magnitude: &FloatImage, centre: (f64, f64), reach: f64) -> Vec<[f64; 2]> {
     let (w, h) = (magnitude.width() as f64, magnitude.height() as f64);
     let steps = ((reach - RAY_START_PX) / RAY_STEP_PX) as usize;
@@ -244,14 +243,13 @@ fn ray_edges(magnitude: &FloatImage, centre: (f64, f64), reach: f64) -> Vec<[f64
             (samples.len() >= steps / 2).then_some((direction, samples, peak))
         })
         .collect();
-    let rising = rays.iter().filter(|(_, _, peak)| peak + 1 == steps).count();
-    let follow_on = rising >= RAYS / 2;
+    // A peak within the fall's search of the reach has no room left to show its fall: its
+    // ray is still rising as far as the reach can tell (an outline there is the reach's), so
+    // it follows on; left out, the shorter rays alone would pull the circle in.
+    let at_reach = |peak: usize| peak + search >= steps;
     let mut edges = Vec::with_capacity(RAYS);
     for (direction, mut samples, mut peak) in rays {
-        if peak + 1 == steps {
-            if !follow_on {
-                continue;
-            }
+        if at_reach(peak) {
             let mut fell = false;
             while let Some(v) = sample(direction, samples.len()) {
                 samples.push(v);
@@ -476,6 +474,33 @@ mod tests {
                 c.radius_px
             );
         }
+    }
+
+    #[test]
+    fn a_fall_just_past_the_reach_is_looked_for_there() {
+        // Reach 0.45 x 200 = 90 px. The change peaks at 86 px, inside the edge (as the shading
+        // flattens at steep slopes), eases off and falls at 94 px, within the fall's search of
+        // the peak but past the reach: the edge, halfway between peak and fall, is at 90 px.
+        // Looked for only within the reach, the fall was the easing off and the edge 87.7 px.
+        let (w, h, centre) = (240u32, 200u32, (120.0, 100.0));
+        let change = |r: f64| match r {
+            r if r <= 86.0 => 100.0 * r / 86.0,
+            r if r <= 93.0 => 100.0 - (r - 86.0),
+            r if r <= 95.0 => 93.0 * (95.0 - r) / 2.0,
+            _ => 0.0,
+        };
+        let lights = [(1.0, 0.0), (-0.5, 0.87), (-0.5, -0.87)];
+        let reference = RgbImage::from_pixel(w, h, image::Rgb([120, 120, 120]));
+        let frame = RgbImage::from_fn(w, h, |x, y| {
+            let (dx, dy) = (x as f64 - centre.0, y as f64 - centre.1);
+            let r = dx.hypot(dy).max(1e-6);
+            image::Rgb(std::array::from_fn(|c| {
+                let (lx, ly) = lights[c];
+                (120.0 + change(r) * (lx * dx + ly * dy) / r).round() as u8
+            }))
+        });
+        let c = estimate_contact_circle(&frame, &reference).expect("a circle");
+        assert!((c.radius_px - 90.0).abs() < 1.0, "radius {}", c.radius_px);
     }
 
     #[test]
