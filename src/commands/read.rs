@@ -166,10 +166,7 @@ pub fn read(args: &ReadRequest) -> Result<(ReadReport, FrameReading, image::RgbI
         imprint,
         peak_depth_mm: reading.peak_mm.max(0.0),
         contact_axes_mm: imprint.then_some(reading.contact_axes_mm),
-        contact_edge: imprint.then_some(match reading.contact_outline_px {
-            Some(_) => "outline",
-            None => "half_depth",
-        }),
+        contact_edge: imprint.then(|| reading.contact_edge()),
         contact_radius_mm: imprint.then(|| reading.contact_radius_mm()),
         within_frame: imprint.then_some(reading.within_frame),
         readable_share: readable as f64 / reading.valid.len() as f64,

@@ -359,10 +359,7 @@ fn frame_records(
                 read_peak_mm: reading.peak_mm,
                 border_share: read_share_of_indentation(&reading, &spec.gel),
                 read_contact_radius_mm: reading.contact_radius_mm(),
-                contact_edge: match reading.contact_outline_px {
-                    Some(_) => "outline",
-                    None => "half_depth",
-                },
+                contact_edge: reading.contact_edge(),
                 within_frame: reading.within_frame,
             })
         })

@@ -46,6 +46,15 @@ impl FrameReading {
         (self.contact_axes_mm[0] * self.contact_axes_mm[1]).sqrt()
     }
 
+    /// Where the contact's size was taken: "outline" (the round outline where the gel's slope
+    /// peaks) or "half_depth" (the region deeper than half the peak).
+    pub fn contact_edge(&self) -> &'static str {
+        match self.contact_outline_px {
+            Some(_) => "outline",
+            None => "half_depth",
+        }
+    }
+
     /// Whether a pixel lies in the contact region its size is taken from: inside the
     /// outline, or in the half-depth region.
     pub fn in_contact(&self, i: usize) -> bool {
