@@ -61,6 +61,12 @@ pub fn short_number(v: f64) -> String {
     }
 }
 
+/// A list of numbers from outside as `[a, b, c]`, each `short_number`.
+pub fn short_numbers(v: &[f64]) -> String {
+    let items: Vec<String> = v.iter().map(|x| short_number(*x)).collect();
+    format!("[{}]", items.join(", "))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -17,7 +17,9 @@
 
 use crate::catalog::{FruitCatalog, FruitShape};
 use crate::geometry::{CameraIntrinsics, Pose};
+use crate::hand_eye::calibration_file::PLACEMENT_LIMIT_M;
 use crate::hardness::scale::Hardness;
+use crate::printable::{short_number, short_numbers};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -258,8 +260,8 @@ impl Scene {
                 "table.size_m",
                 format!(
                     "[{}, {}] m: each side must be {} to {} m",
-                    crate::printable::short_number(table.size_m[0]),
-                    crate::printable::short_number(table.size_m[1]),
+                    short_number(table.size_m[0]),
+                    short_number(table.size_m[1]),
                     TABLE_SIZE_M[0],
                     TABLE_SIZE_M[1]
                 ),
@@ -313,6 +315,19 @@ impl Scene {
                 "position_m and look_at_m must be finite".into(),
             ));
         }
+        // The limit a table-top rig stands in, as for a rig's `devices.toml`: far beyond it the
+        // direction between the two points is lost to rounding.
+        for (name, at) in [("camera.position_m", eye), ("camera.look_at_m", target)] {
+            if at.iter().any(|v| v.abs() > PLACEMENT_LIMIT_M) {
+                return Err(err(
+                    name,
+                    format!(
+                        "{} must be within {PLACEMENT_LIMIT_M} m of the world's origin on each axis",
+                        short_numbers(&at)
+                    ),
+                ));
+            }
+        }
         let pose = Pose::camera_looking_at(DVec3::from_array(eye), DVec3::from_array(target))
             .ok_or_else(|| {
                 err(
@@ -354,7 +369,7 @@ impl Scene {
                     &field(name),
                     format!(
                         "{} m is not a size an object on a table has ({} to {} m)",
-                        crate::printable::short_number(v),
+                        short_number(v),
                         OBJECT_SIZE_M[0],
                         OBJECT_SIZE_M[1]
                     ),
@@ -385,14 +400,17 @@ impl Scene {
         if !(x.is_finite() && y.is_finite()) {
             return Err(err(
                 &field("position_m"),
-                format!("must be finite, got [{x}, {y}]"),
+                format!("must be finite, got {}", short_numbers(&[x, y])),
             ));
         }
         let [hx, hy] = [table.size_m[0] / 2.0, table.size_m[1] / 2.0];
         if x.abs() > hx || y.abs() > hy {
             return Err(err(
                 &field("position_m"),
-                format!("[{x}, {y}] is off the table (|x| <= {hx}, |y| <= {hy})"),
+                format!(
+                    "{} is off the table (|x| <= {hx}, |y| <= {hy})",
+                    short_numbers(&[x, y])
+                ),
             ));
         }
         let yaw_deg = o.yaw_deg.unwrap_or(0.0);
@@ -406,7 +424,7 @@ impl Scene {
         if !(poisson.is_finite() && (0.0..0.5).contains(&poisson)) {
             return Err(err(
                 &field("poisson"),
-                format!("must lie in [0, 0.5), got {poisson}"),
+                format!("must lie in [0, 0.5), got {}", short_number(poisson)),
             ));
         }
         let explicit_hardness = match (&o.hardness, o.modulus_mpa) {
@@ -505,7 +523,7 @@ impl Scene {
                                         &field("scale"),
                                         format!(
                                             "{} is not a mesh unit in metres ({} for millimetres to {})",
-                                            crate::printable::short_number(scale),
+                                            short_number(scale),
                                             MESH_SCALE[0] * 10.0,
                                             MESH_SCALE[1]
                                         ),

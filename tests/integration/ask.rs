@@ -329,6 +329,10 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
             "name = \"x\"\n[[objects]]\nkind = \"lime\"\nposition_m = [0.0, 1.5]\n",
             "objects[0].position_m: [0, 1.5] is off the table",
         ),
+        (
+            "name = \"x\"\n[[objects]]\nkind = \"lime\"\nposition_m = [1e308, 0.0]\n",
+            "objects[0].position_m: [1e308, 0] is off the table",
+        ),
         // Nonsense a scene must not carry into the world: sizes no object on a table has,
         // objects placed in one another, a camera that cannot see the table or stands in a
         // fruit. `scene check` and `ask` refuse them alike.
@@ -355,6 +359,11 @@ fn bad_input_gets_a_one_line_error_naming_file_and_field() {
         (
             "name = \"x\"\n[camera]\nposition_m = [0.0, 0.0, 0.02]\nlook_at_m = [0.0, 0.1, 0.0]\n[[objects]]\nkind = \"apple\"\nposition_m = [0, 0]\n",
             "camera: at [0.0, 0.0, 0.02] it stands inside objects[0] (apple)",
+        ),
+        // So far away that the direction to the table is lost to rounding.
+        (
+            "name = \"x\"\n[camera]\nposition_m = [1e308, 0.0, 0.7]\nlook_at_m = [0.0, 0.0, 0.0]\n",
+            "camera.position_m: [1e308, 0, 0.7] must be within 10 m of the world's origin on each axis",
         ),
     ];
     for (body, expected) in cases {
