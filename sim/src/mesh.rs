@@ -171,7 +171,10 @@ impl TriMesh {
         let (lo, hi) = self.bounds();
         let ext = hi - lo;
         if ext.min_element() <= 1e-6 * ext.max_element().max(1e-12) {
-            return Err(bad("flat or zero-size bounding box"));
+            return Err(bad(&format!(
+                "flat or zero-size: its bounding box spans {:?} (mesh units), a side under a millionth of the longest",
+                ext.to_array().map(|v| v as f32)
+            )));
         }
         let area: f64 = self
             .triangles
@@ -1027,6 +1030,15 @@ mod tests {
         )
         .unwrap();
         assert!(load(&flat).unwrap_err().to_string().contains("degenerate"));
+        // One vertex 1e30 out: the box is named, so the far vertex is found, not hunted for.
+        let far = dir.path().join("far.obj");
+        std::fs::write(
+            &far,
+            "v 0 0 0\nv 1e30 0 0\nv 0 0.05 0\nv 0 0 0.05\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n",
+        )
+        .unwrap();
+        let e = load(&far).unwrap_err().to_string();
+        assert!(e.contains("bounding box spans [1e30, 0.05, 0.05]"), "{e}");
         let garbage = dir.path().join("bad.glb");
         std::fs::write(&garbage, "not a gltf").unwrap();
         assert!(
