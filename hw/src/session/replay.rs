@@ -275,7 +275,7 @@ fn check_poses(manifest: &Manifest) -> Result<(), (String, String)> {
                 format!(
                     "position {} is more than {MAX_PLACE_M} m from the world's origin; a \
                      session's poses lie in one workcell",
-                    pose.position
+                    tactex_core::printable::short_numbers(&pose.position.to_array())
                 ),
             ));
         }
@@ -290,6 +290,64 @@ fn check_poses(manifest: &Manifest) -> Result<(), (String, String)> {
                 .enumerate()
                 .map(|(i, m)| (format!("arm.moves[{i}].time_s"), m.time_s)),
         );
+    // The pipeline asks every move at a positive speed; another was edited in, and would
+    // only show later as the replay diverging from the recording.
+    for (i, m) in manifest.arm.moves.iter().enumerate() {
+        if !(m.speed_m_s.is_finite() && m.speed_m_s > 0.0) {
+            return Err((
+                format!("arm.moves[{i}].speed_m_s"),
+                format!(
+                    "{} is not a speed a move is asked at (m/s, positive)",
+                    tactex_core::printable::short_number(m.speed_m_s)
+                ),
+            ));
+        }
+    }
+    // A device's frames are listed in the order taken.
+    let stamps = [
+        (
+            "camera.frames",
+            manifest
+                .camera
+                .frames
+                .iter()
+                .map(|f| f.timestamp_s)
+                .collect::<Vec<f64>>(),
+        ),
+        (
+            "tactile.frames",
+            manifest
+                .tactile
+                .frames
+                .iter()
+                .map(|f| f.timestamp_s)
+                .collect(),
+        ),
+    ];
+    for (list, stamps) in stamps {
+        for (i, t) in stamps.iter().enumerate() {
+            let field = format!("{list}[{i}].timestamp_s");
+            if !(t.is_finite() && t.abs() <= MAX_CLOCK_S) {
+                return Err((
+                    field,
+                    format!(
+                        "{} is not a frame's time (seconds within 1e10)",
+                        tactex_core::printable::short_number(*t)
+                    ),
+                ));
+            }
+            if i > 0 && *t < stamps[i - 1] {
+                return Err((
+                    field,
+                    format!(
+                        "{} is before the frame listed before it ({}); frames are listed in the order taken",
+                        tactex_core::printable::short_number(*t),
+                        tactex_core::printable::short_number(stamps[i - 1])
+                    ),
+                ));
+            }
+        }
+    }
     for (field, time) in times {
         if let Some(t) = time.filter(|t| !(t.is_finite() && t.abs() <= MAX_CLOCK_S)) {
             return Err((

@@ -277,6 +277,29 @@ fn a_session_no_device_could_have_recorded_is_refused_when_opened() {
     assert!(err.contains("camera.depth_scale_m: 1e308"), "{err}");
     let err = refused(&|m| m["arm"]["start_time_s"] = (-1e308).into());
     assert!(err.contains("arm.start_time_s: -1e308"), "{err}");
+    let err = refused(&|m| m["camera"]["pose"]["position"] = serde_json::json!([1e300, 0, 0]));
+    assert!(err.contains("position [1e300, 0, 0] is more"), "{err}");
+    // Frames listed out of the order taken, and a move asked at no speed: edits no device
+    // makes, which would show only later as the replay diverging from the recording.
+    let err = refused(&|m| {
+        let mut late = m["tactile"]["frames"][0].clone();
+        late["timestamp_s"] = 2.0.into();
+        let mut early = late.clone();
+        early["timestamp_s"] = 1.0.into();
+        m["tactile"]["frames"] = serde_json::json!([late, early]);
+    });
+    assert!(
+        err.contains("tactile.frames[1].timestamp_s: 1 is before the frame listed before it (2)"),
+        "{err}"
+    );
+    let err = refused(&|m| m["camera"]["frames"][0]["timestamp_s"] = 1e300.into());
+    assert!(err.contains("camera.frames[0].timestamp_s: 1e300"), "{err}");
+    let err = refused(&|m| {
+        let pose = m["arm"]["start_pose"].clone();
+        m["arm"]["moves"] = serde_json::json!([{"target": pose, "speed_m_s": -0.05,
+            "reached": pose, "time_s": null, "error": null}]);
+    });
+    assert!(err.contains("arm.moves[0].speed_m_s: -0.05"), "{err}");
     // One frame listed past any question's count is refused before a frame is decoded.
     let err = refused(&|m| {
         let frame = m["tactile"]["frames"][0].clone();
