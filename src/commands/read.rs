@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use tactex_core::tactile::frame_reading::{FrameReading, read_frame};
 use tactex_core::tactile::sensor_profile::ProfileId;
+use tactex_core::tactile::slopes::ColourDrift;
 
 #[derive(Args, Debug)]
 pub struct ReadArgs {
@@ -156,7 +157,8 @@ pub fn read(args: &ReadRequest) -> Result<(ReadReport, FrameReading, image::RgbI
             );
         }
     }
-    let reading = read_frame(&image, &reference, spec).expect("sizes were checked");
+    let reading =
+        read_frame(&image, &reference, spec, ColourDrift::Measured).expect("sizes were checked");
     let readable = reading.valid.iter().filter(|v| **v).count();
     let imprint = reading.peak_mm >= MIN_IMPRINT_MM;
     let report = ReadReport {

@@ -344,12 +344,16 @@ fn frame_records(
 ) -> Vec<FrameRecord> {
     use tactex_core::hardness::border_level::read_share_of_indentation;
     use tactex_core::tactile::frame_reading::read_frame;
+    use tactex_core::tactile::slopes::ColourDrift;
+    // Read as the estimators read a press: its first frame's drift given to the rest.
+    let mut drift = ColourDrift::Measured;
     solved
         .iter()
         .zip(&sequence.frames)
         .enumerate()
         .filter_map(|(frame, (truth, image))| {
-            let reading = read_frame(&image.image, &sequence.reference.image, spec)?;
+            let reading = read_frame(&image.image, &sequence.reference.image, spec, drift)?;
+            drift = drift.for_next_frame(reading.drift);
             Some(FrameRecord {
                 index,
                 frame,

@@ -9,6 +9,7 @@ use serde::Serialize;
 use tactex_core::stats::median;
 use tactex_core::tactile::ball_calibration::BallPress;
 use tactex_core::tactile::frame_reading::read_frame;
+use tactex_core::tactile::slopes::ColourDrift;
 use tactex_core::tactile::spec::TactileSpec;
 
 #[derive(Serialize, Debug, Clone, Copy)]
@@ -31,7 +32,7 @@ pub fn score_reading(
     press: &BallPress,
     model_depth_mm: f64,
 ) -> Option<ReadingScore> {
-    let r = read_frame(frame, reference, spec)?;
+    let r = read_frame(frame, reference, spec, ColourDrift::Measured)?;
     let radius = r.contact_radius_mm();
     Some(ReadingScore {
         peak_depth_mm: r.peak_mm,

@@ -155,6 +155,7 @@ mod tests {
             within_frame: true,
             imprint_middle_px: middle,
             mm_per_px: MM_PER_PX,
+            drift: None,
         };
         // A round contact: the share of the circle of its area (5 mm).
         let round = read_share_of_indentation(&reading([6.25, 4.0], Some(MIDDLE)), &gel);

@@ -15,7 +15,7 @@
 use crate::frames::TactileFrame;
 use crate::hardness::scale::Hardness;
 use crate::hertz::{Elastic, Hertz, object_modulus_from_share};
-use crate::tactile::slopes::{SlopeField, recover_slopes};
+use crate::tactile::slopes::{ColourDrift, SlopeField, recover_slopes};
 use crate::tactile::spec::TactileSpec;
 use serde::Serialize;
 
@@ -289,10 +289,15 @@ impl HardnessEstimator for HertzSlopeEstimator {
         if press.travel_mm.iter().any(|t| !t.is_finite()) {
             return Err(EstimateError::BadSequence("travel must be finite".into()));
         }
+        let mut drift = ColourDrift::Measured;
         let fields: Vec<SlopeField> = press
             .frames
             .iter()
-            .map(|f| recover_slopes(&f.image, &press.reference.image, spec))
+            .map(|f| {
+                let field = recover_slopes(&f.image, &press.reference.image, spec, drift)?;
+                drift = drift.for_next_frame(field.drift);
+                Some(field)
+            })
             .collect::<Option<_>>()
             .ok_or_else(|| EstimateError::BadSequence("frame and reference sizes differ".into()))?;
         let last = fields.last().expect("at least two frames");

@@ -18,6 +18,7 @@ use crate::hardness::layer_compliance::hertz_ellipse_centre_compliance_ratio;
 use crate::hardness::scale::Hardness;
 use crate::hertz::Elastic;
 use crate::tactile::frame_reading::read_frame;
+use crate::tactile::slopes::ColourDrift;
 use crate::tactile::spec::TactileSpec;
 
 #[derive(Clone, Debug)]
@@ -57,11 +58,13 @@ impl HardnessEstimator for IndentationEstimator {
         let mut peaks = Vec::with_capacity(n);
         let mut contact_axes = Vec::with_capacity(n);
         let mut within_frame = Vec::with_capacity(n);
+        let mut drift = ColourDrift::Measured;
         for frame in &press.frames {
-            let reading =
-                read_frame(&frame.image, &press.reference.image, spec).ok_or_else(|| {
+            let reading = read_frame(&frame.image, &press.reference.image, spec, drift)
+                .ok_or_else(|| {
                     EstimateError::BadSequence("frame and reference sizes differ".into())
                 })?;
+            drift = drift.for_next_frame(reading.drift);
             contact_axes.push(reading.contact_axes_mm);
             within_frame.push(reading.within_frame);
             // The peak read against the frame's border, as the gel's indentation.

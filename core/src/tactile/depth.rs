@@ -109,6 +109,7 @@ mod tests {
             gx: vec![0.0; w * h],
             gy: vec![0.0; w * h],
             valid: vec![true; w * h],
+            drift: None,
         };
         for y in 0..h {
             for x in 0..w {
@@ -163,6 +164,7 @@ mod tests {
             gx: vec![0.0; w * h],
             gy: vec![0.0; w * h],
             valid: vec![true; w * h],
+            drift: None,
         };
         let cap = |x: f64, y: f64| {
             let q = (x - cx * px).powi(2) + (y - 60.0 * px).powi(2);

@@ -6,7 +6,7 @@
 
 use crate::tactile::contact_circle::contact_circle_around;
 use crate::tactile::depth::integrate_slopes;
-use crate::tactile::slopes::recover_slopes;
+use crate::tactile::slopes::{ColourDrift, recover_slopes};
 use crate::tactile::spec::TactileSpec;
 use image::RgbImage;
 use std::f64::consts::PI;
@@ -38,6 +38,9 @@ pub struct FrameReading {
     /// The gel's size of one pixel of this reading (mm): the frame's, or twice it where the
     /// frame was read on 2 x 2 blocks.
     pub mm_per_px: f64,
+    /// The colour drift taken out (grey levels per channel), where the frame was read through
+    /// a glow: a press's first frame's is given to its deeper ones.
+    pub drift: Option<[f32; 3]>,
 }
 
 impl FrameReading {
@@ -86,8 +89,9 @@ pub fn read_frame(
     frame: &RgbImage,
     reference: &RgbImage,
     spec: &TactileSpec,
+    drift: ColourDrift,
 ) -> Option<FrameReading> {
-    let slopes = recover_slopes(frame, reference, spec)?;
+    let slopes = recover_slopes(frame, reference, spec, drift)?;
     let depth = integrate_slopes(&slopes);
     let p = peak(&depth);
     let deep = |d: f64| d > 0.5 * p;
@@ -134,6 +138,7 @@ pub fn read_frame(
         within_frame,
         imprint_middle_px: middle.map(|(x, y)| [x, y]),
         mm_per_px: slopes.mm_per_px,
+        drift: slopes.drift,
     })
 }
 

@@ -23,6 +23,32 @@ pub struct SlopeField {
     pub gx: Vec<f32>,
     pub gy: Vec<f32>,
     pub valid: Vec<bool>,
+    /// The colour drift taken out of the frame (grey levels per channel), where it was read
+    /// through a glow.
+    pub drift: Option<[f32; 3]>,
+}
+
+/// A frame's colour drift from its reference: real frames drift from shot to shot far from
+/// any contact. A frame's own untouched gel carries a wide imprint's glow too, so a press's
+/// deeper frames take the drift its first frame (the least imprint, the least glow) shows:
+/// the frames of one press are taken within seconds, under the same light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ColourDrift {
+    /// Measured on the frame's own gel that a first reading calls untouched.
+    Measured,
+    /// Given (grey levels per channel).
+    Given([f32; 3]),
+}
+
+impl ColourDrift {
+    /// What a press's next frame takes, after a frame read with `self` took out `taken`: the
+    /// first frame's drift, once there is one.
+    pub fn for_next_frame(self, taken: Option<[f32; 3]>) -> ColourDrift {
+        match (self, taken) {
+            (ColourDrift::Measured, Some(d)) => ColourDrift::Given(d),
+            _ => self,
+        }
+    }
 }
 
 impl SlopeField {
@@ -37,6 +63,7 @@ impl SlopeField {
             gx: vec![0.0; n],
             gy: vec![0.0; n],
             valid: half.down_valid(&self.valid),
+            drift: None,
         }
     }
 }
@@ -80,6 +107,7 @@ pub fn recover_slopes(
     frame: &RgbImage,
     reference: &RgbImage,
     spec: &TactileSpec,
+    drift: ColourDrift,
 ) -> Option<SlopeField> {
     if frame.dimensions() != reference.dimensions() {
         return None;
@@ -109,6 +137,7 @@ pub fn recover_slopes(
         gx: vec![0.0; w * h],
         gy: vec![0.0; w * h],
         valid,
+        drift: None,
     };
     let Some(table) = &spec.table else {
         for (i, (p, r)) in frame.pixels().zip(reference.pixels()).enumerate() {
@@ -147,7 +176,10 @@ pub fn recover_slopes(
         None => (field, observed, spec.glow.clone()),
     };
     match &glow {
-        Some(glow) => read_through_glow(table, glow, spec, observed, &mut field),
+        Some(glow) => {
+            let taken = read_through_glow(table, glow, spec, observed, &mut field, drift);
+            field.drift = Some(taken);
+        }
         None => {
             read_table(table, &observed, &mut field);
             fill_slope_holes(&mut field, spec);
@@ -168,7 +200,8 @@ fn read_through_glow(
     spec: &TactileSpec,
     observed: Vec<[f32; 3]>,
     field: &mut SlopeField,
-) {
+    drift_given: ColourDrift,
+) -> [f32; 3] {
     let (w, h) = (field.width, field.height);
     let band = outer_band(&field.valid, w, h);
     // The glow is read backwards over the whole frame, so the marker dots' holes are filled
@@ -176,7 +209,11 @@ fn read_through_glow(
     // read like the rest.
     let hole = hole_px(spec, field);
     let observed = fill_holes(&observed, &mut field.valid, w, h, hole);
-    let first = without_drift(&observed, &field.valid, drift(&observed, &band));
+    let first_drift = match drift_given {
+        ColourDrift::Measured => drift(&observed, &band),
+        ColourDrift::Given(d) => d,
+    };
+    let first = without_drift(&observed, &field.valid, first_drift);
     let smoothing_px = NOISE_SMOOTHING_MM / field.mm_per_px;
     let inverse = GlowInverse::shared(glow, w, h, smoothing_px);
     let first_reading = match HalfResolution::of(w, h) {
@@ -192,7 +229,11 @@ fn read_through_glow(
         .copied()
         .filter(|i| depth[*i] < UNTOUCHED_SHARE * peak)
         .collect();
-    let observed = without_drift(&observed, &field.valid, drift(&observed, &untouched));
+    let taken = match drift_given {
+        ColourDrift::Measured => drift(&observed, &untouched),
+        ColourDrift::Given(d) => d,
+    };
+    let observed = without_drift(&observed, &field.valid, taken);
     let linear: Vec<[f32; 3]> = match &first_reading.rest {
         Some(rest) => observed
             .iter()
@@ -207,6 +248,7 @@ fn read_through_glow(
         field,
     );
     take_out_tilt(field, depth, peak);
+    taken
 }
 
 /// The drift is measured over gel the contact's glow and rise still reach, so round a wide
@@ -529,7 +571,7 @@ mod tests {
                 (reference.get_pixel(0, 0)[c] as f64 * g[c]).round() as u8
             }))
         });
-        let s = recover_slopes(&frame, &reference, &spec).unwrap();
+        let s = recover_slopes(&frame, &reference, &spec, ColourDrift::Measured).unwrap();
         let i = 6 * 16 + 8;
         assert!(s.valid[i]);
         // 8-bit quantisation of ~150 levels limits the slope to about 1/100.
@@ -586,7 +628,8 @@ mod tests {
             let change = table.change(gx as f32, gy as f32, u, v);
             Rgb(change.map(|c| (140.0 + c).round().clamp(0.0, 255.0) as u8))
         });
-        let field = recover_slopes(&frame, &reference, &spec).expect("same sizes");
+        let field =
+            recover_slopes(&frame, &reference, &spec, ColourDrift::Measured).expect("same sizes");
         assert_eq!((field.width, field.height), (120, 90));
         assert_eq!(field.mm_per_px, 2.0 * px);
         let read = integrate_slopes(&field);
@@ -606,6 +649,7 @@ mod tests {
             gx: vec![tilt; w * h],
             gy: vec![0.0; w * h],
             valid: vec![true; w * h],
+            drift: None,
         };
         let mut depth = vec![0.0f32; w * h];
         let cy = h as f64 / 2.0;

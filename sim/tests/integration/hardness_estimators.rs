@@ -134,6 +134,7 @@ fn frames_past_the_first_one_cut_by_the_frames_edge_are_not_read() {
                 &f.image,
                 &sequence.reference.image,
                 &spec,
+                tactex_core::tactile::slopes::ColourDrift::Measured,
             )
             .expect("same size")
             .within_frame
@@ -155,4 +156,63 @@ fn frames_past_the_first_one_cut_by_the_frames_edge_are_not_read() {
         format!("{:?}", read.hardness),
         format!("{:?}", read_blanked.hardness)
     );
+}
+
+/// A wide contact's glow lights the gel far from it, where the reader measures the colour
+/// drift; taken for drift, it read the deeper frames of wide presses through the FOTS profile
+/// at up to 3.6x the solver's depth (a 60 mm sphere at 1 MPa: +262%; a 30 mm sphere at 3 MPa:
+/// +93%). A press's frames are taken under the same light, so its deeper frames take the
+/// drift its first frame (the least glow) shows.
+#[test]
+fn a_wide_contacts_glow_is_not_taken_for_colour_drift_in_a_press() {
+    use tactex_core::hardness::border_level::read_share_of_indentation;
+    use tactex_core::tactile::frame_reading::read_frame;
+    use tactex_core::tactile::sensor_profile::SensorProfile;
+    use tactex_core::tactile::slopes::ColourDrift;
+    let profile = SensorProfile::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../tests/fixtures/fots/profile/fots-9.toml"),
+    )
+    .expect("the fixture profile loads");
+    let spec = profile.spec.clone();
+    let optics = SensorOptics::for_profile(&profile);
+    // (sphere radius mm, modulus MPa, centre off the pad's middle mm)
+    for (radius_mm, modulus_mpa, off_mm) in [(60.0, 1.0, 0.0), (30.0, 3.0, 0.0), (40.0, 2.0, 2.0)] {
+        let sphere = ObjectSurface::Sphere {
+            radius_mm,
+            centre_mm: DVec2::splat(off_mm),
+        };
+        let setup = PressSetup {
+            surface: &sphere,
+            object: Elastic {
+                modulus_mpa: Some(modulus_mpa),
+                poisson: 0.35,
+            },
+            gel: spec.gel,
+            fidelity: Fidelity::Layer,
+            optics: &optics,
+            phase_mm: 0.1,
+            cell_mm: None,
+            seed: 5,
+        };
+        let press = plan_press(&mut ContactSolver::new(), &setup, &PressProtocol::default())
+            .expect("the press finds contact");
+        let sequence = press.sequence(press.render(&mut CpuRenderer, &optics).expect("renders"));
+        let mut drift = ColourDrift::Measured;
+        for (k, (truth, frame)) in press.frames.iter().zip(&sequence.frames).enumerate() {
+            let reading = read_frame(&frame.image, &sequence.reference.image, &spec, drift)
+                .expect("same size");
+            drift = drift.for_next_frame(reading.drift);
+            // As the estimator reads it: the peak against the frame's border.
+            let read_mm = reading.peak_mm / read_share_of_indentation(&reading, &spec.gel);
+            let ratio = read_mm / truth.gel_max_indentation_mm;
+            let case =
+                format!("{radius_mm} mm sphere at {modulus_mpa} MPa, frame {k}: {ratio:.2}x");
+            assert!(ratio < 1.6, "{case}");
+            // The first three frames are fitted whatever the frame's edge does.
+            if k < 3 {
+                assert!((ratio - 1.0).abs() < 0.15, "{case}");
+            }
+        }
+    }
 }
