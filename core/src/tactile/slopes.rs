@@ -224,13 +224,15 @@ fn read_through_glow(
     // shading there is not drift, and taken for it the whole imprint reads shallow.
     let depth = &first_reading.indentation_mm;
     let peak = depth.iter().copied().fold(0.0f32, f32::max);
-    let untouched: Vec<usize> = band
-        .iter()
-        .copied()
-        .filter(|i| depth[*i] < UNTOUCHED_SHARE * peak)
-        .collect();
     let taken = match drift_given {
-        ColourDrift::Measured => drift(&observed, &untouched),
+        ColourDrift::Measured => {
+            let untouched: Vec<usize> = band
+                .iter()
+                .copied()
+                .filter(|i| depth[*i] < UNTOUCHED_SHARE * peak)
+                .collect();
+            drift(&observed, &untouched)
+        }
         ColourDrift::Given(d) => d,
     };
     let observed = without_drift(&observed, &field.valid, taken);

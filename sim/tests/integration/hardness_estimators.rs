@@ -2,14 +2,44 @@
 //! the full chain (solver, shading, markers, noise).
 
 use glam::DVec2;
+use tactex_core::hardness::estimate::PressSequence;
 use tactex_core::hardness::estimate::{HardnessEstimator, HertzSlopeEstimator};
 use tactex_core::hardness::indentation_estimator::IndentationEstimator;
 use tactex_core::hertz::Elastic;
 use tactex_core::press::protocol::PressProtocol;
 use tactex_core::tactile::spec::TactileSpec;
 use tactex_sim::contact::{ContactSolver, Fidelity, ObjectSurface};
-use tactex_sim::datagen::press_protocol::{PressSetup, plan_press};
+use tactex_sim::datagen::press_protocol::{PlannedPress, PressSetup, plan_press};
 use tactex_sim::render::gel::{CpuRenderer, SensorOptics};
+
+/// A sphere pressed into the gel of `spec` at `fidelity`, rendered on the
+/// CPU through `optics`: the solver's press and the frames an estimator reads.
+fn press_sphere(
+    spec: &TactileSpec,
+    optics: &SensorOptics,
+    fidelity: Fidelity,
+    sphere: &ObjectSurface,
+    modulus_mpa: f64,
+    seed: u32,
+) -> (PlannedPress, PressSequence) {
+    let setup = PressSetup {
+        surface: sphere,
+        object: Elastic {
+            modulus_mpa: Some(modulus_mpa),
+            poisson: 0.35,
+        },
+        gel: spec.gel,
+        fidelity,
+        optics,
+        phase_mm: 0.1,
+        cell_mm: None,
+        seed,
+    };
+    let press = plan_press(&mut ContactSolver::new(), &setup, &PressProtocol::default())
+        .expect("the press finds contact");
+    let sequence = press.sequence(press.render(&mut CpuRenderer, optics).expect("renders"));
+    (press, sequence)
+}
 
 /// Presses a 25 mm sphere of soft to firm fruit flesh (0.1, 0.4, 1.5 MPa; the 4 mm gel is
 /// 0.3 MPa) at `fidelity` and asserts the estimator reads each modulus back within
@@ -23,22 +53,7 @@ fn reads_back_sphere_moduli(estimator: &dyn HardnessEstimator, fidelity: Fidelit
     };
     let mut last = 0.0;
     for truth in [0.1, 0.4, 1.5] {
-        let setup = PressSetup {
-            surface: &sphere,
-            object: Elastic {
-                modulus_mpa: Some(truth),
-                poisson: 0.35,
-            },
-            gel: spec.gel,
-            fidelity,
-            optics: &optics,
-            phase_mm: 0.1,
-            cell_mm: None,
-            seed: 11,
-        };
-        let press = plan_press(&mut ContactSolver::new(), &setup, &PressProtocol::default())
-            .expect("the press finds contact");
-        let sequence = press.sequence(press.render(&mut CpuRenderer, &optics).expect("renders"));
+        let (_, sequence) = press_sphere(&spec, &optics, fidelity, &sphere, truth, 11);
         let e = estimator
             .estimate(&sequence, &spec)
             .expect("an estimate")
@@ -110,22 +125,7 @@ fn frames_past_the_first_one_cut_by_the_frames_edge_are_not_read() {
         radius_mm: 60.0,
         centre_mm: DVec2::new(0.5, 0.3),
     };
-    let setup = PressSetup {
-        surface: &sphere,
-        object: Elastic {
-            modulus_mpa: Some(0.3),
-            poisson: 0.35,
-        },
-        gel: spec.gel,
-        fidelity: Fidelity::Layer,
-        optics: &optics,
-        phase_mm: 0.1,
-        cell_mm: None,
-        seed: 5,
-    };
-    let press = plan_press(&mut ContactSolver::new(), &setup, &PressProtocol::default())
-        .expect("the press finds contact");
-    let sequence = press.sequence(press.render(&mut CpuRenderer, &optics).expect("renders"));
+    let (_, sequence) = press_sphere(&spec, &optics, Fidelity::Layer, &sphere, 0.3, 5);
     let within: Vec<bool> = sequence
         .frames
         .iter()
@@ -182,22 +182,8 @@ fn a_wide_contacts_glow_is_not_taken_for_colour_drift_in_a_press() {
             radius_mm,
             centre_mm: DVec2::splat(off_mm),
         };
-        let setup = PressSetup {
-            surface: &sphere,
-            object: Elastic {
-                modulus_mpa: Some(modulus_mpa),
-                poisson: 0.35,
-            },
-            gel: spec.gel,
-            fidelity: Fidelity::Layer,
-            optics: &optics,
-            phase_mm: 0.1,
-            cell_mm: None,
-            seed: 5,
-        };
-        let press = plan_press(&mut ContactSolver::new(), &setup, &PressProtocol::default())
-            .expect("the press finds contact");
-        let sequence = press.sequence(press.render(&mut CpuRenderer, &optics).expect("renders"));
+        let (press, sequence) =
+            press_sphere(&spec, &optics, Fidelity::Layer, &sphere, modulus_mpa, 5);
         let mut drift = ColourDrift::Measured;
         for (k, (truth, frame)) in press.frames.iter().zip(&sequence.frames).enumerate() {
             let reading = read_frame(&frame.image, &sequence.reference.image, &spec, drift)
